@@ -1,0 +1,190 @@
+//! The edge distance, defined once: the f64 twin of `edge_eval` in `shaders/common.wgsl`.
+//!
+//! A clip-space vertex `(x, y, z, w)` maps to homogeneous pixel coordinates
+//! `P = ((x + w)/2 · W, (w − y)/2 · H, w)`. The screen line through an edge is `L = Pa × Pb`
+//! and the distance of pixel centre `p = (px, py, 1)` to it is `|L · p| / ‖L.xy‖` pixels.
+//! Nothing divides by `w`, so the result stays exact when a vertex is at or behind the eye
+//! (Olano & Greer 1997). Coordinates are taken relative to the pixel centre, which keeps the
+//! cross products small. An edge with both ends behind the near plane (clip `z < 0`) is not
+//! visible; the three `L · p`, normalised to sum to 1, are the perspective-correct
+//! barycentrics.
+
+use glam::{DVec2, DVec3, DVec4};
+
+/// Distance reported for an edge that is masked out, not visible, or degenerate.
+pub const NO_EDGE: f64 = f64::INFINITY;
+
+/// Result of [`edge_eval`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EdgeEval {
+    /// Pixels from the pixel centre to the screen line of edge `i` (corner `i` → `i + 1`).
+    pub distance: [f64; 3],
+    /// Perspective-correct barycentrics of the pixel centre.
+    pub bary: [f64; 3],
+}
+
+impl EdgeEval {
+    /// Distance to the nearest drawn edge.
+    pub fn min_distance(&self) -> f64 {
+        self.distance[0].min(self.distance[1]).min(self.distance[2])
+    }
+}
+
+/// Homogeneous pixel coordinates of a clip-space vertex, relative to the pixel centre.
+pub fn pixel_relative(clip: DVec4, pixel: DVec2, size: DVec2) -> DVec3 {
+    let half = 0.5 * size;
+    DVec3::new(
+        clip.x * half.x + clip.w * (half.x - pixel.x),
+        clip.w * (half.y - pixel.y) - clip.y * half.y,
+        clip.w,
+    )
+}
+
+/// Edge distances and barycentrics of `pixel` (a pixel centre, e.g. `(x + 0.5, y + 0.5)`) for
+/// the triangle with clip-space corners `clip`; bit `i` of `mask` enables edge `i`.
+pub fn edge_eval(clip: [DVec4; 3], mask: u8, pixel: DVec2, size: DVec2) -> EdgeEval {
+    let p = clip.map(|c| pixel_relative(c, pixel, size));
+    let l = [p[0].cross(p[1]), p[1].cross(p[2]), p[2].cross(p[0])];
+    let behind = clip.map(|c| c.z < 0.0);
+    let distance = std::array::from_fn(|i| {
+        let drawn = mask & (1 << i) != 0 && !(behind[i] && behind[(i + 1) % 3]);
+        line_distance(l[i], drawn)
+    });
+    let e = [l[1].z, l[2].z, l[0].z];
+    let sum = e[0] + e[1] + e[2];
+    let bary = if sum != 0.0 {
+        e.map(|v| v / sum)
+    } else {
+        [1.0 / 3.0; 3]
+    };
+    EdgeEval { distance, bary }
+}
+
+fn line_distance(l: DVec3, drawn: bool) -> f64 {
+    let len = l.truncate().length();
+    if !drawn || !(len > 0.0) {
+        return NO_EDGE;
+    }
+    l.z.abs() / len
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SIZE: DVec2 = DVec2::new(200.0, 100.0);
+
+    /// Clip coordinates of a screen point at depth w (z set in front of the near plane).
+    fn at(sx: f64, sy: f64, w: f64) -> DVec4 {
+        DVec4::new(
+            (2.0 * sx / SIZE.x - 1.0) * w,
+            (1.0 - 2.0 * sy / SIZE.y) * w,
+            0.5 * w,
+            w,
+        )
+    }
+
+    #[test]
+    fn distances_in_pixels_on_screen_triangle() {
+        // Right triangle with legs on x = 10 and y = 10 (screen), hypotenuse x + y = 120.
+        let tri = [
+            at(10.0, 10.0, 1.0),
+            at(110.0, 10.0, 2.0),
+            at(10.0, 110.0, 3.0),
+        ];
+        let e = edge_eval(tri, 0b111, DVec2::new(20.5, 30.5), SIZE);
+        assert!((e.distance[0] - 20.5).abs() < 1e-9); // edge 0: y = 10
+        assert!((e.distance[2] - 10.5).abs() < 1e-9); // edge 2: x = 10
+        assert!((e.distance[1] - (120.0 - 51.0) / 2f64.sqrt()).abs() < 1e-9);
+        let sum: f64 = e.bary.iter().sum();
+        assert!((sum - 1.0).abs() < 1e-12);
+        // Masked edges are infinitely far.
+        let e = edge_eval(tri, 0b010, DVec2::new(20.5, 30.5), SIZE);
+        assert_eq!(e.min_distance(), e.distance[1]);
+    }
+
+    #[test]
+    fn barycentrics_are_perspective_correct() {
+        let view_proj = glam::dcamera::rh::proj::directx::perspective(1.0, 2.0, 0.1, 100.0)
+            * glam::dcamera::rh::view::look_at_mat4(
+                DVec3::new(0.3, 0.2, 4.0),
+                DVec3::ZERO,
+                DVec3::Y,
+            );
+        let world = [
+            DVec3::new(-1.0, -1.0, 0.0),
+            DVec3::new(2.0, -0.5, -3.0),
+            DVec3::new(0.0, 1.5, 1.0),
+        ];
+        let clip = world.map(|p| view_proj * p.extend(1.0));
+        // A known interior point: project it, evaluate there, recover its weights.
+        let weights = [0.2, 0.5, 0.3];
+        let q = world[0] * weights[0] + world[1] * weights[1] + world[2] * weights[2];
+        let c = view_proj * q.extend(1.0);
+        let pixel = DVec2::new(
+            (c.x / c.w + 1.0) * 0.5 * SIZE.x,
+            (1.0 - c.y / c.w) * 0.5 * SIZE.y,
+        );
+        let e = edge_eval(clip, 0b111, pixel, SIZE);
+        for i in 0..3 {
+            assert!((e.bary[i] - weights[i]).abs() < 1e-9, "{:?}", e.bary);
+        }
+    }
+
+    #[test]
+    fn exact_with_a_vertex_behind_the_eye() {
+        // The 3D segment from a (in front) to b (behind the eye) projects to the ray from
+        // a's image away from b's "image" through infinity: the line is the same line.
+        let view_proj = glam::dcamera::rh::proj::directx::perspective(1.2, 2.0, 0.1, 100.0);
+        let a = DVec3::new(0.5, 0.2, -2.0);
+        let b = DVec3::new(-0.3, 0.1, 1.0); // behind the eye (z > 0 in view space)
+        let c = DVec3::new(0.0, -1.0, -3.0);
+        let clip = [a, b, c].map(|p| view_proj * p.extend(1.0));
+        assert!(clip[1].w < 0.0);
+        // A point on segment a-b in front of the near plane lies on edge 0's line.
+        let q = a.lerp(b, 0.3);
+        let cq = view_proj * q.extend(1.0);
+        assert!(cq.w > 0.1);
+        let pixel = DVec2::new(
+            (cq.x / cq.w + 1.0) * 0.5 * SIZE.x,
+            (1.0 - cq.y / cq.w) * 0.5 * SIZE.y,
+        );
+        let e = edge_eval(clip, 0b111, pixel, SIZE);
+        assert!(e.distance[0] < 1e-9, "{:?}", e.distance);
+        assert!(e.distance.iter().all(|d| d.is_finite()));
+    }
+
+    #[test]
+    fn edges_behind_the_near_plane_are_invisible() {
+        let mut tri = [
+            at(10.0, 10.0, 1.0),
+            at(110.0, 10.0, 2.0),
+            at(10.0, 110.0, 3.0),
+        ];
+        tri[0].z = -0.1;
+        tri[1].z = -0.2;
+        let e = edge_eval(tri, 0b111, DVec2::new(20.5, 30.5), SIZE);
+        assert_eq!(e.distance[0], NO_EDGE);
+        assert!(e.distance[1].is_finite() && e.distance[2].is_finite());
+    }
+
+    #[test]
+    fn degenerate_triangles_give_no_nan() {
+        let p = at(50.0, 50.0, 1.0);
+        let e = edge_eval([p, p, p], 0b111, DVec2::new(50.5, 50.5), SIZE);
+        assert!(e.distance.iter().all(|d| *d == NO_EDGE));
+        assert!(e.bary.iter().all(|b| b.is_finite()));
+        let e = edge_eval(
+            [
+                at(0.0, 0.0, 1.0),
+                at(50.0, 50.0, 1.0),
+                at(100.0, 100.0, 1.0),
+            ],
+            0b111,
+            DVec2::new(20.5, 20.5),
+            SIZE,
+        );
+        assert!(e.distance.iter().all(|d| !d.is_nan()));
+        assert!(e.bary.iter().all(|b| b.is_finite()));
+    }
+}

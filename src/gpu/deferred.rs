@@ -1,0 +1,575 @@
+//! The deferred wireframe pass: a visibility raster pass (triangle id + depth) followed by a
+//! compute pass that reconstructs each pixel's distance to its triangle's edges.
+
+use super::{check_size, shaders, FrameUniforms, GpuMesh};
+use crate::camera::Camera;
+use crate::error::{Error, Result};
+use crate::style::Style;
+use wgpu::util::DeviceExt;
+
+/// Format of the triangle-id target; `u32::MAX` marks background.
+pub const ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
+/// Format of the depth target (reverse-Z: 1 at the near plane, 0 at the far plane).
+pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// Format of the diagnostic distance map.
+pub const DISTANCE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+/// Edge-pass workgroup side (8 × 8 pixels).
+const TILE: u32 = 8;
+
+/// Construction options.
+#[derive(Clone, Copy, Debug)]
+pub struct PassOptions {
+    /// Format of the texture the pass writes: `Rgba8Unorm` (written sRGB-encoded),
+    /// `Rgba16Float` or `Rgba32Float` (linear). It needs `STORAGE_BINDING` usage.
+    pub output_format: wgpu::TextureFormat,
+}
+
+impl Default for PassOptions {
+    fn default() -> Self {
+        Self {
+            output_format: wgpu::TextureFormat::Rgba8Unorm,
+        }
+    }
+}
+
+/// Where the edge pass writes.
+pub enum OutputTarget<'a> {
+    /// Shade the surface and draw the lines over it.
+    Shaded(&'a wgpu::TextureView),
+    /// Post-process: blend the lines over the host's colour image `host` (a sampled
+    /// texture of the same size) into `output`. Background pixels copy `host`.
+    Overlay {
+        /// The host's rendered colour, read as a float texture.
+        host: &'a wgpu::TextureView,
+        /// Where the blended image goes (the pass's output format).
+        output: &'a wgpu::TextureView,
+    },
+    /// The raw per-pixel distance (pixels) into the pass's own `R32Float` texture, see
+    /// [`DeferredPass::distance_texture`].
+    Distance,
+}
+
+/// Size-dependent targets, rebuilt only when the size changes.
+struct Targets {
+    size: (u32, u32),
+    ids: wgpu::Texture,
+    depth: wgpu::Texture,
+    distance: wgpu::Texture,
+}
+
+/// The deferred wireframe pass. Construct once with [`DeferredPass::new`], call
+/// [`prepare`](Self::prepare) when the camera, style or size changes, then
+/// [`encode`](Self::encode) into the host's command encoder each frame.
+pub struct DeferredPass {
+    format: wgpu::TextureFormat,
+    pulled: bool,
+    visibility: wgpu::RenderPipeline,
+    visibility_layout: wgpu::BindGroupLayout,
+    mesh_layout: wgpu::BindGroupLayout,
+    shade: (wgpu::ComputePipeline, wgpu::BindGroupLayout),
+    overlay: (wgpu::ComputePipeline, wgpu::BindGroupLayout),
+    distance: (wgpu::ComputePipeline, wgpu::BindGroupLayout),
+    frame: wgpu::Buffer,
+    draw: wgpu::Buffer,
+    targets: Option<Targets>,
+}
+
+fn entry(
+    binding: u32,
+    visibility: wgpu::ShaderStages,
+    ty: wgpu::BindingType,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty,
+        count: None,
+    }
+}
+
+fn uniform() -> wgpu::BindingType {
+    wgpu::BindingType::Buffer {
+        ty: wgpu::BufferBindingType::Uniform,
+        has_dynamic_offset: false,
+        min_binding_size: None,
+    }
+}
+
+fn storage() -> wgpu::BindingType {
+    wgpu::BindingType::Buffer {
+        ty: wgpu::BufferBindingType::Storage { read_only: true },
+        has_dynamic_offset: false,
+        min_binding_size: None,
+    }
+}
+
+fn texture(sample_type: wgpu::TextureSampleType) -> wgpu::BindingType {
+    wgpu::BindingType::Texture {
+        sample_type,
+        view_dimension: wgpu::TextureViewDimension::D2,
+        multisampled: false,
+    }
+}
+
+fn storage_texture(format: wgpu::TextureFormat) -> wgpu::BindingType {
+    wgpu::BindingType::StorageTexture {
+        access: wgpu::StorageTextureAccess::WriteOnly,
+        format,
+        view_dimension: wgpu::TextureViewDimension::D2,
+    }
+}
+
+impl DeferredPass {
+    /// Builds the pipelines. Uses `@builtin(primitive_index)` where the device has
+    /// `Features::PRIMITIVE_INDEX`, and a vertex-pulling visibility pass otherwise.
+    pub fn new(device: &wgpu::Device, options: PassOptions) -> Result<Self> {
+        let format = options.output_format;
+        let edge_source = shaders::edge_pass(format).ok_or_else(|| {
+            Error::InvalidSetting(format!(
+                "output format {format:?} is not one the edge pass can write (Rgba8Unorm, Rgba16Float, Rgba32Float)"
+            ))
+        })?;
+        let pulled = !device.features().contains(wgpu::Features::PRIMITIVE_INDEX);
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+
+        let vs = wgpu::ShaderStages::VERTEX;
+        let fs = wgpu::ShaderStages::FRAGMENT;
+        let cs = wgpu::ShaderStages::COMPUTE;
+        let mut vis_entries = vec![entry(0, vs, uniform()), entry(1, fs | vs, uniform())];
+        if pulled {
+            vis_entries.push(entry(2, vs, storage()));
+            vis_entries.push(entry(3, vs, storage()));
+        }
+        let visibility_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("wirepass visibility"),
+            entries: &vis_entries,
+        });
+        let vis_source = shaders::assemble(if pulled {
+            shaders::VISIBILITY_PULLED
+        } else {
+            shaders::VISIBILITY
+        });
+        let vis_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("wirepass visibility"),
+            source: wgpu::ShaderSource::Wgsl(vis_source.into()),
+        });
+        let vis_pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("wirepass visibility"),
+            bind_group_layouts: &[Some(&visibility_layout)],
+            immediate_size: 0,
+        });
+        let position_layout = wgpu::VertexBufferLayout {
+            array_stride: 12,
+            step_mode: wgpu::VertexStepMode::Vertex,
+            attributes: &wgpu::vertex_attr_array![0 => Float32x3],
+        };
+        let buffers = if pulled {
+            vec![]
+        } else {
+            vec![Some(position_layout)]
+        };
+        let visibility = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("wirepass visibility"),
+            layout: Some(&vis_pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &vis_module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &buffers,
+            },
+            primitive: wgpu::PrimitiveState::default(),
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Greater),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &vis_module,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &[Some(ID_FORMAT.into())],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+
+        let mesh_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("wirepass edge pass mesh"),
+            entries: &[
+                entry(0, cs, uniform()),
+                entry(1, cs, storage()),
+                entry(2, cs, storage()),
+                entry(3, cs, storage()),
+                entry(4, cs, storage()),
+                entry(5, cs, texture(wgpu::TextureSampleType::Uint)),
+            ],
+        });
+        let edge_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("wirepass edge pass"),
+            source: wgpu::ShaderSource::Wgsl(edge_source.into()),
+        });
+        let compute = |name: &str, entries: &[wgpu::BindGroupLayoutEntry]| {
+            let out_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some(name),
+                entries,
+            });
+            let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some(name),
+                bind_group_layouts: &[Some(&mesh_layout), Some(&out_layout)],
+                immediate_size: 0,
+            });
+            let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(name),
+                layout: Some(&layout),
+                module: &edge_module,
+                entry_point: Some(name),
+                compilation_options: Default::default(),
+                cache: None,
+            });
+            (pipeline, out_layout)
+        };
+        let shade = compute("shade_main", &[entry(0, cs, storage_texture(format))]);
+        let overlay = compute(
+            "overlay_main",
+            &[
+                entry(1, cs, storage_texture(format)),
+                entry(
+                    2,
+                    cs,
+                    texture(wgpu::TextureSampleType::Float { filterable: false }),
+                ),
+            ],
+        );
+        let distance = compute(
+            "distance_main",
+            &[entry(3, cs, storage_texture(DISTANCE_FORMAT))],
+        );
+
+        let frame = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("wirepass frame"),
+            size: std::mem::size_of::<FrameUniforms>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let draw = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("wirepass draw"),
+            contents: bytemuck::bytes_of(&[0u32; 4]),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(Error::Device(format!("creating the deferred pass: {e}")));
+        }
+        Ok(Self {
+            format,
+            pulled,
+            visibility,
+            visibility_layout,
+            mesh_layout,
+            shade,
+            overlay,
+            distance,
+            frame,
+            draw,
+            targets: None,
+        })
+    }
+
+    /// True when the visibility pass pulls vertices because the device lacks
+    /// `PRIMITIVE_INDEX`.
+    pub fn uses_vertex_pulling(&self) -> bool {
+        self.pulled
+    }
+
+    /// The output format chosen at construction.
+    pub fn output_format(&self) -> wgpu::TextureFormat {
+        self.format
+    }
+
+    /// Validates the camera, style and size, uploads the frame's uniforms, and (re)builds the
+    /// id, depth and distance targets when the size changed.
+    pub fn prepare(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        mesh: &GpuMesh,
+        camera: &Camera,
+        style: &Style,
+        size: (u32, u32),
+    ) -> Result<()> {
+        check_size(device, size)?;
+        camera.validate()?;
+        style.validate()?;
+        let uniforms = FrameUniforms::new(camera, style, size, mesh.origin());
+        queue.write_buffer(&self.frame, 0, bytemuck::bytes_of(&uniforms));
+        if self.targets.as_ref().map(|t| t.size) != Some(size) {
+            let make = |label, format, usage| {
+                device.create_texture(&wgpu::TextureDescriptor {
+                    label: Some(label),
+                    size: wgpu::Extent3d {
+                        width: size.0,
+                        height: size.1,
+                        depth_or_array_layers: 1,
+                    },
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format,
+                    usage,
+                    view_formats: &[],
+                })
+            };
+            use wgpu::TextureUsages as U;
+            self.targets = Some(Targets {
+                size,
+                ids: make(
+                    "wirepass ids",
+                    ID_FORMAT,
+                    U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC,
+                ),
+                depth: make(
+                    "wirepass depth",
+                    DEPTH_FORMAT,
+                    U::RENDER_ATTACHMENT | U::COPY_SRC,
+                ),
+                distance: make(
+                    "wirepass distance",
+                    DISTANCE_FORMAT,
+                    U::STORAGE_BINDING | U::COPY_SRC,
+                ),
+            });
+        }
+        Ok(())
+    }
+
+    fn targets(&self) -> Result<&Targets> {
+        self.targets
+            .as_ref()
+            .ok_or_else(|| Error::InvalidSetting("encode called before prepare".into()))
+    }
+
+    /// The size the pass was last prepared for.
+    pub fn size(&self) -> Option<(u32, u32)> {
+        self.targets.as_ref().map(|t| t.size)
+    }
+
+    /// The triangle-id target (`R32Uint`, `u32::MAX` = background) of the last frame.
+    pub fn id_texture(&self) -> Option<&wgpu::Texture> {
+        self.targets.as_ref().map(|t| &t.ids)
+    }
+
+    /// The reverse-Z depth target (`Depth32Float`, 1 = near plane) of the last frame.
+    pub fn depth_texture(&self) -> Option<&wgpu::Texture> {
+        self.targets.as_ref().map(|t| &t.depth)
+    }
+
+    /// The distance map written by [`OutputTarget::Distance`].
+    pub fn distance_texture(&self) -> Option<&wgpu::Texture> {
+        self.targets.as_ref().map(|t| &t.distance)
+    }
+
+    /// Records the visibility pass and the edge pass into `encoder`.
+    pub fn encode(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        mesh: &GpuMesh,
+        target: OutputTarget<'_>,
+    ) -> Result<()> {
+        self.encode_visibility(device, encoder, mesh)?;
+        self.encode_edges(device, encoder, mesh, target)
+    }
+
+    /// Records only the visibility pass (triangle ids and depth).
+    pub fn encode_visibility(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        mesh: &GpuMesh,
+    ) -> Result<()> {
+        let targets = self.targets()?;
+        let ids = targets.ids.create_view(&Default::default());
+        let depth = targets.depth.create_view(&Default::default());
+        let mut entries = vec![
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: self.frame.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: self.draw.as_entire_binding(),
+            },
+        ];
+        if self.pulled {
+            entries.push(wgpu::BindGroupEntry {
+                binding: 2,
+                resource: mesh.positions.as_entire_binding(),
+            });
+            entries.push(wgpu::BindGroupEntry {
+                binding: 3,
+                resource: mesh.indices.as_entire_binding(),
+            });
+        }
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("wirepass visibility"),
+            layout: &self.visibility_layout,
+            entries: &entries,
+        });
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("wirepass visibility"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &ids,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color {
+                        r: f64::from(u32::MAX),
+                        g: 0.0,
+                        b: 0.0,
+                        a: 0.0,
+                    }),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &depth,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(0.0),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.visibility);
+        pass.set_bind_group(0, &group, &[]);
+        if self.pulled {
+            pass.draw(0..3 * mesh.triangles, 0..1);
+        } else {
+            pass.set_vertex_buffer(0, mesh.positions.slice(..));
+            pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
+            pass.draw_indexed(0..3 * mesh.triangles, 0, 0..1);
+        }
+        Ok(())
+    }
+
+    /// Records only the edge pass; the visibility pass of this frame must precede it.
+    pub fn encode_edges(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        mesh: &GpuMesh,
+        target: OutputTarget<'_>,
+    ) -> Result<()> {
+        let targets = self.targets()?;
+        let ids = targets.ids.create_view(&Default::default());
+        let mesh_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("wirepass edge pass mesh"),
+            layout: &self.mesh_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: self.frame.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: mesh.positions.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: mesh.normals.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: mesh.indices.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: mesh.edge_masks.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: wgpu::BindingResource::TextureView(&ids),
+                },
+            ],
+        });
+        let check = |view: &wgpu::TextureView, what: &str| -> Result<()> {
+            let t = view.texture();
+            if (t.width(), t.height()) != targets.size {
+                return Err(Error::InvalidSetting(format!(
+                    "{what} is {}x{}, but the pass was prepared for {}x{}",
+                    t.width(),
+                    t.height(),
+                    targets.size.0,
+                    targets.size.1
+                )));
+            }
+            Ok(())
+        };
+        let distance_view;
+        let (pipeline, layout, entries) = match target {
+            OutputTarget::Shaded(out) => {
+                check(out, "the output texture")?;
+                (
+                    &self.shade.0,
+                    &self.shade.1,
+                    vec![wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: wgpu::BindingResource::TextureView(out),
+                    }],
+                )
+            }
+            OutputTarget::Overlay { host, output } => {
+                check(output, "the output texture")?;
+                check(host, "the host colour texture")?;
+                (
+                    &self.overlay.0,
+                    &self.overlay.1,
+                    vec![
+                        wgpu::BindGroupEntry {
+                            binding: 1,
+                            resource: wgpu::BindingResource::TextureView(output),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 2,
+                            resource: wgpu::BindingResource::TextureView(host),
+                        },
+                    ],
+                )
+            }
+            OutputTarget::Distance => {
+                distance_view = targets.distance.create_view(&Default::default());
+                (
+                    &self.distance.0,
+                    &self.distance.1,
+                    vec![wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: wgpu::BindingResource::TextureView(&distance_view),
+                    }],
+                )
+            }
+        };
+        let out_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("wirepass edge pass output"),
+            layout,
+            entries: &entries,
+        });
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("wirepass edge pass"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, &mesh_group, &[]);
+        pass.set_bind_group(1, &out_group, &[]);
+        pass.dispatch_workgroups(
+            targets.size.0.div_ceil(TILE),
+            targets.size.1.div_ceil(TILE),
+            1,
+        );
+        Ok(())
+    }
+}

@@ -1,0 +1,36 @@
+//! GPU side: device creation, mesh buffers, the per-frame uniforms and the passes.
+
+mod context;
+mod deferred;
+mod frame;
+mod mesh;
+mod readback;
+pub mod shaders;
+
+pub use context::{GpuContext, OPTIONAL_FEATURES};
+pub use deferred::{DeferredPass, OutputTarget, PassOptions};
+pub use frame::FrameUniforms;
+pub use mesh::GpuMesh;
+pub use readback::read_texture;
+
+use crate::error::{Error, Result};
+
+/// Checks an image size against the device: non-zero and within `max_texture_dimension_2d`.
+pub fn check_size(device: &wgpu::Device, (width, height): (u32, u32)) -> Result<()> {
+    if width == 0 || height == 0 {
+        return Err(Error::InvalidSetting(format!(
+            "image size {width}x{height} has a zero side"
+        )));
+    }
+    let limit = device.limits().max_texture_dimension_2d;
+    let side = width.max(height);
+    if side > limit {
+        return Err(Error::OverLimit {
+            what: format!("image side of {width}x{height}"),
+            value: u64::from(side),
+            limit_name: "max_texture_dimension_2d",
+            limit: u64::from(limit),
+        });
+    }
+    Ok(())
+}

@@ -1,0 +1,237 @@
+//! Triangle meshes as every method sees them: positions, smooth normals, triangles, and the
+//! per-triangle mask that says which triangle edges were edges of the source polygons.
+
+mod obj;
+mod procedural;
+
+pub use obj::load_obj;
+pub use procedural::{default_scene, grid, sphere, torus, Procedural};
+
+use crate::error::{Error, Result};
+use glam::Vec3;
+
+/// All three edges of a triangle. Edge `i` runs from corner `i` to corner `(i + 1) % 3`.
+pub const ALL_EDGES: u8 = 0b111;
+
+/// Which triangle edges are drawn.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum EdgeSelection {
+    /// Every triangle edge, diagonals of triangulated polygons included.
+    All,
+    /// Only edges of the source polygons: the diagonals a triangulation adds are left out.
+    #[default]
+    Polygon,
+}
+
+/// A validated triangle mesh. All objects and groups of a file form one mesh, so triangle
+/// ids (the index into [`Mesh::triangles`]) are global across the scene.
+#[derive(Clone, Debug)]
+pub struct Mesh {
+    positions: Vec<Vec3>,
+    normals: Vec<Vec3>,
+    triangles: Vec<[u32; 3]>,
+    polygon_edges: Vec<u8>,
+}
+
+impl Mesh {
+    /// Builds a mesh, checking that every coordinate is finite and every index in range.
+    ///
+    /// `normals`, when given, has one entry per position; otherwise area-weighted smooth
+    /// normals are computed. `polygon_edges`, when given, has one 3-bit mask per triangle
+    /// (bit `i` set: edge `i` is a polygon edge); otherwise every edge is a polygon edge.
+    pub fn new(
+        positions: Vec<Vec3>,
+        normals: Option<Vec<Vec3>>,
+        triangles: Vec<[u32; 3]>,
+        polygon_edges: Option<Vec<u8>>,
+    ) -> Result<Self> {
+        if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
+            return Err(Error::InvalidMesh(format!(
+                "vertex {i} has a non-finite coordinate {:?}",
+                positions[i]
+            )));
+        }
+        if triangles.is_empty() {
+            return Err(Error::InvalidMesh("the mesh has no triangles".into()));
+        }
+        let n = positions.len();
+        if n > u32::MAX as usize {
+            return Err(Error::InvalidMesh(format!(
+                "{n} vertices exceed u32 indexing"
+            )));
+        }
+        for (t, tri) in triangles.iter().enumerate() {
+            if let Some(&v) = tri.iter().find(|&&v| v as usize >= n) {
+                return Err(Error::InvalidMesh(format!(
+                    "triangle {t} refers to vertex {v}, but there are only {n} vertices"
+                )));
+            }
+        }
+        if triangles.len() >= u32::MAX as usize {
+            return Err(Error::InvalidMesh(format!(
+                "{} triangles exceed the id range (u32::MAX is the background id)",
+                triangles.len()
+            )));
+        }
+        let polygon_edges = match polygon_edges {
+            Some(mask) if mask.len() != triangles.len() => {
+                return Err(Error::InvalidMesh(format!(
+                    "{} edge masks for {} triangles",
+                    mask.len(),
+                    triangles.len()
+                )))
+            }
+            Some(mask) => mask.into_iter().map(|m| m & ALL_EDGES).collect(),
+            None => vec![ALL_EDGES; triangles.len()],
+        };
+        let normals = match normals {
+            Some(normals) if normals.len() != n => {
+                return Err(Error::InvalidMesh(format!(
+                    "{} normals for {n} vertices",
+                    normals.len()
+                )))
+            }
+            Some(normals) => {
+                if let Some(i) = normals.iter().position(|v| !v.is_finite()) {
+                    return Err(Error::InvalidMesh(format!(
+                        "normal {i} has a non-finite component"
+                    )));
+                }
+                normals
+                    .into_iter()
+                    .map(|v| v.try_normalize().unwrap_or(Vec3::ZERO))
+                    .collect()
+            }
+            None => smooth_normals(&positions, &triangles),
+        };
+        Ok(Self {
+            positions,
+            normals,
+            triangles,
+            polygon_edges,
+        })
+    }
+
+    /// Vertex positions.
+    pub fn positions(&self) -> &[Vec3] {
+        &self.positions
+    }
+
+    /// Unit vertex normals (zero where a vertex touches only degenerate triangles).
+    pub fn normals(&self) -> &[Vec3] {
+        &self.normals
+    }
+
+    /// Triangles as vertex indices; a triangle's position in this slice is its id.
+    pub fn triangles(&self) -> &[[u32; 3]] {
+        &self.triangles
+    }
+
+    /// Number of triangles.
+    pub fn triangle_count(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// The per-triangle 3-bit mask of edges to draw for `selection`.
+    pub fn edge_mask(&self, selection: EdgeSelection) -> Vec<u8> {
+        match selection {
+            EdgeSelection::All => vec![ALL_EDGES; self.triangles.len()],
+            EdgeSelection::Polygon => self.polygon_edges.clone(),
+        }
+    }
+
+    /// Axis-aligned bounds `(min, max)` of the positions that triangles use.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        for tri in &self.triangles {
+            for &v in tri {
+                let p = self.positions[v as usize];
+                lo = lo.min(p);
+                hi = hi.max(p);
+            }
+        }
+        (lo, hi)
+    }
+
+    /// Concatenates meshes into one scene; ids of later meshes follow those of earlier ones.
+    pub fn merge(meshes: &[Mesh]) -> Result<Mesh> {
+        let mut positions = Vec::new();
+        let mut normals = Vec::new();
+        let mut triangles = Vec::new();
+        let mut polygon_edges = Vec::new();
+        for m in meshes {
+            let base = positions.len() as u32;
+            positions.extend_from_slice(&m.positions);
+            normals.extend_from_slice(&m.normals);
+            triangles.extend(m.triangles.iter().map(|t| t.map(|v| v + base)));
+            polygon_edges.extend_from_slice(&m.polygon_edges);
+        }
+        Mesh::new(positions, Some(normals), triangles, Some(polygon_edges))
+    }
+}
+
+/// Area-weighted vertex normals: each triangle adds its unnormalised cross product, whose
+/// length is twice its area, to its three corners.
+pub fn smooth_normals(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
+    let mut acc = vec![glam::DVec3::ZERO; positions.len()];
+    for tri in triangles {
+        let [a, b, c] = tri.map(|v| positions[v as usize].as_dvec3());
+        let n = (b - a).cross(c - a);
+        for &v in tri {
+            acc[v as usize] += n;
+        }
+    }
+    acc.into_iter()
+        .map(|n| n.try_normalize().unwrap_or(glam::DVec3::ZERO).as_vec3())
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn quad() -> Mesh {
+        let p = vec![
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(1.0, 1.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+        ];
+        Mesh::new(
+            p,
+            None,
+            vec![[0, 1, 2], [0, 2, 3]],
+            Some(vec![0b011, 0b110]),
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn smooth_normals_of_a_flat_quad_point_up() {
+        for n in quad().normals() {
+            assert!((*n - Vec3::Z).length() < 1e-6);
+        }
+    }
+
+    #[test]
+    fn rejects_bad_indices_and_nan() {
+        let p = vec![Vec3::ZERO, Vec3::X, Vec3::Y];
+        assert!(Mesh::new(p.clone(), None, vec![[0, 1, 3]], None).is_err());
+        assert!(Mesh::new(p.clone(), None, vec![], None).is_err());
+        let mut bad = p;
+        bad[1].y = f32::NAN;
+        assert!(Mesh::new(bad, None, vec![[0, 1, 2]], None).is_err());
+    }
+
+    #[test]
+    fn merge_offsets_indices() {
+        let m = Mesh::merge(&[quad(), quad()]).unwrap();
+        assert_eq!(m.triangles()[2], [4, 5, 6]);
+        assert_eq!(
+            m.edge_mask(EdgeSelection::Polygon),
+            vec![0b011, 0b110, 0b011, 0b110]
+        );
+        assert_eq!(m.edge_mask(EdgeSelection::All), vec![ALL_EDGES; 4]);
+    }
+}

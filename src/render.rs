@@ -1,0 +1,186 @@
+//! Offscreen rendering for the CLI, tools and tests: one frame into CPU images and maps.
+
+use crate::camera::Camera;
+use crate::error::{Error, Result};
+use crate::gpu::{read_texture, DeferredPass, GpuContext, GpuMesh, OutputTarget, PassOptions};
+use crate::mesh::{EdgeSelection, Mesh};
+use crate::style::Style;
+use std::path::Path;
+
+/// What to render.
+#[derive(Clone, Debug)]
+pub struct Scene<'a> {
+    /// The mesh.
+    pub mesh: &'a Mesh,
+    /// The camera.
+    pub camera: Camera,
+    /// Colours, line width, lighting.
+    pub style: Style,
+    /// Image size in pixels.
+    pub size: (u32, u32),
+    /// Which edges are drawn.
+    pub edges: EdgeSelection,
+}
+
+/// One rendered frame on the CPU. Maps are row-major, row 0 at the top.
+#[derive(Clone, Debug)]
+pub struct Frame {
+    /// Width and height in pixels.
+    pub size: (u32, u32),
+    /// 8-bit sRGB RGBA image.
+    pub rgba: Vec<u8>,
+    /// Visible triangle per pixel, `u32::MAX` on background.
+    pub ids: Vec<u32>,
+    /// Depth in the `perspective_rh` convention: 0 at the near plane, 1 at the far plane
+    /// and on background.
+    pub depth: Vec<f32>,
+    /// Pixels to the nearest drawn edge of the visible triangle; `inf` on background and
+    /// where no edge of the triangle is drawn.
+    pub edge_distance: Vec<f32>,
+}
+
+/// Renders `scene` with the deferred pass and reads back the image and all maps.
+pub fn render_deferred(ctx: &GpuContext, scene: &Scene<'_>) -> Result<Frame> {
+    let device = &ctx.device;
+    let mut pass = DeferredPass::new(device, PassOptions::default())?;
+    let mesh = GpuMesh::new(device, scene.mesh, scene.edges)?;
+    pass.prepare(
+        device,
+        &ctx.queue,
+        &mesh,
+        &scene.camera,
+        &scene.style,
+        scene.size,
+    )?;
+    let (width, height) = scene.size;
+    let output = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("wirepass output"),
+        size: wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: pass.output_format(),
+        usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    });
+    let view = output.create_view(&Default::default());
+    let mut encoder = device.create_command_encoder(&Default::default());
+    pass.encode(device, &mut encoder, &mesh, OutputTarget::Shaded(&view))?;
+    pass.encode_edges(device, &mut encoder, &mesh, OutputTarget::Distance)?;
+    ctx.queue.submit([encoder.finish()]);
+    ctx.finish()?;
+
+    let all = wgpu::TextureAspect::All;
+    let missing = || Error::Device("the pass has no targets after prepare".into());
+    let rgba = read_texture(device, &ctx.queue, &output, all)?;
+    let ids = read_texture(
+        device,
+        &ctx.queue,
+        pass.id_texture().ok_or_else(missing)?,
+        all,
+    )?;
+    let depth = read_texture(
+        device,
+        &ctx.queue,
+        pass.depth_texture().ok_or_else(missing)?,
+        wgpu::TextureAspect::DepthOnly,
+    )?;
+    let distance = read_texture(
+        device,
+        &ctx.queue,
+        pass.distance_texture().ok_or_else(missing)?,
+        all,
+    )?;
+    ctx.finish()?;
+    let floats = |bytes: &[u8]| -> Vec<f32> { bytemuck::pod_collect_to_vec(bytes) };
+    Ok(Frame {
+        size: scene.size,
+        rgba,
+        ids: bytemuck::pod_collect_to_vec(&ids),
+        // Reverse-Z back to the 0..1 convention.
+        depth: floats(&depth)
+            .into_iter()
+            .map(|r| (1.0 - f64::from(r)) as f32)
+            .collect(),
+        edge_distance: floats(&distance)
+            .into_iter()
+            .map(|d| if d >= 1e38 { f32::INFINITY } else { d })
+            .collect(),
+    })
+}
+
+impl Frame {
+    /// Writes the image as an sRGB PNG.
+    pub fn save_png(&self, path: &Path) -> Result<()> {
+        image::save_buffer(
+            path,
+            &self.rgba,
+            self.size.0,
+            self.size.1,
+            image::ColorType::Rgba8,
+        )
+        .map_err(|e| Error::Image {
+            path: path.to_owned(),
+            message: e.to_string(),
+        })
+    }
+
+    /// Writes `ids.npy`, `depth.npy`, `edge_distance.npy` and `camera.json` into `dir`.
+    pub fn dump(&self, dir: &Path, camera: &Camera) -> Result<()> {
+        std::fs::create_dir_all(dir).map_err(|source| Error::Io {
+            path: dir.to_owned(),
+            source,
+        })?;
+        let shape = [u64::from(self.size.1), u64::from(self.size.0)];
+        write_npy(&dir.join("ids.npy"), &shape, &self.ids)?;
+        write_npy(&dir.join("depth.npy"), &shape, &self.depth)?;
+        write_npy(&dir.join("edge_distance.npy"), &shape, &self.edge_distance)?;
+        let path = dir.join("camera.json");
+        let text = camera_json(camera, self.size);
+        std::fs::write(&path, text).map_err(|source| Error::Io { path, source })
+    }
+}
+
+fn write_npy<T: npyz::Serialize + npyz::AutoSerialize + Copy>(
+    path: &Path,
+    shape: &[u64],
+    data: &[T],
+) -> Result<()> {
+    use npyz::WriterBuilder;
+    let io = |source| Error::Io {
+        path: path.to_owned(),
+        source,
+    };
+    let file = std::io::BufWriter::new(std::fs::File::create(path).map_err(io)?);
+    let mut writer = npyz::WriteOptions::new()
+        .default_dtype()
+        .shape(shape)
+        .writer(file)
+        .begin_nd()
+        .map_err(io)?;
+    writer.extend(data.iter().copied()).map_err(io)?;
+    writer.finish().map_err(io)
+}
+
+/// The camera as JSON: its parameters, the size, and the view and projection matrices
+/// (column-major, f64), so a reader can reproduce every pixel's ray.
+pub fn camera_json(camera: &Camera, size: (u32, u32)) -> String {
+    let v = |x: glam::Vec3| x.to_array().to_vec();
+    let json = serde_json::json!({
+        "eye": v(camera.eye),
+        "target": v(camera.target),
+        "up": v(camera.up),
+        "fov_y_deg": camera.fov_y_deg,
+        "near": camera.near,
+        "far": camera.far,
+        "size": [size.0, size.1],
+        "view": camera.view().to_cols_array().to_vec(),
+        "projection": camera.projection(f64::from(size.0) / f64::from(size.1)).to_cols_array().to_vec(),
+        "conventions": "right-handed look_at; perspective_rh depth 0..1; row 0 at the top; pixel (x, y) centred at (x + 0.5, y + 0.5); matrices column-major",
+    });
+    serde_json::to_string_pretty(&json).unwrap_or_default()
+}

@@ -1,0 +1,220 @@
+//! How a wireframe looks: colours, line width, lighting, and the CPU twins of the WGSL
+//! line profile and shading in `shaders/common.wgsl` (the ground truth uses these).
+
+use crate::error::{Error, Result};
+use glam::Vec3;
+
+/// A linear-light RGBA colour.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Color(pub [f32; 4]);
+
+impl Color {
+    /// Parses `#rgb`, `#rrggbb` or `#rrggbbaa` (the `#` optional) as sRGB and converts to linear.
+    pub fn from_hex(s: &str) -> Result<Color> {
+        let hex = s.strip_prefix('#').unwrap_or(s);
+        let bad = || {
+            Error::InvalidSetting(format!(
+                "colour {s:?} is not #rgb, #rrggbb or #rrggbbaa hexadecimal"
+            ))
+        };
+        if !hex.bytes().all(|b| b.is_ascii_hexdigit()) {
+            return Err(bad());
+        }
+        let digits: Vec<u8> = match hex.len() {
+            3 => hex.bytes().flat_map(|b| [b, b]).collect(),
+            6 | 8 => hex.bytes().collect(),
+            _ => return Err(bad()),
+        };
+        let mut c = [1.0_f32; 4];
+        for (i, pair) in digits.chunks(2).enumerate() {
+            let text = std::str::from_utf8(pair).map_err(|_| bad())?;
+            let v = u8::from_str_radix(text, 16).map_err(|_| bad())?;
+            c[i] = f32::from(v) / 255.0;
+        }
+        Ok(Color([
+            srgb_to_linear(c[0]),
+            srgb_to_linear(c[1]),
+            srgb_to_linear(c[2]),
+            c[3],
+        ]))
+    }
+
+    /// The colour as 8-bit sRGB with straight alpha.
+    pub fn to_srgb8(self) -> [u8; 4] {
+        let [r, g, b, a] = self.0;
+        let q = |v: f32| (v.clamp(0.0, 1.0) * 255.0).round() as u8;
+        [
+            q(linear_to_srgb(r)),
+            q(linear_to_srgb(g)),
+            q(linear_to_srgb(b)),
+            q(a),
+        ]
+    }
+}
+
+/// Appearance settings shared by every method, so images differ only by method.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Style {
+    /// Line width in pixels, constant at any distance and resolution.
+    pub line_width: f32,
+    /// Colour of the lines; its alpha scales the line's opacity.
+    pub wire_color: Color,
+    /// Base colour of the shaded surface.
+    pub fill_color: Color,
+    /// Colour where no triangle is visible.
+    pub background: Color,
+    /// Share of ambient light, 0..1; the rest comes from the key light.
+    pub ambient: f32,
+    /// Direction towards the key light in view space (x right, y up, z towards the viewer),
+    /// so the lighting follows the camera.
+    pub light_view_dir: Vec3,
+}
+
+impl Default for Style {
+    fn default() -> Self {
+        Style {
+            line_width: 1.5,
+            wire_color: Color([0.005, 0.01, 0.02, 1.0]),
+            fill_color: Color([0.55, 0.62, 0.72, 1.0]),
+            background: Color([1.0, 1.0, 1.0, 1.0]),
+            ambient: 0.3,
+            light_view_dir: Vec3::new(-0.4, 0.6, 1.0),
+        }
+    }
+}
+
+impl Style {
+    /// Rejects settings that cannot produce a sensible image.
+    pub fn validate(&self) -> Result<()> {
+        if !(self.line_width >= 0.0 && self.line_width.is_finite()) {
+            return Err(Error::InvalidSetting(format!(
+                "line width {} must be a finite number >= 0",
+                self.line_width
+            )));
+        }
+        if !(0.0..=1.0).contains(&self.ambient) {
+            return Err(Error::InvalidSetting(format!(
+                "ambient {} is not in 0..1",
+                self.ambient
+            )));
+        }
+        if self.light_view_dir.try_normalize().is_none() {
+            return Err(Error::InvalidSetting("light direction is zero".into()));
+        }
+        for c in [self.wire_color, self.fill_color, self.background] {
+            if c.0.iter().any(|v| !v.is_finite()) {
+                return Err(Error::InvalidSetting(format!(
+                    "colour {:?} is not finite",
+                    c.0
+                )));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Twin of `line_intensity` in common.wgsl: intensity of a `width`-pixel line at distance `d`
+/// pixels from its centre. A core of `width − 2` px at full intensity, then the Gaussian
+/// falloff `exp2(−2 t²)` of NVIDIA's "Solid Wireframe" over the next 2 px; lines narrower
+/// than 2 px keep the falloff and fade in proportion to their width.
+pub fn line_intensity(d: f64, width: f64) -> f64 {
+    let t = (d - (0.5 * width - 1.0).max(0.0)).max(0.0);
+    if t >= 2.0 || t.is_nan() {
+        return 0.0;
+    }
+    (0.5 * width).min(1.0) * (-2.0 * t * t).exp2()
+}
+
+/// How far from an edge its line can colour a pixel, in pixels.
+pub fn line_reach(width: f64) -> f64 {
+    (0.5 * width - 1.0).max(0.0) + 2.0
+}
+
+/// Twin of `shade` in common.wgsl: diffuse key light plus ambient, with the normal turned
+/// towards the viewer.
+pub fn shade(
+    base: [f64; 3],
+    normal: glam::DVec3,
+    to_eye: glam::DVec3,
+    light: glam::DVec3,
+    ambient: f64,
+) -> [f64; 3] {
+    let n = if normal.dot(to_eye) < 0.0 {
+        -normal
+    } else {
+        normal
+    };
+    let k = ambient + (1.0 - ambient) * n.dot(light).max(0.0);
+    base.map(|c| c * k)
+}
+
+/// sRGB transfer function, linear → encoded.
+pub fn linear_to_srgb(x: f32) -> f32 {
+    let x = x.clamp(0.0, 1.0);
+    if x <= 0.003_130_8 {
+        12.92 * x
+    } else {
+        1.055 * x.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// sRGB transfer function, encoded → linear.
+pub fn srgb_to_linear(x: f32) -> f32 {
+    if x <= 0.040_45 {
+        x / 12.92
+    } else {
+        ((x + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hex_colours() {
+        assert_eq!(Color::from_hex("#ffffff").unwrap().to_srgb8(), [255; 4]);
+        assert_eq!(Color::from_hex("f00").unwrap().to_srgb8(), [255, 0, 0, 255]);
+        assert_eq!(
+            Color::from_hex("#12345680").unwrap().to_srgb8(),
+            [0x12, 0x34, 0x56, 0x80]
+        );
+        for bad in ["", "#12", "#gggggg", "#1234567", "red"] {
+            assert!(Color::from_hex(bad).is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn profile_shape() {
+        // Full intensity on the centre of a wide line, zero beyond its reach.
+        assert_eq!(line_intensity(0.0, 4.0), 1.0);
+        assert_eq!(line_intensity(1.0, 4.0), 1.0);
+        assert_eq!(line_intensity(line_reach(4.0), 4.0), 0.0);
+        // The seeds' exp2(-2 d^2) is the 2 px case.
+        assert!((line_intensity(0.7, 2.0) - (-2.0_f64 * 0.49).exp2()).abs() < 1e-12);
+        // Thin lines fade rather than vanish.
+        assert!((line_intensity(0.0, 0.5) - 0.25).abs() < 1e-12);
+        assert_eq!(line_intensity(0.0, 0.0), 0.0);
+        // Monotone in distance.
+        let mut last = 2.0;
+        for i in 0..100 {
+            let v = line_intensity(f64::from(i) * 0.05, 3.0);
+            assert!(v <= last);
+            last = v;
+        }
+    }
+
+    #[test]
+    fn rejects_bad_style() {
+        let s = Style {
+            line_width: -1.0,
+            ..Style::default()
+        };
+        assert!(s.validate().is_err());
+        let s = Style {
+            line_width: f32::NAN,
+            ..Style::default()
+        };
+        assert!(s.validate().is_err());
+    }
+}
