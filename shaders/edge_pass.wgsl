@@ -106,13 +106,16 @@ fn overlay_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     textureStore(overlay_out, gid.xy, encode_output(color));
 }
 
-// Diagnostic mode: the raw distance map (pixels; NO_EDGE on background).
-@group(1) @binding(3) var distance_out: texture_storage_2d<r32float, write>;
+// Diagnostic mode: the raw distance (pixels; NO_EDGE on background) and the raster depth,
+// which some backends (GL) cannot copy out of a depth texture directly.
+@group(1) @binding(3) var diagnostic_out: texture_storage_2d<rgba32float, write>;
+@group(1) @binding(4) var depth_in: texture_2d<f32>;
 
 @compute @workgroup_size(8, 8)
-fn distance_main(@builtin(global_invocation_id) gid: vec3<u32>) {
+fn diagnostic_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if !inside(gid.xy) {
         return;
     }
-    textureStore(distance_out, gid.xy, vec4<f32>(evaluate(gid.xy).distance, 0.0, 0.0, 0.0));
+    let depth = textureLoad(depth_in, gid.xy, 0).x;
+    textureStore(diagnostic_out, gid.xy, vec4<f32>(evaluate(gid.xy).distance, depth, 0.0, 0.0));
 }

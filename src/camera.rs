@@ -54,20 +54,37 @@ impl Camera {
         Ok(())
     }
 
-    /// Frames an axis-aligned box: looks at its centre from the front-right-above, at a
-    /// distance where the bounding sphere fills the view, with near/far hugging the sphere.
+    /// Frames an axis-aligned box: looks at its centre from the front-right-above, at the
+    /// smallest distance where all eight corners are in view (plus a 5 % margin), with near
+    /// and far hugging the box's bounding sphere.
     pub fn framing(lo: Vec3, hi: Vec3, aspect: f32) -> Camera {
         let (lo, hi) = (lo.as_dvec3(), hi.as_dvec3());
         let centre = (lo + hi) * 0.5;
         let radius = ((hi - lo).length() * 0.5).max(1e-6);
         let fov_y = 40.0_f64;
-        let half = (fov_y.to_radians() * 0.5).tan();
-        // The sphere must fit the narrower of the two fields of view.
-        let half_min = half * f64::from(aspect).min(1.0);
-        let distance = radius / half_min.atan().sin() * 1.05;
-        let dir = DVec3::new(0.55, 0.35, 1.0).normalize();
+        let tan_y = (fov_y.to_radians() * 0.5).tan();
+        let tan_x = tan_y * f64::from(aspect);
+        let forward = -DVec3::new(0.55, 0.35, 1.0).normalize();
+        let right = forward.cross(DVec3::Y).normalize();
+        let up = right.cross(forward);
+        // Corner o is in view from distance d when |o·right| <= (d - o·forward) tan_x, and
+        // likewise for up; the largest such d over the corners frames the box.
+        let mut distance = radius * 1e-3;
+        for i in 0..8 {
+            let corner = DVec3::new(
+                if i & 1 == 0 { lo.x } else { hi.x },
+                if i & 2 == 0 { lo.y } else { hi.y },
+                if i & 4 == 0 { lo.z } else { hi.z },
+            );
+            let o = corner - centre;
+            let along = o.dot(forward);
+            distance = distance
+                .max(along + o.dot(right).abs() / tan_x)
+                .max(along + o.dot(up).abs() / tan_y);
+        }
+        distance *= 1.05;
         Camera {
-            eye: (centre + dir * distance).as_vec3(),
+            eye: (centre - forward * distance).as_vec3(),
             target: centre.as_vec3(),
             up: Vec3::Y,
             fov_y_deg: fov_y as f32,

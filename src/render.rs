@@ -70,7 +70,7 @@ pub fn render_deferred(ctx: &GpuContext, scene: &Scene<'_>) -> Result<Frame> {
     let view = output.create_view(&Default::default());
     let mut encoder = device.create_command_encoder(&Default::default());
     pass.encode(device, &mut encoder, &mesh, OutputTarget::Shaded(&view))?;
-    pass.encode_edges(device, &mut encoder, &mesh, OutputTarget::Distance)?;
+    pass.encode_edges(device, &mut encoder, &mesh, OutputTarget::Diagnostic)?;
     ctx.queue.submit([encoder.finish()]);
     ctx.finish()?;
 
@@ -83,32 +83,26 @@ pub fn render_deferred(ctx: &GpuContext, scene: &Scene<'_>) -> Result<Frame> {
         pass.id_texture().ok_or_else(missing)?,
         all,
     )?;
-    let depth = read_texture(
+    let diagnostic = read_texture(
         device,
         &ctx.queue,
-        pass.depth_texture().ok_or_else(missing)?,
-        wgpu::TextureAspect::DepthOnly,
-    )?;
-    let distance = read_texture(
-        device,
-        &ctx.queue,
-        pass.distance_texture().ok_or_else(missing)?,
+        pass.diagnostic_texture().ok_or_else(missing)?,
         all,
     )?;
     ctx.finish()?;
-    let floats = |bytes: &[u8]| -> Vec<f32> { bytemuck::pod_collect_to_vec(bytes) };
+    let diagnostic: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&diagnostic);
     Ok(Frame {
         size: scene.size,
         rgba,
         ids: bytemuck::pod_collect_to_vec(&ids),
         // Reverse-Z back to the 0..1 convention.
-        depth: floats(&depth)
-            .into_iter()
-            .map(|r| (1.0 - f64::from(r)) as f32)
+        depth: diagnostic
+            .iter()
+            .map(|t| (1.0 - f64::from(t[1])) as f32)
             .collect(),
-        edge_distance: floats(&distance)
-            .into_iter()
-            .map(|d| if d >= 1e38 { f32::INFINITY } else { d })
+        edge_distance: diagnostic
+            .iter()
+            .map(|t| if t[0] >= 1e38 { f32::INFINITY } else { t[0] })
             .collect(),
     })
 }

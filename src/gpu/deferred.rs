@@ -11,8 +11,8 @@ use wgpu::util::DeviceExt;
 pub const ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 /// Format of the depth target (reverse-Z: 1 at the near plane, 0 at the far plane).
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
-/// Format of the diagnostic distance map.
-pub const DISTANCE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+/// Format of the diagnostic map: distance in pixels (r) and reverse-Z raster depth (g).
+pub const DIAGNOSTIC_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 /// Edge-pass workgroup side (8 × 8 pixels).
 const TILE: u32 = 8;
 
@@ -44,9 +44,10 @@ pub enum OutputTarget<'a> {
         /// Where the blended image goes (the pass's output format).
         output: &'a wgpu::TextureView,
     },
-    /// The raw per-pixel distance (pixels) into the pass's own `R32Float` texture, see
-    /// [`DeferredPass::distance_texture`].
-    Distance,
+    /// Diagnostics into the pass's own `Rgba32Float` texture (see
+    /// [`DeferredPass::diagnostic_texture`]): the per-pixel edge distance in pixels (red) and
+    /// the raster depth (green), for tools and tests.
+    Diagnostic,
 }
 
 /// Size-dependent targets, rebuilt only when the size changes.
@@ -54,7 +55,7 @@ struct Targets {
     size: (u32, u32),
     ids: wgpu::Texture,
     depth: wgpu::Texture,
-    distance: wgpu::Texture,
+    diagnostic: wgpu::Texture,
 }
 
 /// The deferred wireframe pass. Construct once with [`DeferredPass::new`], call
@@ -68,7 +69,7 @@ pub struct DeferredPass {
     mesh_layout: wgpu::BindGroupLayout,
     shade: (wgpu::ComputePipeline, wgpu::BindGroupLayout),
     overlay: (wgpu::ComputePipeline, wgpu::BindGroupLayout),
-    distance: (wgpu::ComputePipeline, wgpu::BindGroupLayout),
+    diagnostic: (wgpu::ComputePipeline, wgpu::BindGroupLayout),
     frame: wgpu::Buffer,
     draw: wgpu::Buffer,
     targets: Option<Targets>,
@@ -243,9 +244,16 @@ impl DeferredPass {
                 ),
             ],
         );
-        let distance = compute(
-            "distance_main",
-            &[entry(3, cs, storage_texture(DISTANCE_FORMAT))],
+        let diagnostic = compute(
+            "diagnostic_main",
+            &[
+                entry(3, cs, storage_texture(DIAGNOSTIC_FORMAT)),
+                entry(
+                    4,
+                    cs,
+                    texture(wgpu::TextureSampleType::Float { filterable: false }),
+                ),
+            ],
         );
 
         let frame = device.create_buffer(&wgpu::BufferDescriptor {
@@ -270,7 +278,7 @@ impl DeferredPass {
             mesh_layout,
             shade,
             overlay,
-            distance,
+            diagnostic,
             frame,
             draw,
             targets: None,
@@ -289,7 +297,7 @@ impl DeferredPass {
     }
 
     /// Validates the camera, style and size, uploads the frame's uniforms, and (re)builds the
-    /// id, depth and distance targets when the size changed.
+    /// id, depth and diagnostic targets when the size changed.
     pub fn prepare(
         &mut self,
         device: &wgpu::Device,
@@ -332,11 +340,11 @@ impl DeferredPass {
                 depth: make(
                     "wirepass depth",
                     DEPTH_FORMAT,
-                    U::RENDER_ATTACHMENT | U::COPY_SRC,
+                    U::RENDER_ATTACHMENT | U::TEXTURE_BINDING,
                 ),
-                distance: make(
-                    "wirepass distance",
-                    DISTANCE_FORMAT,
+                diagnostic: make(
+                    "wirepass diagnostic",
+                    DIAGNOSTIC_FORMAT,
                     U::STORAGE_BINDING | U::COPY_SRC,
                 ),
             });
@@ -365,9 +373,9 @@ impl DeferredPass {
         self.targets.as_ref().map(|t| &t.depth)
     }
 
-    /// The distance map written by [`OutputTarget::Distance`].
-    pub fn distance_texture(&self) -> Option<&wgpu::Texture> {
-        self.targets.as_ref().map(|t| &t.distance)
+    /// The diagnostic map written by [`OutputTarget::Diagnostic`].
+    pub fn diagnostic_texture(&self) -> Option<&wgpu::Texture> {
+        self.targets.as_ref().map(|t| &t.diagnostic)
     }
 
     /// Records the visibility pass and the edge pass into `encoder`.
@@ -510,7 +518,7 @@ impl DeferredPass {
             }
             Ok(())
         };
-        let distance_view;
+        let (diagnostic_view, depth_view);
         let (pipeline, layout, entries) = match target {
             OutputTarget::Shaded(out) => {
                 check(out, "the output texture")?;
@@ -541,15 +549,22 @@ impl DeferredPass {
                     ],
                 )
             }
-            OutputTarget::Distance => {
-                distance_view = targets.distance.create_view(&Default::default());
+            OutputTarget::Diagnostic => {
+                diagnostic_view = targets.diagnostic.create_view(&Default::default());
+                depth_view = targets.depth.create_view(&Default::default());
                 (
-                    &self.distance.0,
-                    &self.distance.1,
-                    vec![wgpu::BindGroupEntry {
-                        binding: 3,
-                        resource: wgpu::BindingResource::TextureView(&distance_view),
-                    }],
+                    &self.diagnostic.0,
+                    &self.diagnostic.1,
+                    vec![
+                        wgpu::BindGroupEntry {
+                            binding: 3,
+                            resource: wgpu::BindingResource::TextureView(&diagnostic_view),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 4,
+                            resource: wgpu::BindingResource::TextureView(&depth_view),
+                        },
+                    ],
                 )
             }
         };
