@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use wirepass::cli::{load_mesh, parse_size, CameraArgs};
 use wirepass::gpu::GpuContext;
-use wirepass::render::{render_deferred, Scene};
+use wirepass::render::{render, Method, Scene};
 use wirepass::{Color, EdgeSelection, Result, Style};
 
 #[derive(Parser)]
@@ -52,6 +52,9 @@ struct RenderArgs {
     /// Background colour, #rrggbb (sRGB).
     #[arg(long, default_value = "#ffffff")]
     background: String,
+    /// How to draw: deferred (visibility buffer + compute edge pass).
+    #[arg(long, default_value = "deferred", value_parser = parse_method)]
+    method: Method,
     /// Which edges to draw.
     #[arg(long, value_enum, default_value = "polygon")]
     edges: Edges,
@@ -65,7 +68,11 @@ struct RenderArgs {
     camera: CameraArgs,
 }
 
-fn render(args: &RenderArgs) -> Result<()> {
+fn parse_method(s: &str) -> std::result::Result<Method, String> {
+    s.parse().map_err(|e: wirepass::Error| e.to_string())
+}
+
+fn render_command(args: &RenderArgs) -> Result<()> {
     let size = parse_size(&args.size)?;
     let style = Style {
         line_width: args.line_width,
@@ -89,14 +96,15 @@ fn render(args: &RenderArgs) -> Result<()> {
         size,
         edges,
     };
-    let frame = render_deferred(&ctx, &scene)?;
+    let frame = render(&ctx, &scene, args.method)?;
     frame.save_png(&args.output)?;
     if let Some(dir) = &args.dump {
         frame.dump(dir, &camera)?;
     }
     eprintln!(
-        "wrote {} ({}x{}, {} triangles, {})",
+        "wrote {} ({}, {}x{}, {} triangles, {})",
         args.output.display(),
+        args.method.name(),
         size.0,
         size.1,
         mesh.triangle_count(),
@@ -108,7 +116,7 @@ fn render(args: &RenderArgs) -> Result<()> {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
-        Command::Render(args) => render(args),
+        Command::Render(args) => render_command(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

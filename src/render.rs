@@ -39,6 +39,46 @@ pub struct Frame {
     pub edge_distance: Vec<f32>,
 }
 
+/// A way of drawing the wireframe.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Method {
+    /// Visibility buffer + compute edge pass (the subject of this crate).
+    Deferred,
+}
+
+impl Method {
+    /// Every method, in report order.
+    pub const ALL: &'static [Method] = &[Method::Deferred];
+
+    /// The name used on the command line and in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Deferred => "deferred",
+        }
+    }
+}
+
+impl std::str::FromStr for Method {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Method> {
+        Method::ALL
+            .iter()
+            .copied()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| {
+                let names: Vec<_> = Method::ALL.iter().map(|m| m.name()).collect();
+                Error::InvalidSetting(format!("method {s:?} is not one of {}", names.join(", ")))
+            })
+    }
+}
+
+/// Renders `scene` with `method` and reads back the image and all maps.
+pub fn render(ctx: &GpuContext, scene: &Scene<'_>, method: Method) -> Result<Frame> {
+    match method {
+        Method::Deferred => render_deferred(ctx, scene),
+    }
+}
+
 /// Renders `scene` with the deferred pass and reads back the image and all maps.
 pub fn render_deferred(ctx: &GpuContext, scene: &Scene<'_>) -> Result<Frame> {
     let device = &ctx.device;
