@@ -1,0 +1,63 @@
+//! Helpers shared by the GPU integration tests.
+#![allow(dead_code)]
+
+use glam::{DVec2, Vec3};
+use std::path::PathBuf;
+use std::sync::OnceLock;
+use wirepass::gpu::GpuContext;
+use wirepass::{edge_math, Camera, EdgeSelection, Mesh};
+
+/// One device for the whole test binary. A missing adapter fails loudly: GPU tests never
+/// pass by skipping.
+pub fn gpu() -> &'static GpuContext {
+    static CTX: OnceLock<GpuContext> = OnceLock::new();
+    CTX.get_or_init(|| match GpuContext::new() {
+        Ok(ctx) => ctx,
+        Err(e) => panic!(
+            "GPU tests need an adapter (lavapipe: apt-get install mesa-vulkan-drivers, or \
+             WGPU_BACKEND=gl for llvmpipe): {e}"
+        ),
+    })
+}
+
+/// Path of a shared test mesh.
+pub fn shared_mesh(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/meshes")
+        .join(name)
+}
+
+/// Loads a shared test mesh.
+pub fn load(name: &str) -> Mesh {
+    wirepass::mesh::load_obj(&shared_mesh(name)).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// A camera at `eye` looking at `target`, with explicit planes.
+pub fn camera(eye: Vec3, target: Vec3, near: f32, far: f32) -> Camera {
+    Camera {
+        eye,
+        target,
+        up: Vec3::Y,
+        fov_y_deg: 50.0,
+        near,
+        far,
+    }
+}
+
+/// The f64 edge distance of pixel (x, y) to triangle `id`, as the CPU definition gives it.
+pub fn cpu_distance(
+    mesh: &Mesh,
+    camera: &Camera,
+    size: (u32, u32),
+    edges: EdgeSelection,
+    id: u32,
+    (x, y): (u32, u32),
+) -> f64 {
+    let vp = camera.view_projection(size.0, size.1);
+    let tri = mesh.triangles()[id as usize];
+    let clip = tri.map(|v| vp * mesh.positions()[v as usize].as_dvec3().extend(1.0));
+    let mask = mesh.edge_mask(edges)[id as usize];
+    let pixel = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
+    let size = DVec2::new(f64::from(size.0), f64::from(size.1));
+    edge_math::edge_eval(clip, mask, pixel, size).min_distance()
+}

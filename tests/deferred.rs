@@ -1,0 +1,349 @@
+//! The deferred pass end to end on a software adapter: edge selection, hard cameras,
+//! determinism, and the post-process (overlay) mode of the library API.
+
+mod common;
+
+use common::{camera, cpu_distance, gpu, load};
+use glam::Vec3;
+use wirepass::gpu::{DeferredPass, GpuMesh, OutputTarget, PassOptions};
+use wirepass::render::{render, Frame, Method, Scene};
+use wirepass::{Camera, EdgeSelection, Mesh, Style};
+
+const BACKGROUND: u32 = u32::MAX;
+
+fn draw(mesh: &Mesh, camera: Camera, size: (u32, u32), edges: EdgeSelection) -> Frame {
+    draw_styled(mesh, camera, size, edges, Style::default())
+}
+
+fn draw_styled(
+    mesh: &Mesh,
+    camera: Camera,
+    size: (u32, u32),
+    edges: EdgeSelection,
+    style: Style,
+) -> Frame {
+    let scene = Scene {
+        mesh,
+        camera,
+        style,
+        size,
+        edges,
+    };
+    render(gpu(), &scene, Method::Deferred).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Largest |GPU − CPU| edge distance over covered pixels whose true distance is under
+/// `reach` pixels, given the GPU's own ids. This checks the edge pass's math (not coverage):
+/// same triangle, same definition, f32 on the GPU against f64 on the CPU.
+fn max_distance_error(
+    mesh: &Mesh,
+    cam: &Camera,
+    frame: &Frame,
+    edges: EdgeSelection,
+    reach: f64,
+) -> (f64, usize) {
+    let (w, h) = frame.size;
+    let mut worst: f64 = 0.0;
+    let mut measured = 0;
+    for y in 0..h {
+        for x in 0..w {
+            let i = (y * w + x) as usize;
+            let id = frame.ids[i];
+            let gpu_d = frame.edge_distance[i];
+            assert!(!gpu_d.is_nan(), "NaN distance at ({x}, {y})");
+            if id == BACKGROUND {
+                assert!(
+                    gpu_d.is_infinite(),
+                    "background pixel ({x}, {y}) has distance {gpu_d}"
+                );
+                continue;
+            }
+            let cpu_d = cpu_distance(mesh, cam, frame.size, edges, id, (x, y));
+            if cpu_d < reach {
+                measured += 1;
+                worst = worst.max((f64::from(gpu_d) - cpu_d).abs());
+            }
+        }
+    }
+    (worst, measured)
+}
+
+#[test]
+fn suzanne_draws_no_quad_diagonal() {
+    let mesh = load("suzanne.obj");
+    let size = (256, 256);
+    let (lo, hi) = mesh.bounds();
+    let cam = Camera::framing(lo, hi, 1.0);
+    // 3 px lines: full line colour within 0.5 px of an edge.
+    let style = Style {
+        line_width: 3.0,
+        ..Style::default()
+    };
+    let polygon = draw_styled(&mesh, cam, size, EdgeSelection::Polygon, style.clone());
+    let all = draw_styled(&mesh, cam, size, EdgeSelection::All, style.clone());
+    assert_eq!(
+        polygon.ids, all.ids,
+        "edge selection must not change coverage"
+    );
+
+    // Both selections follow the CPU definition for their own mask.
+    for (frame, edges) in [
+        (&polygon, EdgeSelection::Polygon),
+        (&all, EdgeSelection::All),
+    ] {
+        let (err, n) = max_distance_error(&mesh, &cam, frame, edges, 4.0);
+        assert!(n > 1000, "too few pixels near edges: {n}");
+        assert!(err <= 0.01, "{edges:?}: max |GPU − CPU| distance {err} px");
+    }
+    // Pixels on a quad diagonal: a line with `All`, none with `Polygon`.
+    let masks = mesh.edge_mask(EdgeSelection::Polygon);
+    let wire = style.wire_color.to_srgb8();
+    let mut on_diagonal = 0;
+    for (i, &id) in polygon.ids.iter().enumerate() {
+        if id == BACKGROUND || masks[id as usize] == 0b111 {
+            continue;
+        }
+        let (x, y) = (i as u32 % size.0, i as u32 / size.0);
+        let to_diagonal = cpu_distance(&mesh, &cam, size, EdgeSelection::All, id, (x, y));
+        if to_diagonal < 0.25 && polygon.edge_distance[i] > 3.0 {
+            on_diagonal += 1;
+            let near_wire = |px: &[u8]| px.iter().zip(wire).all(|(a, b)| a.abs_diff(b) < 40);
+            assert!(
+                near_wire(&all.rgba[4 * i..4 * i + 3]),
+                "All: no line on a diagonal at ({x}, {y})"
+            );
+            assert!(
+                !near_wire(&polygon.rgba[4 * i..4 * i + 3]),
+                "Polygon: a diagonal is drawn at ({x}, {y})"
+            );
+        }
+    }
+    assert!(
+        on_diagonal > 100,
+        "only {on_diagonal} diagonal pixels checked"
+    );
+}
+
+#[test]
+fn triangle_mesh_with_all_edges_matches_the_cpu_definition() {
+    let mesh = load("teapot.obj");
+    let (lo, hi) = mesh.bounds();
+    let cam = Camera::framing(lo, hi, 4.0 / 3.0);
+    let frame = draw(&mesh, cam, (320, 240), EdgeSelection::All);
+    let (err, n) = max_distance_error(&mesh, &cam, &frame, EdgeSelection::All, 4.0);
+    assert!(n > 1000);
+    assert!(
+        err <= 0.01,
+        "max |GPU − CPU| distance {err} px over {n} pixels"
+    );
+}
+
+#[test]
+fn eye_inside_the_bunny_cuts_the_near_plane_cleanly() {
+    let mesh = load("stanford-bunny.obj");
+    let (lo, hi) = mesh.bounds();
+    let centre = (lo + hi) * 0.5;
+    // Inside the body, looking towards the head: the near plane cuts many triangles, some
+    // of whose vertices are behind the eye.
+    let cam = camera(centre, centre + Vec3::new(-0.3, 0.4, 0.2), 0.02, 1.0);
+    let frame = draw(&mesh, cam, (320, 240), EdgeSelection::All);
+    let covered = frame.ids.iter().filter(|&&id| id != BACKGROUND).count();
+    assert!(
+        covered > 320 * 240 / 2,
+        "only {covered} pixels see the inside of the bunny"
+    );
+    let (err, n) = max_distance_error(&mesh, &cam, &frame, EdgeSelection::All, 4.0);
+    assert!(n > 1000);
+    assert!(
+        err <= 0.01,
+        "max |GPU − CPU| distance {err} px over {n} pixels"
+    );
+    assert!(
+        seen_crossing(&mesh, &cam, &frame, |clip| clip.z < 0.0) > 1000,
+        "the near plane should cut visible triangles"
+    );
+}
+
+#[test]
+fn vertices_behind_the_eye_keep_exact_edges() {
+    // A coarse floor seen from just above it: visible triangles reach behind the eye.
+    let mesh = wirepass::mesh::grid(200).unwrap();
+    let cam = camera(
+        Vec3::new(0.1, -0.2, 0.03),
+        Vec3::new(0.3, 1.0, 0.0),
+        0.01,
+        10.0,
+    );
+    let cam = Camera { up: Vec3::Z, ..cam };
+    let frame = draw(&mesh, cam, (320, 240), EdgeSelection::All);
+    let (err, n) = max_distance_error(&mesh, &cam, &frame, EdgeSelection::All, 4.0);
+    assert!(n > 1000);
+    assert!(
+        err <= 0.01,
+        "max |GPU − CPU| distance {err} px over {n} pixels"
+    );
+    assert!(
+        seen_crossing(&mesh, &cam, &frame, |clip| clip.w < 0.0) > 1000,
+        "no visible triangle reaches behind the eye"
+    );
+}
+
+/// Number of covered pixels whose triangle has a corner for which `test(clip)` holds.
+fn seen_crossing(
+    mesh: &Mesh,
+    cam: &Camera,
+    frame: &Frame,
+    test: impl Fn(glam::DVec4) -> bool,
+) -> usize {
+    let vp = cam.view_projection(frame.size.0, frame.size.1);
+    frame
+        .ids
+        .iter()
+        .filter(|&&id| id != BACKGROUND)
+        .filter(|&&id| {
+            mesh.triangles()[id as usize]
+                .iter()
+                .any(|&v| test(vp * mesh.positions()[v as usize].as_dvec3().extend(1.0)))
+        })
+        .count()
+}
+
+#[test]
+fn same_render_twice_is_identical() {
+    let mesh = wirepass::mesh::default_scene();
+    let (lo, hi) = mesh.bounds();
+    let cam = Camera::framing(lo, hi, 1.5);
+    let a = draw(&mesh, cam, (300, 200), EdgeSelection::Polygon);
+    let b = draw(&mesh, cam, (300, 200), EdgeSelection::Polygon);
+    assert_eq!(a.rgba, b.rgba);
+    assert_eq!(a.ids, b.ids);
+    assert_eq!(
+        bytemuck::cast_slice::<f32, u8>(&a.edge_distance),
+        bytemuck::cast_slice::<f32, u8>(&b.edge_distance)
+    );
+}
+
+#[test]
+fn overlay_blends_lines_over_the_host_image_and_resizes() {
+    let ctx = gpu();
+    let device = &ctx.device;
+    let mesh = wirepass::mesh::sphere(2000).unwrap();
+    let mut pass = DeferredPass::new(
+        device,
+        PassOptions {
+            output_format: wgpu::TextureFormat::Rgba16Float,
+        },
+    )
+    .unwrap();
+    let gpu_mesh = GpuMesh::new(device, &mesh, EdgeSelection::All).unwrap();
+    let style = Style::default();
+    let host_color = [0.2_f32, 0.4, 0.6, 1.0];
+    for size in [(64u32, 48u32), (96, 96)] {
+        let (lo, hi) = mesh.bounds();
+        let cam = Camera::framing(lo, hi, size.0 as f32 / size.1 as f32);
+        pass.prepare(device, &ctx.queue, &gpu_mesh, &cam, &style, size)
+            .unwrap();
+        let texture = |usage| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: None,
+                size: wgpu::Extent3d {
+                    width: size.0,
+                    height: size.1,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::Rgba16Float,
+                usage,
+                view_formats: &[],
+            })
+        };
+        use wgpu::TextureUsages as U;
+        let host = texture(U::TEXTURE_BINDING | U::RENDER_ATTACHMENT);
+        let output = texture(U::STORAGE_BINDING | U::COPY_SRC);
+        let (host_view, out_view) = (
+            host.create_view(&Default::default()),
+            output.create_view(&Default::default()),
+        );
+        let mut encoder = device.create_command_encoder(&Default::default());
+        // The host's own rendering: a flat clear.
+        encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: None,
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &host_view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color {
+                        r: 0.2,
+                        g: 0.4,
+                        b: 0.6,
+                        a: 1.0,
+                    }),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.encode(
+            device,
+            &mut encoder,
+            &gpu_mesh,
+            OutputTarget::Overlay {
+                host: &host_view,
+                output: &out_view,
+            },
+        )
+        .unwrap();
+        pass.encode_edges(device, &mut encoder, &gpu_mesh, OutputTarget::Diagnostic)
+            .unwrap();
+        ctx.queue.submit([encoder.finish()]);
+        ctx.finish().unwrap();
+        let texels: Vec<[half::f16; 4]> = bytemuck::pod_collect_to_vec(
+            &wirepass::gpu::read_texture(device, &ctx.queue, &output, wgpu::TextureAspect::All)
+                .unwrap(),
+        );
+        let diag: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(
+            &wirepass::gpu::read_texture(
+                device,
+                &ctx.queue,
+                pass.diagnostic_texture().unwrap(),
+                wgpu::TextureAspect::All,
+            )
+            .unwrap(),
+        );
+        let (mut lines, mut plain) = (0, 0);
+        for (t, d) in texels.iter().zip(&diag) {
+            let c = t.map(half::f16::to_f32);
+            let far_from_edges = d[0] >= 3.0; // beyond the 1.5 px line's reach
+            if far_from_edges {
+                plain += 1;
+                for k in 0..4 {
+                    assert!(
+                        (c[k] - host_color[k]).abs() < 2e-3,
+                        "host colour changed: {c:?}"
+                    );
+                }
+            } else if d[0] < 0.1 {
+                lines += 1;
+                let wire = style.wire_color.0;
+                let i = wirepass::style::line_intensity(f64::from(d[0]), 1.5) as f32;
+                for k in 0..3 {
+                    let expect = host_color[k] * (1.0 - i) + wire[k] * i;
+                    assert!(
+                        (c[k] - expect).abs() < 5e-3,
+                        "line pixel {c:?}, expected {expect}"
+                    );
+                }
+            }
+        }
+        assert!(
+            lines > 10 && plain > 10,
+            "{lines} line pixels, {plain} plain pixels at {size:?}"
+        );
+    }
+}
