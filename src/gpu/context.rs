@@ -32,7 +32,9 @@ impl GpuContext {
     }
 
     async fn new_async() -> Result<Self> {
-        let backends = match std::env::var("WGPU_BACKEND") {
+        // Without WGPU_BACKEND, native backends are tried first and GL only when they offer
+        // nothing: probing EGL is slow and noisy where a Vulkan driver exists.
+        let tries = match std::env::var("WGPU_BACKEND") {
             Ok(list) => {
                 let b = wgpu::Backends::from_comma_list(&list);
                 if b.is_empty() {
@@ -40,20 +42,27 @@ impl GpuContext {
                         "WGPU_BACKEND={list:?} names no known backend (vulkan, gl, metal, dx12)"
                     )));
                 }
-                b
+                vec![b]
             }
-            Err(_) => wgpu::Backends::all(),
+            Err(_) => vec![wgpu::Backends::PRIMARY, wgpu::Backends::GL],
         };
-        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
-        desc.backends = backends;
-        desc.flags = wgpu::InstanceFlags::from_build_config().with_env();
-        let instance = wgpu::Instance::new(desc);
-        let mut adapters = instance.enumerate_adapters(backends).await;
         let wanted = std::env::var("WGPU_ADAPTER_NAME")
             .ok()
             .map(|s| s.to_lowercase());
-        if let Some(name) = &wanted {
-            adapters.retain(|a| a.get_info().name.to_lowercase().contains(name));
+        let mut adapters = Vec::new();
+        let mut backends = wgpu::Backends::empty();
+        for b in tries {
+            backends |= b;
+            let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+            desc.backends = b;
+            desc.flags = wgpu::InstanceFlags::from_build_config().with_env();
+            adapters = wgpu::Instance::new(desc).enumerate_adapters(b).await;
+            if let Some(name) = &wanted {
+                adapters.retain(|a| a.get_info().name.to_lowercase().contains(name));
+            }
+            if !adapters.is_empty() {
+                break;
+            }
         }
         adapters.sort_by_key(|a| rank(&a.get_info()));
         let Some(adapter) = adapters.into_iter().next() else {
