@@ -56,13 +56,8 @@ fn edge_eval(c0: vec4<f32>, c1: vec4<f32>, c2: vec4<f32>, mask: u32, pixel: vec2
     let l0 = cross(p0, p1);
     let l1 = cross(p1, p2);
     let l2 = cross(p2, p0);
-    let behind = vec3<bool>(c0.z < 0.0, c1.z < 0.0, c2.z < 0.0);
     var out: EdgeEval;
-    out.distance = vec3<f32>(
-        line_distance(l0, (mask & 1u) != 0u && !(behind.x && behind.y)),
-        line_distance(l1, (mask & 2u) != 0u && !(behind.y && behind.z)),
-        line_distance(l2, (mask & 4u) != 0u && !(behind.z && behind.x)),
-    );
+    out.distance = edge_distances(l0, l1, l2, vec3<f32>(c0.z, c1.z, c2.z), mask);
     // Corner i's weight is the line of the opposite edge evaluated at the pixel.
     let e = vec3<f32>(l1.z, l2.z, l0.z);
     let sum = e.x + e.y + e.z;
@@ -72,6 +67,17 @@ fn edge_eval(c0: vec4<f32>, c1: vec4<f32>, c2: vec4<f32>, mask: u32, pixel: vec2
         out.bary = vec3<f32>(1.0 / 3.0);
     }
     return out;
+}
+
+// Distances to the three edge lines of `edge_eval`, applying the mask and the near-plane rule
+// (`clip_z` holds the corners' clip z; below 0 is behind the near plane).
+fn edge_distances(l0: vec3<f32>, l1: vec3<f32>, l2: vec3<f32>, clip_z: vec3<f32>, mask: u32) -> vec3<f32> {
+    let behind = clip_z < vec3<f32>(0.0);
+    return vec3<f32>(
+        line_distance(l0, (mask & 1u) != 0u && !(behind.x && behind.y)),
+        line_distance(l1, (mask & 2u) != 0u && !(behind.y && behind.z)),
+        line_distance(l2, (mask & 4u) != 0u && !(behind.z && behind.x)),
+    );
 }
 
 fn line_distance(l: vec3<f32>, drawn: bool) -> f32 {

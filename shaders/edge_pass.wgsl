@@ -22,41 +22,134 @@ fn normal(v: u32) -> vec3<f32> {
     return vec3<f32>(normals[3u * v], normals[3u * v + 1u], normals[3u * v + 2u]);
 }
 
+// Pixels whose centre lies within this many pixels of their triangle's boundary are checked
+// against the triangles of their 3×3 neighbourhood. Rasterizers snap vertices to a sub-pixel
+// grid (8 bits on lavapipe, llvmpipe and desktop GPUs: errors up to 1/512 px), so such a
+// centre may have been given to the wrong side of an edge; the exact test below decides.
+const COVERAGE_MARGIN: f32 = 1.0 / 128.0;
+
+// One triangle seen from one pixel centre.
+struct Sample {
+    id: u32,
+    clip0: vec4<f32>,
+    clip1: vec4<f32>,
+    clip2: vec4<f32>,
+    // Screen lines of the three edges, relative to the pixel centre (see `edge_eval`).
+    l0: vec3<f32>,
+    l1: vec3<f32>,
+    l2: vec3<f32>,
+    bary: vec3<f32>,
+    // The centre's ray hits the triangle between the near and far planes.
+    covers: bool,
+    // Distance from the centre to the nearest edge line, drawn or not.
+    margin: f32,
+    // Clip w of the hit point (the view distance): smaller is nearer.
+    w: f32,
+}
+
+fn sample(id: u32, pixel: vec2<f32>) -> Sample {
+    var s: Sample;
+    s.id = id;
+    let v = vec3<u32>(indices[3u * id], indices[3u * id + 1u], indices[3u * id + 2u]);
+    s.clip0 = frame.view_proj * vec4<f32>(position(v.x), 1.0);
+    s.clip1 = frame.view_proj * vec4<f32>(position(v.y), 1.0);
+    s.clip2 = frame.view_proj * vec4<f32>(position(v.z), 1.0);
+    let p0 = pixel_relative(s.clip0, pixel, frame.size);
+    let p1 = pixel_relative(s.clip1, pixel, frame.size);
+    let p2 = pixel_relative(s.clip2, pixel, frame.size);
+    s.l0 = cross(p0, p1);
+    s.l1 = cross(p1, p2);
+    s.l2 = cross(p2, p0);
+    let e = vec3<f32>(s.l1.z, s.l2.z, s.l0.z);
+    let sum = e.x + e.y + e.z;
+    s.bary = select(vec3<f32>(-1.0), e / sum, sum != 0.0);
+    let hit = s.bary.x * s.clip0 + s.bary.y * s.clip1 + s.bary.z * s.clip2;
+    s.covers = all(s.bary >= vec3<f32>(0.0)) && hit.z >= 0.0 && hit.z <= hit.w;
+    s.w = hit.w;
+    s.margin = min(line_distance(s.l0, true), min(line_distance(s.l1, true), line_distance(s.l2, true)));
+    return s;
+}
+
+// The triangle whose surface the centre of pixel `xy` sees: the rasterizer's answer unless
+// the centre lies within COVERAGE_MARGIN of that triangle's boundary, or the pixel is
+// background. Then the neighbourhood's triangles are tested exactly and the nearest one
+// covering the centre wins; if none does, the pixel is background where background is next
+// to it, and keeps the rasterizer's triangle otherwise (the true one is not in reach).
+fn resolve(xy: vec2<u32>, pixel: vec2<f32>) -> Sample {
+    let raster = textureLoad(ids, xy, 0).x;
+    var best: Sample;
+    best.id = BACKGROUND_ID;
+    best.w = 3.0e38;
+    var fallback = best;
+    if raster != BACKGROUND_ID {
+        let s = sample(raster, pixel);
+        if s.covers && s.margin >= COVERAGE_MARGIN {
+            return s;
+        }
+        if s.covers {
+            best = s;
+        }
+        fallback = s;
+    }
+    var background_near = raster == BACKGROUND_ID;
+    let last = vec2<i32>(frame.size) - 1;
+    var checked = raster;
+    for (var dy = -1; dy <= 1; dy++) {
+        for (var dx = -1; dx <= 1; dx++) {
+            let q = clamp(vec2<i32>(xy) + vec2<i32>(dx, dy), vec2<i32>(0), last);
+            let id = textureLoad(ids, vec2<u32>(q), 0).x;
+            background_near = background_near || id == BACKGROUND_ID;
+            if id == BACKGROUND_ID || id == raster || id == checked {
+                continue;
+            }
+            checked = id;
+            let s = sample(id, pixel);
+            if s.covers && s.w < best.w {
+                best = s;
+            }
+        }
+    }
+    if best.id == BACKGROUND_ID && !background_near {
+        return fallback;
+    }
+    return best;
+}
+
 struct Pixel {
-    // False on background.
-    covered: bool,
+    // The visible triangle, BACKGROUND_ID on background.
+    id: u32,
     // Distance in pixels to the nearest drawn edge of the visible triangle.
     distance: f32,
     // Linear shaded surface colour.
     surface: vec3<f32>,
+    // Reverse-Z depth of the visible point (0 on background).
+    depth: f32,
 }
 
 fn evaluate(xy: vec2<u32>) -> Pixel {
     var out: Pixel;
-    out.covered = false;
+    let pixel = vec2<f32>(xy) + 0.5;
+    let s = resolve(xy, pixel);
+    out.id = s.id;
     out.distance = NO_EDGE;
-    let id = textureLoad(ids, xy, 0).x;
-    if id == BACKGROUND_ID {
+    out.depth = 0.0;
+    if s.id == BACKGROUND_ID {
         return out;
     }
+    let id = s.id;
+    let mask = (edge_masks[id >> 2u] >> ((id & 3u) * 8u)) & 7u;
+    let d = edge_distances(s.l0, s.l1, s.l2, vec3<f32>(s.clip0.z, s.clip1.z, s.clip2.z), mask);
+    out.distance = min(d.x, min(d.y, d.z));
+
     let v = vec3<u32>(indices[3u * id], indices[3u * id + 1u], indices[3u * id + 2u]);
     let w0 = position(v.x);
     let w1 = position(v.y);
     let w2 = position(v.z);
-    let mask = (edge_masks[id >> 2u] >> ((id & 3u) * 8u)) & 7u;
-    let pixel = vec2<f32>(xy) + 0.5;
-    let e = edge_eval(
-        frame.view_proj * vec4<f32>(w0, 1.0),
-        frame.view_proj * vec4<f32>(w1, 1.0),
-        frame.view_proj * vec4<f32>(w2, 1.0),
-        mask, pixel, frame.size,
-    );
-    out.covered = true;
-    out.distance = min(e.distance.x, min(e.distance.y, e.distance.z));
-
-    let world = e.bary.x * w0 + e.bary.y * w1 + e.bary.z * w2;
+    let b = s.bary;
+    let world = b.x * w0 + b.y * w1 + b.z * w2;
+    out.depth = dot(frame.depth_row, vec4<f32>(world, 1.0)) / s.w;
     let to_eye = frame.eye.xyz - world;
-    var n = e.bary.x * normal(v.x) + e.bary.y * normal(v.y) + e.bary.z * normal(v.z);
+    var n = b.x * normal(v.x) + b.y * normal(v.y) + b.z * normal(v.z);
     if !(dot(n, n) > 1e-12) {
         n = cross(w1 - w0, w2 - w0);
     }
@@ -81,7 +174,7 @@ fn shade_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let p = evaluate(gid.xy);
     var color = frame.background;
-    if p.covered {
+    if p.id != BACKGROUND_ID {
         let i = line_intensity(p.distance, frame.line_width);
         color = vec4<f32>(mix(p.surface, frame.wire_color.rgb, i * frame.wire_color.a), 1.0);
     }
@@ -99,23 +192,24 @@ fn overlay_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let p = evaluate(gid.xy);
     var color = textureLoad(host_color, gid.xy, 0);
-    if p.covered {
+    if p.id != BACKGROUND_ID {
         let i = line_intensity(p.distance, frame.line_width) * frame.wire_color.a;
         color = vec4<f32>(mix(color.rgb, frame.wire_color.rgb, i), max(color.a, i));
     }
     textureStore(overlay_out, gid.xy, encode_output(color));
 }
 
-// Diagnostic mode: the raw distance (pixels; NO_EDGE on background) and the raster depth,
-// which some backends (GL) cannot copy out of a depth texture directly.
+// Diagnostic mode, for tools and tests: the raw edge distance (pixels; NO_EDGE on
+// background) and the reverse-Z depth of the visible point, and the resolved triangle id.
 @group(1) @binding(3) var diagnostic_out: texture_storage_2d<rgba32float, write>;
-@group(1) @binding(4) var depth_in: texture_2d<f32>;
+@group(1) @binding(4) var resolved_ids: texture_storage_2d<r32uint, write>;
 
 @compute @workgroup_size(8, 8)
 fn diagnostic_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if !inside(gid.xy) {
         return;
     }
-    let depth = textureLoad(depth_in, gid.xy, 0).x;
-    textureStore(diagnostic_out, gid.xy, vec4<f32>(evaluate(gid.xy).distance, depth, 0.0, 0.0));
+    let p = evaluate(gid.xy);
+    textureStore(diagnostic_out, gid.xy, vec4<f32>(p.distance, p.depth, 0.0, 0.0));
+    textureStore(resolved_ids, gid.xy, vec4<u32>(p.id, 0u, 0u, 0u));
 }

@@ -11,8 +11,11 @@ use wgpu::util::DeviceExt;
 pub const ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 /// Format of the depth target (reverse-Z: 1 at the near plane, 0 at the far plane).
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
-/// Format of the diagnostic map: distance in pixels (r) and reverse-Z raster depth (g).
+/// Format of the diagnostic map: distance in pixels (r) and reverse-Z depth (g) of the
+/// visible point.
 pub const DIAGNOSTIC_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+/// Format of the resolved-id map the diagnostic mode writes.
+pub const RESOLVED_ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 /// Edge-pass workgroup side (8 × 8 pixels).
 const TILE: u32 = 8;
 
@@ -44,9 +47,9 @@ pub enum OutputTarget<'a> {
         /// Where the blended image goes (the pass's output format).
         output: &'a wgpu::TextureView,
     },
-    /// Diagnostics into the pass's own `Rgba32Float` texture (see
-    /// [`DeferredPass::diagnostic_texture`]): the per-pixel edge distance in pixels (red) and
-    /// the raster depth (green), for tools and tests.
+    /// Diagnostics for tools and tests into the pass's own textures: the edge distance in
+    /// pixels (red) and reverse-Z depth (green) of [`DeferredPass::diagnostic_texture`], and
+    /// the triangle ids after the exact coverage test, [`DeferredPass::resolved_id_texture`].
     Diagnostic,
 }
 
@@ -56,6 +59,7 @@ struct Targets {
     ids: wgpu::Texture,
     depth: wgpu::Texture,
     diagnostic: wgpu::Texture,
+    resolved_ids: wgpu::Texture,
 }
 
 /// The deferred wireframe pass. Construct once with [`DeferredPass::new`], call
@@ -248,11 +252,7 @@ impl DeferredPass {
             "diagnostic_main",
             &[
                 entry(3, cs, storage_texture(DIAGNOSTIC_FORMAT)),
-                entry(
-                    4,
-                    cs,
-                    texture(wgpu::TextureSampleType::Float { filterable: false }),
-                ),
+                entry(4, cs, storage_texture(RESOLVED_ID_FORMAT)),
             ],
         );
 
@@ -337,14 +337,15 @@ impl DeferredPass {
                     ID_FORMAT,
                     U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC,
                 ),
-                depth: make(
-                    "wirepass depth",
-                    DEPTH_FORMAT,
-                    U::RENDER_ATTACHMENT | U::TEXTURE_BINDING,
-                ),
+                depth: make("wirepass depth", DEPTH_FORMAT, U::RENDER_ATTACHMENT),
                 diagnostic: make(
                     "wirepass diagnostic",
                     DIAGNOSTIC_FORMAT,
+                    U::STORAGE_BINDING | U::COPY_SRC,
+                ),
+                resolved_ids: make(
+                    "wirepass resolved ids",
+                    RESOLVED_ID_FORMAT,
                     U::STORAGE_BINDING | U::COPY_SRC,
                 ),
             });
@@ -371,6 +372,12 @@ impl DeferredPass {
     /// The reverse-Z depth target (`Depth32Float`, 1 = near plane) of the last frame.
     pub fn depth_texture(&self) -> Option<&wgpu::Texture> {
         self.targets.as_ref().map(|t| &t.depth)
+    }
+
+    /// The triangle each pixel centre sees, after the edge pass's exact coverage test
+    /// (see `resolve` in `edge_pass.wgsl`), written by [`OutputTarget::Diagnostic`].
+    pub fn resolved_id_texture(&self) -> Option<&wgpu::Texture> {
+        self.targets.as_ref().map(|t| &t.resolved_ids)
     }
 
     /// The diagnostic map written by [`OutputTarget::Diagnostic`].
@@ -518,7 +525,7 @@ impl DeferredPass {
             }
             Ok(())
         };
-        let (diagnostic_view, depth_view);
+        let (diagnostic_view, resolved_view);
         let (pipeline, layout, entries) = match target {
             OutputTarget::Shaded(out) => {
                 check(out, "the output texture")?;
@@ -551,7 +558,7 @@ impl DeferredPass {
             }
             OutputTarget::Diagnostic => {
                 diagnostic_view = targets.diagnostic.create_view(&Default::default());
-                depth_view = targets.depth.create_view(&Default::default());
+                resolved_view = targets.resolved_ids.create_view(&Default::default());
                 (
                     &self.diagnostic.0,
                     &self.diagnostic.1,
@@ -562,7 +569,7 @@ impl DeferredPass {
                         },
                         wgpu::BindGroupEntry {
                             binding: 4,
-                            resource: wgpu::BindingResource::TextureView(&depth_view),
+                            resource: wgpu::BindingResource::TextureView(&resolved_view),
                         },
                     ],
                 )
