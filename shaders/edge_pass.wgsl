@@ -11,6 +11,9 @@
 // Edge masks, 8 bits per triangle, 4 triangles per word.
 @group(0) @binding(4) var<storage, read> edge_masks: array<u32>;
 @group(0) @binding(5) var ids: texture_2d<u32>;
+// The triangle across each edge (3 per triangle, edge i = corner i -> i+1), or
+// BACKGROUND_ID for boundary and non-manifold edges.
+@group(0) @binding(6) var<storage, read> neighbours: array<u32>;
 
 const BACKGROUND_ID: u32 = 0xffffffffu;
 
@@ -70,6 +73,39 @@ fn sample(id: u32, pixel: vec2<f32>) -> Sample {
     return s;
 }
 
+// Steps of the walk across edges in `walk`: enough to go round a vertex's fan of small
+// triangles from a rasterized neighbour to the one that owns the centre.
+const WALK_STEPS: u32 = 6u;
+
+// Point location by walking: from `start`, which does not cover the pixel centre, cross the
+// edge the centre lies beyond until a triangle covers it. Finds the owner of a centre that
+// the rasterizer gave to a neighbour when the owner (a sub-pixel triangle, say) has no
+// rasterized pixel of its own.
+fn walk(start: Sample, pixel: vec2<f32>) -> Sample {
+    var s = start;
+    for (var step = 0u; step < WALK_STEPS; step++) {
+        if s.covers || any(s.bary == vec3<f32>(-1.0)) {
+            return s;
+        }
+        // Corner k's weight is negative beyond the opposite edge (k + 1) % 3.
+        var edge = 1u;
+        if s.bary.y < s.bary.x && s.bary.y <= s.bary.z {
+            edge = 2u;
+        } else if s.bary.z < s.bary.x && s.bary.z < s.bary.y {
+            edge = 0u;
+        }
+        if s.bary[(edge + 2u) % 3u] >= 0.0 {
+            return s; // inside the triangle but beyond the near or far plane
+        }
+        let next = neighbours[3u * s.id + edge];
+        if next == BACKGROUND_ID {
+            return s;
+        }
+        s = sample(next, pixel);
+    }
+    return s;
+}
+
 // The triangle whose surface the centre of pixel `xy` sees: the rasterizer's answer unless
 // the centre lies within COVERAGE_MARGIN of that triangle's boundary, or the pixel is
 // background. Then the neighbourhood's triangles are tested exactly and the nearest one
@@ -88,6 +124,11 @@ fn resolve(xy: vec2<u32>, pixel: vec2<f32>) -> Sample {
         }
         if s.covers {
             best = s;
+        } else {
+            let found = walk(s, pixel);
+            if found.covers {
+                best = found;
+            }
         }
         fallback = s;
     }
@@ -103,7 +144,10 @@ fn resolve(xy: vec2<u32>, pixel: vec2<f32>) -> Sample {
                 continue;
             }
             checked = id;
-            let s = sample(id, pixel);
+            var s = sample(id, pixel);
+            if !s.covers && raster == BACKGROUND_ID {
+                s = walk(s, pixel);
+            }
             if s.covers && s.w < best.w {
                 best = s;
             }

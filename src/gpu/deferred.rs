@@ -210,6 +210,7 @@ impl DeferredPass {
                 entry(3, cs, storage()),
                 entry(4, cs, storage()),
                 entry(5, cs, texture(wgpu::TextureSampleType::Uint)),
+                entry(6, cs, storage()),
             ],
         });
         let edge_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -509,6 +510,10 @@ impl DeferredPass {
                 wgpu::BindGroupEntry {
                     binding: 5,
                     resource: wgpu::BindingResource::TextureView(&ids),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 6,
+                    resource: mesh.neighbours.as_entire_binding(),
                 },
             ],
         });

@@ -5,8 +5,8 @@ use crate::mesh::{EdgeSelection, Mesh};
 use glam::DVec3;
 use wgpu::util::DeviceExt;
 
-/// A mesh uploaded for drawing: positions, normals, indices and the packed edge mask in
-/// storage buffers (positions and indices double as vertex and index buffers).
+/// A mesh uploaded for drawing: positions, normals, indices, the packed edge mask and the
+/// edge adjacency (for the edge pass's exact coverage walk) in storage buffers (positions and indices double as vertex and index buffers).
 ///
 /// Positions are stored relative to the centre of the mesh bounds, `origin`, so that f32
 /// keeps its precision for meshes far from the world origin; the per-frame matrix adds the
@@ -16,6 +16,7 @@ pub struct GpuMesh {
     pub(crate) normals: wgpu::Buffer,
     pub(crate) indices: wgpu::Buffer,
     pub(crate) edge_masks: wgpu::Buffer,
+    pub(crate) neighbours: wgpu::Buffer,
     pub(crate) triangles: u32,
     pub(crate) origin: DVec3,
     pub(crate) bytes: u64,
@@ -35,12 +36,14 @@ impl GpuMesh {
         let indices: &[u32] = bytemuck::cast_slice(mesh.triangles());
         let mut masks = mesh.edge_mask(edges);
         masks.resize(masks.len().div_ceil(4) * 4, 0);
+        let neighbours: &[u32] = bytemuck::cast_slice(mesh.edge_neighbours());
 
         let limits = device.limits();
         for (what, len) in [
             ("vertex positions", positions.len() * 4),
             ("vertex normals", normals.len() * 4),
             ("triangle indices", indices.len() * 4),
+            ("edge neighbours", neighbours.len() * 4),
         ] {
             let len = len as u64;
             let limit =
@@ -83,6 +86,11 @@ impl GpuMesh {
                 "wirepass edge masks",
                 &masks,
                 storage | wgpu::BufferUsages::COPY_DST,
+            ),
+            neighbours: create(
+                "wirepass edge neighbours",
+                bytemuck::cast_slice(neighbours),
+                storage,
             ),
             triangles: mesh.triangle_count() as u32,
             origin,

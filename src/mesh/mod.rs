@@ -1,6 +1,7 @@
 //! Triangle meshes as every method sees them: positions, smooth normals, triangles, and the
 //! per-triangle mask that says which triangle edges were edges of the source polygons.
 
+pub mod adjacency;
 mod obj;
 mod procedural;
 
@@ -31,6 +32,8 @@ pub struct Mesh {
     normals: Vec<Vec3>,
     triangles: Vec<[u32; 3]>,
     polygon_edges: Vec<u8>,
+    /// Edge adjacency, computed on first use.
+    neighbours: std::sync::OnceLock<Vec<[u32; 3]>>,
 }
 
 impl Mesh {
@@ -109,6 +112,7 @@ impl Mesh {
             normals,
             triangles,
             polygon_edges,
+            neighbours: Default::default(),
         })
     }
 
@@ -138,6 +142,14 @@ impl Mesh {
             EdgeSelection::All => vec![ALL_EDGES; self.triangles.len()],
             EdgeSelection::Polygon => self.polygon_edges.clone(),
         }
+    }
+
+    /// The triangle across each triangle edge (edge `i` runs from corner `i` to `i + 1`),
+    /// with vertices welded by position, or [`adjacency::NO_NEIGHBOUR`] on boundary and
+    /// non-manifold edges. Computed once, on first use.
+    pub fn edge_neighbours(&self) -> &[[u32; 3]] {
+        self.neighbours
+            .get_or_init(|| adjacency::edge_neighbours(&self.positions, &self.triangles))
     }
 
     /// Axis-aligned bounds `(min, max)` of the positions that triangles use.

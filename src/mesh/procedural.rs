@@ -181,6 +181,7 @@ pub fn default_scene() -> Mesh {
         normals: scene.normals,
         triangles: scene.triangles,
         polygon_edges: scene.edges,
+        neighbours: Default::default(),
     }
 }
 
