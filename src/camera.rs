@@ -35,7 +35,10 @@ impl Camera {
             return bad(format!("eye and target are the same point {}", self.eye));
         }
         let up = self.up.as_dvec3();
-        if up.length() == 0.0 || dir.normalize().cross(up.normalize()).length() < 1e-6 {
+        if up.length() == 0.0 {
+            return bad("up is the zero vector".into());
+        }
+        if dir.normalize().cross(up.normalize()).length() < 1e-6 {
             return bad(format!(
                 "up {} is parallel to the view direction {}",
                 self.up,

@@ -1,0 +1,123 @@
+//! The command line: a render that works, and bad input that gives one clear line and a
+//! non-zero exit, never a panic.
+
+use std::process::Command;
+
+fn wirepass(args: &[&str]) -> (bool, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_wirepass"))
+        .args(args)
+        .output()
+        .expect("the wirepass binary runs");
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(!stderr.contains("panicked"), "panic for {args:?}: {stderr}");
+    (out.status.success(), stderr)
+}
+
+fn temp(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("wirepass-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+#[test]
+fn renders_the_built_in_scene_and_dumps_numpy_files() {
+    let png = temp("scene.png");
+    let dump = temp("dump");
+    let (ok, err) = wirepass(&[
+        "render",
+        "--size",
+        "64x48",
+        "-o",
+        png.to_str().unwrap(),
+        "--dump",
+        dump.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let img = image::open(&png).unwrap();
+    assert_eq!((img.width(), img.height()), (64, 48));
+    for (name, descr) in [
+        ("ids.npy", "<u4"),
+        ("depth.npy", "<f4"),
+        ("edge_distance.npy", "<f4"),
+    ] {
+        let bytes = std::fs::read(dump.join(name)).unwrap();
+        assert_eq!(&bytes[..6], b"\x93NUMPY", "{name}");
+        let header = String::from_utf8_lossy(&bytes[10..128.min(bytes.len())]).into_owned();
+        assert!(
+            header.contains(descr) && header.contains("(48, 64"),
+            "{name}: {header}"
+        );
+        let payload = bytes.len() - (10 + u16::from_le_bytes([bytes[8], bytes[9]]) as usize);
+        assert_eq!(payload, 48 * 64 * 4, "{name}");
+    }
+    let camera: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dump.join("camera.json")).unwrap()).unwrap();
+    for key in [
+        "eye",
+        "target",
+        "up",
+        "fov_y_deg",
+        "near",
+        "far",
+        "size",
+        "view",
+        "projection",
+    ] {
+        assert!(camera.get(key).is_some(), "camera.json lacks {key}");
+    }
+    assert_eq!(camera["view"].as_array().unwrap().len(), 16);
+}
+
+#[test]
+fn bad_settings_give_one_clear_line() {
+    let out = temp("bad.png");
+    let o = out.to_str().unwrap();
+    let cases: &[(&[&str], &str)] = &[
+        (&["render", "--size", "0x10", "-o", o], "zero side"),
+        (&["render", "--size", "100x", "-o", o], "WIDTHxHEIGHT"),
+        (
+            &["render", "--size", "1000000x10", "-o", o],
+            "max_texture_dimension_2d",
+        ),
+        (
+            &["render", "--eye", "1,1,1", "--target", "1,1,1", "-o", o],
+            "same point",
+        ),
+        (&["render", "--up", "0,0,0", "-o", o], "zero vector"),
+        (
+            &[
+                "render", "--eye", "0,5,0", "--target", "0,0,0", "--up", "0,1,0", "-o", o,
+            ],
+            "parallel",
+        ),
+        (&["render", "--fov", "0", "-o", o], "fov"),
+        (&["render", "--fov", "180", "-o", o], "fov"),
+        (&["render", "--near", "0", "-o", o], "near"),
+        (&["render", "--near", "2", "--far", "1", "-o", o], "far"),
+        (&["render", "--line-width", "-1", "-o", o], "line width"),
+        (&["render", "--wire-color", "red", "-o", o], "colour"),
+        (&["render", "--eye", "1,2", "-o", o], "x,y,z"),
+        (&["render", "sphere:2", "-o", o], "sphere"),
+        (&["render", "cube:10", "-o", o], "procedural"),
+        (
+            &["render", "/no/such/mesh.obj", "-o", o],
+            "/no/such/mesh.obj",
+        ),
+        (&["render", "--method", "magic", "-o", o], "method"),
+    ];
+    for (args, expect) in cases {
+        let (ok, err) = wirepass(args);
+        assert!(!ok, "{args:?} succeeded");
+        assert!(
+            err.contains(expect),
+            "{args:?}: expected {expect:?} in {err:?}"
+        );
+        // Software drivers may print their own notices (e.g. about XDG_RUNTIME_DIR); the
+        // program itself says exactly one line.
+        let lines: Vec<_> = err
+            .lines()
+            .filter(|l| l.starts_with("wirepass: error:") || l.starts_with("error: invalid value"))
+            .collect();
+        assert_eq!(lines.len(), 1, "{args:?}: {err}");
+    }
+}
