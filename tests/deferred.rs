@@ -347,3 +347,45 @@ fn overlay_blends_lines_over_the_host_image_and_resizes() {
         );
     }
 }
+
+#[test]
+fn timer_reports_both_passes() {
+    let ctx = gpu();
+    let device = &ctx.device;
+    let mesh = wirepass::mesh::default_scene();
+    let mut pass = DeferredPass::new(device, PassOptions::default()).unwrap();
+    let gpu_mesh = GpuMesh::new(device, &mesh, EdgeSelection::Polygon).unwrap();
+    let (lo, hi) = mesh.bounds();
+    let cam = Camera::framing(lo, hi, 1.0);
+    pass.prepare(
+        device,
+        &ctx.queue,
+        &gpu_mesh,
+        &cam,
+        &Style::default(),
+        (64, 64),
+    )
+    .unwrap();
+    let mut timer = wirepass::gpu::GpuTimer::new(device, &ctx.queue, 4)
+        .expect("software adapters expose TIMESTAMP_QUERY");
+    for _ in 0..2 {
+        let mut encoder = device.create_command_encoder(&Default::default());
+        pass.encode_timed(
+            device,
+            &mut encoder,
+            &gpu_mesh,
+            OutputTarget::Diagnostic,
+            &mut timer,
+        )
+        .unwrap();
+        timer.resolve(&mut encoder);
+        ctx.queue.submit([encoder.finish()]);
+        let spans = timer.read(device).unwrap();
+        let names: Vec<_> = spans.iter().map(|s| s.0).collect();
+        assert_eq!(names, ["visibility", "edge"]);
+        assert!(
+            spans.iter().all(|s| s.1.is_finite() && s.1 >= 0.0),
+            "{spans:?}"
+        );
+    }
+}

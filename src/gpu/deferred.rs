@@ -1,7 +1,7 @@
 //! The deferred wireframe pass: a visibility raster pass (triangle id + depth) followed by a
 //! compute pass that reconstructs each pixel's distance to its triangle's edges.
 
-use super::{check_size, shaders, FrameUniforms, GpuMesh};
+use super::{check_size, shaders, FrameUniforms, GpuMesh, GpuTimer};
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::style::Style;
@@ -394,8 +394,22 @@ impl DeferredPass {
         mesh: &GpuMesh,
         target: OutputTarget<'_>,
     ) -> Result<()> {
-        self.encode_visibility(device, encoder, mesh)?;
-        self.encode_edges(device, encoder, mesh, target)
+        self.visibility(device, encoder, mesh, None)?;
+        self.edges(device, encoder, mesh, target, None)
+    }
+
+    /// [`encode`](Self::encode) with GPU timestamps around the two passes, named
+    /// `"visibility"` and `"edge"` in `timer`.
+    pub fn encode_timed(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        mesh: &GpuMesh,
+        target: OutputTarget<'_>,
+        timer: &mut GpuTimer,
+    ) -> Result<()> {
+        self.visibility(device, encoder, mesh, Some(&mut *timer))?;
+        self.edges(device, encoder, mesh, target, Some(timer))
     }
 
     /// Records only the visibility pass (triangle ids and depth).
@@ -404,6 +418,16 @@ impl DeferredPass {
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
         mesh: &GpuMesh,
+    ) -> Result<()> {
+        self.visibility(device, encoder, mesh, None)
+    }
+
+    fn visibility(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        mesh: &GpuMesh,
+        timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
         let targets = self.targets()?;
         let ids = targets.ids.create_view(&Default::default());
@@ -457,7 +481,7 @@ impl DeferredPass {
                 }),
                 stencil_ops: None,
             }),
-            timestamp_writes: None,
+            timestamp_writes: timer.and_then(|t| t.render_span("visibility")),
             occlusion_query_set: None,
             multiview_mask: None,
         });
@@ -480,6 +504,17 @@ impl DeferredPass {
         encoder: &mut wgpu::CommandEncoder,
         mesh: &GpuMesh,
         target: OutputTarget<'_>,
+    ) -> Result<()> {
+        self.edges(device, encoder, mesh, target, None)
+    }
+
+    fn edges(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        mesh: &GpuMesh,
+        target: OutputTarget<'_>,
+        timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
         let targets = self.targets()?;
         let ids = targets.ids.create_view(&Default::default());
@@ -587,7 +622,7 @@ impl DeferredPass {
         });
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("wirepass edge pass"),
-            timestamp_writes: None,
+            timestamp_writes: timer.and_then(|t| t.compute_span("edge")),
         });
         pass.set_pipeline(pipeline);
         pass.set_bind_group(0, &mesh_group, &[]);
