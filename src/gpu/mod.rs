@@ -5,6 +5,7 @@ mod deferred;
 mod frame;
 mod mesh;
 mod readback;
+mod timing;
 pub mod shaders;
 
 pub use context::{GpuContext, OPTIONAL_FEATURES};
@@ -12,6 +13,7 @@ pub use deferred::{DeferredPass, OutputTarget, PassOptions};
 pub use frame::FrameUniforms;
 pub use mesh::GpuMesh;
 pub use readback::read_texture;
+pub use timing::GpuTimer;
 
 use crate::error::{Error, Result};
 
