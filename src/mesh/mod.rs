@@ -15,13 +15,43 @@ use glam::Vec3;
 pub const ALL_EDGES: u8 = 0b111;
 
 /// Which triangle edges are drawn.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub enum EdgeSelection {
     /// Every triangle edge, diagonals of triangulated polygons included.
     All,
     /// Only edges of the source polygons: the diagonals a triangulation adds are left out.
     #[default]
     Polygon,
+    /// Feature edges: where the faces on the two sides meet at a dihedral angle above the
+    /// threshold in degrees, plus boundary and non-manifold edges (vertices welded by
+    /// position). Three.js `EdgesGeometry` uses 1°.
+    Feature(f32),
+}
+
+/// Default threshold of [`EdgeSelection::Feature`], in degrees.
+pub const DEFAULT_FEATURE_ANGLE: f32 = 1.0;
+
+impl std::str::FromStr for EdgeSelection {
+    type Err = Error;
+
+    /// Parses `all`, `polygon`, `feature` or `feature:DEGREES`.
+    fn from_str(s: &str) -> Result<Self> {
+        let bad = || {
+            Error::InvalidSetting(format!(
+                "edges {s:?} is not all, polygon, feature or feature:DEGREES (0 to 180)"
+            ))
+        };
+        match s.split_once(':') {
+            None if s == "all" => Ok(EdgeSelection::All),
+            None if s == "polygon" => Ok(EdgeSelection::Polygon),
+            None if s == "feature" => Ok(EdgeSelection::Feature(DEFAULT_FEATURE_ANGLE)),
+            Some(("feature", deg)) => match deg.trim().parse::<f32>() {
+                Ok(d) if (0.0..=180.0).contains(&d) => Ok(EdgeSelection::Feature(d)),
+                _ => Err(bad()),
+            },
+            _ => Err(bad()),
+        }
+    }
 }
 
 /// A validated triangle mesh. All objects and groups of a file form one mesh, so triangle
@@ -141,7 +171,38 @@ impl Mesh {
         match selection {
             EdgeSelection::All => vec![ALL_EDGES; self.triangles.len()],
             EdgeSelection::Polygon => self.polygon_edges.clone(),
+            EdgeSelection::Feature(degrees) => self.feature_edges(degrees),
         }
+    }
+
+    /// Mask of edges whose dihedral angle exceeds `degrees`, plus boundary and non-manifold
+    /// edges. An edge next to a zero-area triangle, whose normal is undefined, is drawn only
+    /// when it is a boundary.
+    fn feature_edges(&self, degrees: f32) -> Vec<u8> {
+        let cos_limit = f64::from(degrees).to_radians().cos();
+        let face_normal = |t: usize| {
+            let [a, b, c] = self.triangles[t].map(|v| self.positions[v as usize].as_dvec3());
+            (b - a).cross(c - a).try_normalize()
+        };
+        let normals: Vec<_> = (0..self.triangles.len()).map(face_normal).collect();
+        self.edge_neighbours()
+            .iter()
+            .enumerate()
+            .map(|(t, across)| {
+                let mut mask = 0;
+                for (i, &u) in across.iter().enumerate() {
+                    let feature = u == adjacency::NO_NEIGHBOUR
+                        || match (normals[t], normals[u as usize]) {
+                            (Some(n), Some(m)) => n.dot(m) < cos_limit,
+                            _ => false,
+                        };
+                    if feature {
+                        mask |= 1 << i;
+                    }
+                }
+                mask
+            })
+            .collect()
     }
 
     /// The triangle across each triangle edge (edge `i` runs from corner `i` to `i + 1`),
@@ -234,6 +295,55 @@ mod tests {
         let mut bad = p;
         bad[1].y = f32::NAN;
         assert!(Mesh::new(bad, None, vec![[0, 1, 2]], None).is_err());
+    }
+
+    #[test]
+    fn feature_edges_of_a_folded_quad() {
+        // Two triangles folded 90 degrees along their shared edge (0-2 / 2-0).
+        let p = vec![
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+            Vec3::new(0.0, 0.0, 1.0),
+        ];
+        let m = Mesh::new(p, None, vec![[0, 1, 2], [2, 3, 0]], None).unwrap();
+        // Shared edge: triangle 0 edge 2 (2->0), triangle 1 edge 2 (0->2).
+        assert_eq!(
+            m.edge_mask(EdgeSelection::Feature(30.0)),
+            vec![0b111, 0b111]
+        );
+        assert_eq!(
+            m.edge_mask(EdgeSelection::Feature(95.0)),
+            vec![0b011, 0b011]
+        );
+        // A flat quad's diagonal is never a feature.
+        assert_eq!(
+            quad().edge_mask(EdgeSelection::Feature(0.5)),
+            vec![0b011, 0b110]
+        );
+    }
+
+    #[test]
+    fn parses_edge_selections() {
+        assert_eq!("all".parse::<EdgeSelection>().unwrap(), EdgeSelection::All);
+        assert_eq!(
+            "feature".parse::<EdgeSelection>().unwrap(),
+            EdgeSelection::Feature(1.0)
+        );
+        assert_eq!(
+            "feature:30".parse::<EdgeSelection>().unwrap(),
+            EdgeSelection::Feature(30.0)
+        );
+        for bad in [
+            "",
+            "feature:",
+            "feature:-1",
+            "feature:200",
+            "features",
+            "polygon:3",
+        ] {
+            assert!(bad.parse::<EdgeSelection>().is_err(), "{bad}");
+        }
     }
 
     #[test]
