@@ -257,3 +257,17 @@ fn diagnostic_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     textureStore(diagnostic_out, gid.xy, vec4<f32>(p.distance, p.depth, 0.0, 0.0));
     textureStore(resolved_ids, gid.xy, vec4<u32>(p.id, 0u, 0u, 0u));
 }
+
+// Floor mode, for benchmarks: the least any deferred pass can cost. It reads the id and
+// writes a flat colour, with no geometry, shading or line work.
+@group(1) @binding(5) var floor_out: texture_storage_2d<OUTPUT_FORMAT, write>;
+
+@compute @workgroup_size(8, 8)
+fn floor_main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if !inside(gid.xy) {
+        return;
+    }
+    let id = textureLoad(ids, gid.xy, 0).x;
+    let color = select(frame.fill_color, frame.background, id == BACKGROUND_ID);
+    textureStore(floor_out, gid.xy, encode_output(color));
+}

@@ -51,6 +51,9 @@ pub enum OutputTarget<'a> {
     /// pixels (red) and reverse-Z depth (green) of [`DeferredPass::diagnostic_texture`], and
     /// the triangle ids after the exact coverage test, [`DeferredPass::resolved_id_texture`].
     Diagnostic,
+    /// The benchmark floor: reads each pixel's id and writes the fill or background colour
+    /// into the output, doing none of the edge work. What a deferred pass cannot go below.
+    Floor(&'a wgpu::TextureView),
 }
 
 /// Size-dependent targets, rebuilt only when the size changes.
@@ -74,6 +77,7 @@ pub struct DeferredPass {
     shade: (wgpu::ComputePipeline, wgpu::BindGroupLayout),
     overlay: (wgpu::ComputePipeline, wgpu::BindGroupLayout),
     diagnostic: (wgpu::ComputePipeline, wgpu::BindGroupLayout),
+    floor: (wgpu::ComputePipeline, wgpu::BindGroupLayout),
     frame: wgpu::Buffer,
     draw: wgpu::Buffer,
     targets: Option<Targets>,
@@ -256,6 +260,7 @@ impl DeferredPass {
                 entry(4, cs, storage_texture(RESOLVED_ID_FORMAT)),
             ],
         );
+        let floor = compute("floor_main", &[entry(5, cs, storage_texture(format))]);
 
         let frame = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("wirepass frame"),
@@ -280,6 +285,7 @@ impl DeferredPass {
             shade,
             overlay,
             diagnostic,
+            floor,
             frame,
             draw,
             targets: None,
@@ -594,6 +600,17 @@ impl DeferredPass {
                             resource: wgpu::BindingResource::TextureView(host),
                         },
                     ],
+                )
+            }
+            OutputTarget::Floor(out) => {
+                check(out, "the output texture")?;
+                (
+                    &self.floor.0,
+                    &self.floor.1,
+                    vec![wgpu::BindGroupEntry {
+                        binding: 5,
+                        resource: wgpu::BindingResource::TextureView(out),
+                    }],
                 )
             }
             OutputTarget::Diagnostic => {
