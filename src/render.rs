@@ -82,7 +82,7 @@ pub fn render(ctx: &GpuContext, scene: &Scene<'_>, method: Method) -> Result<Fra
 /// Renders `scene` with the deferred pass and reads back the image and all maps.
 pub fn render_deferred(ctx: &GpuContext, scene: &Scene<'_>) -> Result<Frame> {
     let device = &ctx.device;
-    let mut pass = DeferredPass::new(device, PassOptions::default())?;
+    let mut pass = DeferredPass::new(device, PassOptions::default())?.with_diagnostics();
     let mesh = GpuMesh::new(device, scene.mesh, scene.edges)?;
     pass.prepare(
         device,
@@ -120,7 +120,7 @@ pub fn render_deferred(ctx: &GpuContext, scene: &Scene<'_>) -> Result<Frame> {
     let ids = read_texture(
         device,
         &ctx.queue,
-        pass.id_texture().ok_or_else(missing)?,
+        pass.resolved_id_texture().ok_or_else(missing)?,
         all,
     )?;
     let diagnostic = read_texture(

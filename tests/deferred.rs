@@ -234,7 +234,8 @@ fn overlay_blends_lines_over_the_host_image_and_resizes() {
             output_format: wgpu::TextureFormat::Rgba16Float,
         },
     )
-    .unwrap();
+    .unwrap()
+    .with_diagnostics();
     let gpu_mesh = GpuMesh::new(device, &mesh, EdgeSelection::All).unwrap();
     let style = Style::default();
     let host_color = [0.2_f32, 0.4, 0.6, 1.0];
@@ -353,7 +354,9 @@ fn timer_reports_both_passes() {
     let ctx = gpu();
     let device = &ctx.device;
     let mesh = wirepass::mesh::default_scene();
-    let mut pass = DeferredPass::new(device, PassOptions::default()).unwrap();
+    let mut pass = DeferredPass::new(device, PassOptions::default())
+        .unwrap()
+        .with_diagnostics();
     let gpu_mesh = GpuMesh::new(device, &mesh, EdgeSelection::Polygon).unwrap();
     let (lo, hi) = mesh.bounds();
     let cam = Camera::framing(lo, hi, 1.0);

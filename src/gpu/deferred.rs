@@ -61,8 +61,8 @@ struct Targets {
     size: (u32, u32),
     ids: wgpu::Texture,
     depth: wgpu::Texture,
-    diagnostic: wgpu::Texture,
-    resolved_ids: wgpu::Texture,
+    /// Present when diagnostics are enabled: (distance + depth map, resolved ids).
+    diagnostic: Option<(wgpu::Texture, wgpu::Texture)>,
 }
 
 /// The deferred wireframe pass. Construct once with [`DeferredPass::new`], call
@@ -80,6 +80,7 @@ pub struct DeferredPass {
     floor: (wgpu::ComputePipeline, wgpu::BindGroupLayout),
     frame: wgpu::Buffer,
     draw: wgpu::Buffer,
+    diagnostics: bool,
     targets: Option<Targets>,
 }
 
@@ -288,8 +289,33 @@ impl DeferredPass {
             floor,
             frame,
             draw,
+            diagnostics: false,
             targets: None,
         })
+    }
+
+    /// Enables [`OutputTarget::Diagnostic`], which needs 20 more bytes of targets per pixel;
+    /// tools and tests use it, a renderer does not need it.
+    pub fn with_diagnostics(mut self) -> Self {
+        self.diagnostics = true;
+        self.targets = None;
+        self
+    }
+
+    /// GPU memory of the size-dependent targets, in bytes (0 before the first prepare).
+    pub fn target_bytes(&self) -> u64 {
+        let Some(t) = &self.targets else { return 0 };
+        let mut textures = vec![&t.ids, &t.depth];
+        if let Some((d, r)) = &t.diagnostic {
+            textures.extend([d, r]);
+        }
+        textures
+            .iter()
+            .map(|x| {
+                let texel = x.format().block_copy_size(None).unwrap_or(4);
+                u64::from(x.width()) * u64::from(x.height()) * u64::from(texel)
+            })
+            .sum()
     }
 
     /// True when the visibility pass pulls vertices because the device lacks
@@ -345,16 +371,20 @@ impl DeferredPass {
                     U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC,
                 ),
                 depth: make("wirepass depth", DEPTH_FORMAT, U::RENDER_ATTACHMENT),
-                diagnostic: make(
-                    "wirepass diagnostic",
-                    DIAGNOSTIC_FORMAT,
-                    U::STORAGE_BINDING | U::COPY_SRC,
-                ),
-                resolved_ids: make(
-                    "wirepass resolved ids",
-                    RESOLVED_ID_FORMAT,
-                    U::STORAGE_BINDING | U::COPY_SRC,
-                ),
+                diagnostic: self.diagnostics.then(|| {
+                    (
+                        make(
+                            "wirepass diagnostic",
+                            DIAGNOSTIC_FORMAT,
+                            U::STORAGE_BINDING | U::COPY_SRC,
+                        ),
+                        make(
+                            "wirepass resolved ids",
+                            RESOLVED_ID_FORMAT,
+                            U::STORAGE_BINDING | U::COPY_SRC,
+                        ),
+                    )
+                }),
             });
         }
         Ok(())
@@ -382,14 +412,16 @@ impl DeferredPass {
     }
 
     /// The triangle each pixel centre sees, after the edge pass's exact coverage test
-    /// (see `resolve` in `edge_pass.wgsl`), written by [`OutputTarget::Diagnostic`].
+    /// (see `resolve` in `edge_pass.wgsl`), written by [`OutputTarget::Diagnostic`]; `None`
+    /// unless diagnostics are enabled.
     pub fn resolved_id_texture(&self) -> Option<&wgpu::Texture> {
-        self.targets.as_ref().map(|t| &t.resolved_ids)
+        Some(&self.targets.as_ref()?.diagnostic.as_ref()?.1)
     }
 
-    /// The diagnostic map written by [`OutputTarget::Diagnostic`].
+    /// The diagnostic map written by [`OutputTarget::Diagnostic`]; `None` unless
+    /// diagnostics are enabled.
     pub fn diagnostic_texture(&self) -> Option<&wgpu::Texture> {
-        self.targets.as_ref().map(|t| &t.diagnostic)
+        Some(&self.targets.as_ref()?.diagnostic.as_ref()?.0)
     }
 
     /// Records the visibility pass and the edge pass into `encoder`.
@@ -614,8 +646,13 @@ impl DeferredPass {
                 )
             }
             OutputTarget::Diagnostic => {
-                diagnostic_view = targets.diagnostic.create_view(&Default::default());
-                resolved_view = targets.resolved_ids.create_view(&Default::default());
+                let (diagnostic, resolved) = targets.diagnostic.as_ref().ok_or_else(|| {
+                    Error::InvalidSetting(
+                        "diagnostics were not enabled (DeferredPass::with_diagnostics)".into(),
+                    )
+                })?;
+                diagnostic_view = diagnostic.create_view(&Default::default());
+                resolved_view = resolved.create_view(&Default::default());
                 (
                     &self.diagnostic.0,
                     &self.diagnostic.1,
