@@ -18,4 +18,6 @@ pub mod style;
 pub use camera::Camera;
 pub use style::{Color, Style};
 pub mod cli;
+pub mod compare;
+pub mod raycast;
 pub mod render;

@@ -23,6 +23,9 @@ struct Cli {
 enum Command {
     /// Render a mesh (an OBJ file, `sphere:N`, `grid:N`, `torus:N`, or the built-in scene).
     Render(RenderArgs),
+    /// Render one scene with the CPU ray-cast ground truth and every GPU method, and report
+    /// how closely each matches it (images, error maps, sheet.png, report.json).
+    Compare(CompareArgs),
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -113,10 +116,66 @@ fn render_command(args: &RenderArgs) -> Result<()> {
     Ok(())
 }
 
+#[derive(clap::Args)]
+struct CompareArgs {
+    /// OBJ file or procedural mesh (`sphere:20000`, `grid:1k`, `torus:5000`); default: built-in scene.
+    mesh: Option<String>,
+    /// Image size WIDTHxHEIGHT.
+    #[arg(long, default_value = "640x480")]
+    size: String,
+    /// Line width in pixels.
+    #[arg(long, default_value_t = 1.5, allow_hyphen_values = true)]
+    line_width: f32,
+    /// Which edges to draw.
+    #[arg(long, value_enum, default_value = "polygon")]
+    edges: Edges,
+    /// Directory for the images, error maps, sheet.png and report.json.
+    #[arg(long)]
+    out: PathBuf,
+    #[command(flatten)]
+    camera: CameraArgs,
+}
+
+fn compare_command(args: &CompareArgs) -> Result<()> {
+    let size = parse_size(&args.size)?;
+    let style = Style {
+        line_width: args.line_width,
+        ..Style::default()
+    };
+    style.validate()?;
+    let mesh = load_mesh(args.mesh.as_deref())?;
+    let camera = args.camera.camera(&mesh, size)?;
+    let ctx = GpuContext::new()?;
+    let edges = match args.edges {
+        Edges::All => EdgeSelection::All,
+        Edges::Polygon => EdgeSelection::Polygon,
+    };
+    let scene = Scene {
+        mesh: &mesh,
+        camera,
+        style,
+        size,
+        edges,
+    };
+    let report = wirepass::compare::run(&ctx, &scene, &args.out)?;
+    println!(
+        "{}x{}, {} triangles, {}; ground truth (raycast) {:.2} s",
+        size.0,
+        size.1,
+        mesh.triangle_count(),
+        ctx.describe(),
+        report.reference_seconds
+    );
+    println!("{}", wirepass::compare::table(&report));
+    eprintln!("wrote {}", args.out.join("report.json").display());
+    Ok(())
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Render(args) => render_command(args),
+        Command::Compare(args) => compare_command(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

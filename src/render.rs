@@ -42,17 +42,20 @@ pub struct Frame {
 /// A way of drawing the wireframe.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Method {
+    /// CPU ray cast in f64: the ground truth the other methods are measured against.
+    Raycast,
     /// Visibility buffer + compute edge pass (the subject of this crate).
     Deferred,
 }
 
 impl Method {
     /// Every method, in report order.
-    pub const ALL: &'static [Method] = &[Method::Deferred];
+    pub const ALL: &'static [Method] = &[Method::Raycast, Method::Deferred];
 
     /// The name used on the command line and in reports.
     pub fn name(self) -> &'static str {
         match self {
+            Method::Raycast => "raycast",
             Method::Deferred => "deferred",
         }
     }
@@ -75,6 +78,7 @@ impl std::str::FromStr for Method {
 /// Renders `scene` with `method` and reads back the image and all maps.
 pub fn render(ctx: &GpuContext, scene: &Scene<'_>, method: Method) -> Result<Frame> {
     match method {
+        Method::Raycast => crate::raycast::render_raycast(scene),
         Method::Deferred => render_deferred(ctx, scene),
     }
 }

@@ -10,7 +10,7 @@ pub mod shaders;
 
 pub use context::{GpuContext, OPTIONAL_FEATURES};
 pub use deferred::{DeferredPass, OutputTarget, PassOptions};
-pub use frame::FrameUniforms;
+pub use frame::{light_world_dir, FrameUniforms};
 pub use mesh::GpuMesh;
 pub use readback::read_texture;
 pub use timing::GpuTimer;

@@ -1,0 +1,650 @@
+//! Accuracy of every GPU method against the CPU ray-cast ground truth: per-pixel metrics
+//! ([`metrics`]), the images that show where methods differ, and the `wirepass compare`
+//! report ([`run`]).
+
+mod font;
+
+use crate::error::{Error, Result};
+use crate::gpu::GpuContext;
+use crate::raycast::render_raycast;
+use crate::render::{render, Frame, Method, Scene};
+use serde::Serialize;
+use std::path::Path;
+use std::time::Instant;
+
+/// Background id.
+const BACKGROUND: u32 = u32::MAX;
+/// Edge distances are compared only where the true distance is below this many pixels:
+/// that is where a line can be drawn, and where the distance matters.
+pub const DISTANCE_RANGE_PX: f64 = 4.0;
+/// The distance-error heat map spans 10^MIN .. 10^MAX pixels, on a log scale.
+const HEAT_LOG10: (f64, f64) = (-6.0, 0.0);
+
+/// Edge-distance error in pixels: over pixels whose ids agree with the ground truth and whose
+/// true distance is finite and under [`DISTANCE_RANGE_PX`]. `None` when no pixel qualifies.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct DistanceError {
+    /// Mean absolute error.
+    pub mean: Option<f64>,
+    /// 99th percentile (nearest rank) of the absolute error.
+    pub p99: Option<f64>,
+    /// Largest absolute error (`inf` where a method reports no edge where there is one).
+    pub max: Option<f64>,
+    /// Number of pixels measured.
+    pub pixels: usize,
+}
+
+/// Perceptual image difference (NVIDIA FLIP, LDR, default viewing distance), 0..1.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct ImageDifference {
+    /// Mean FLIP error over all pixels.
+    pub flip_mean: f64,
+    /// 99th percentile (nearest rank) of the per-pixel FLIP error.
+    pub flip_p99: f64,
+}
+
+/// How closely one frame matches the reference.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Metrics {
+    /// Among pixels where either side is foreground, the fraction whose id equals the
+    /// reference's (1 when neither has any foreground).
+    pub id_agreement: f64,
+    /// Fraction of all pixels where both agree on foreground versus background.
+    pub coverage_agreement: f64,
+    /// Edge-distance error, see [`DistanceError`].
+    pub distance_error_px: DistanceError,
+    /// FLIP difference of the final images.
+    pub image_difference: ImageDifference,
+}
+
+/// Compares `frame` against `reference` (the ground truth). Both must have the same size.
+///
+/// # Panics
+/// If the frames differ in size or their maps have the wrong length.
+pub fn metrics(reference: &Frame, frame: &Frame) -> Metrics {
+    let errors = distance_errors(reference, frame);
+    let mut measured: Vec<f64> = errors.iter().flatten().copied().collect();
+    measured.sort_by(f64::total_cmp);
+    let distance_error_px = DistanceError {
+        mean: (!measured.is_empty()).then(|| measured.iter().sum::<f64>() / measured.len() as f64),
+        p99: percentile(&measured, 0.99),
+        max: measured.last().copied(),
+        pixels: measured.len(),
+    };
+    let n = reference.ids.len();
+    let (mut either, mut same_id, mut same_cover) = (0usize, 0usize, 0usize);
+    for (&a, &b) in reference.ids.iter().zip(&frame.ids) {
+        let (fa, fb) = (a != BACKGROUND, b != BACKGROUND);
+        same_cover += usize::from(fa == fb);
+        if fa || fb {
+            either += 1;
+            same_id += usize::from(a == b);
+        }
+    }
+    let mut flip: Vec<f64> = flip_map(reference, frame)
+        .into_iter()
+        .map(f64::from)
+        .collect();
+    let flip_mean = flip.iter().sum::<f64>() / flip.len().max(1) as f64;
+    flip.sort_by(f64::total_cmp);
+    Metrics {
+        id_agreement: if either == 0 {
+            1.0
+        } else {
+            same_id as f64 / either as f64
+        },
+        coverage_agreement: same_cover as f64 / n.max(1) as f64,
+        distance_error_px,
+        image_difference: ImageDifference {
+            flip_mean,
+            flip_p99: percentile(&flip, 0.99).unwrap_or(0.0),
+        },
+    }
+}
+
+/// Nearest-rank percentile of sorted values.
+fn percentile(sorted: &[f64], q: f64) -> Option<f64> {
+    if sorted.is_empty() {
+        return None;
+    }
+    let rank = (q * sorted.len() as f64).ceil() as usize;
+    Some(sorted[rank.clamp(1, sorted.len()) - 1])
+}
+
+/// Per pixel, `|d − d_true|` where it is measured (ids agree, true distance finite and under
+/// [`DISTANCE_RANGE_PX`]), `None` elsewhere.
+pub fn distance_errors(reference: &Frame, frame: &Frame) -> Vec<Option<f64>> {
+    assert_eq!(reference.size, frame.size, "frames of different sizes");
+    let n = reference.ids.len();
+    assert!(
+        frame.ids.len() == n
+            && frame.edge_distance.len() == n
+            && reference.edge_distance.len() == n,
+        "maps of the wrong length"
+    );
+    (0..n)
+        .map(|i| {
+            let id = reference.ids[i];
+            let truth = f64::from(reference.edge_distance[i]);
+            let measured = id != BACKGROUND
+                && frame.ids[i] == id
+                && truth.is_finite()
+                && truth < DISTANCE_RANGE_PX;
+            measured.then(|| {
+                let d = f64::from(frame.edge_distance[i]);
+                if d.is_finite() {
+                    (d - truth).abs()
+                } else {
+                    f64::INFINITY
+                }
+            })
+        })
+        .collect()
+}
+
+fn rgb8(frame: &Frame) -> Vec<u8> {
+    frame
+        .rgba
+        .chunks_exact(4)
+        .flat_map(|p| [p[0], p[1], p[2]])
+        .collect()
+}
+
+/// The per-pixel FLIP error (0..1) of `frame` against `reference`.
+pub fn flip_map(reference: &Frame, frame: &Frame) -> Vec<f32> {
+    flip_image(reference, frame).to_vec()
+}
+
+fn flip_image(reference: &Frame, frame: &Frame) -> nv_flip::FlipImageFloat {
+    assert_eq!(reference.size, frame.size, "frames of different sizes");
+    let (w, h) = reference.size;
+    let a = nv_flip::FlipImageRgb8::with_data(w, h, &rgb8(reference));
+    let b = nv_flip::FlipImageRgb8::with_data(w, h, &rgb8(frame));
+    nv_flip::flip(a, b, nv_flip::DEFAULT_PIXELS_PER_DEGREE)
+}
+
+/// An RGBA image in memory.
+#[derive(Clone, Debug)]
+pub struct Image {
+    /// Width and height.
+    pub size: (u32, u32),
+    /// 8-bit RGBA, row-major, top row first.
+    pub rgba: Vec<u8>,
+}
+
+impl Image {
+    fn new(size: (u32, u32), fill: [u8; 4]) -> Self {
+        Self {
+            size,
+            rgba: fill.repeat((size.0 * size.1) as usize),
+        }
+    }
+
+    fn blit(&mut self, src: &Image, (x0, y0): (u32, u32)) {
+        for y in 0..src.size.1.min(self.size.1.saturating_sub(y0)) {
+            let w = src.size.0.min(self.size.0.saturating_sub(x0)) as usize;
+            let s = 4 * (y * src.size.0) as usize;
+            let d = 4 * ((y0 + y) * self.size.0 + x0) as usize;
+            self.rgba[d..d + 4 * w].copy_from_slice(&src.rgba[s..s + 4 * w]);
+        }
+    }
+
+    fn text(&mut self, at: (u32, u32), text: &str, scale: u32, color: [u8; 4]) {
+        font::draw_text(&mut self.rgba, self.size.0, at, text, scale, color);
+    }
+
+    /// Writes the image as a PNG.
+    pub fn save_png(&self, path: &Path) -> Result<()> {
+        image::save_buffer(
+            path,
+            &self.rgba,
+            self.size.0,
+            self.size.1,
+            image::ColorType::Rgba8,
+        )
+        .map_err(|e| Error::Image {
+            path: path.to_owned(),
+            message: e.to_string(),
+        })
+    }
+}
+
+fn magma() -> Vec<[u8; 3]> {
+    nv_flip::magma_lut()
+        .to_vec()
+        .chunks_exact(3)
+        .map(|c| [c[0], c[1], c[2]])
+        .collect()
+}
+
+const GREY: [u8; 4] = [128, 128, 128, 255];
+const WHITE: [u8; 4] = [255, 255, 255, 255];
+const BLACK: [u8; 4] = [0, 0, 0, 255];
+
+/// The edge-distance error as a heat map: magma on a log scale from 1e-6 px (dark) to 1 px
+/// and beyond (bright), grey where not measured, with a labelled scale below the image.
+pub fn distance_error_image(reference: &Frame, frame: &Frame) -> Image {
+    let lut = magma();
+    let (w, h) = reference.size;
+    let (lo, hi) = HEAT_LOG10;
+    let colour = |e: f64| {
+        let t = ((e.max(1e-300).log10() - lo) / (hi - lo)).clamp(0.0, 1.0);
+        let c = lut[(t * (lut.len() - 1) as f64).round() as usize];
+        [c[0], c[1], c[2], 255]
+    };
+    let legend = 2 * font::LINE + 14;
+    let mut img = Image::new((w, h + legend), WHITE);
+    for (i, e) in distance_errors(reference, frame).into_iter().enumerate() {
+        let c = e.map_or(GREY, colour);
+        img.rgba[4 * i..4 * i + 4].copy_from_slice(&c);
+    }
+    // Colour bar over the full width, decade ticks labelled under it.
+    let bar = (h + 2, 8);
+    for x in 0..w {
+        let t = (f64::from(x) + 0.5) / f64::from(w);
+        let c = colour(10f64.powf(lo + t * (hi - lo)));
+        for y in bar.0..bar.0 + bar.1 {
+            let i = 4 * (y * w + x) as usize;
+            img.rgba[i..i + 4].copy_from_slice(&c);
+        }
+    }
+    let decades = (hi - lo) as i32;
+    for k in 0..=decades {
+        let x = (f64::from(k) / f64::from(decades) * f64::from(w - 1)) as u32;
+        let label = match lo as i32 + k {
+            0 => "1".to_string(),
+            e => format!("1e{e}"),
+        };
+        let lx = x
+            .saturating_sub(font::text_width(&label, 1) / 2)
+            .min(w.saturating_sub(font::text_width(&label, 1)));
+        img.text((lx, bar.0 + bar.1 + 2), &label, 1, BLACK);
+    }
+    img.text(
+        (2, bar.0 + bar.1 + 3 + font::LINE),
+        "edge distance error px - grey: not measured",
+        1,
+        BLACK,
+    );
+    img
+}
+
+/// The FLIP error map through nv-flip's magma LUT.
+pub fn flip_error_image(reference: &Frame, frame: &Frame) -> Image {
+    let map = flip_image(reference, frame);
+    let rgb = map.apply_color_lut(&nv_flip::magma_lut()).to_vec();
+    Image {
+        size: reference.size,
+        rgba: rgb
+            .chunks_exact(3)
+            .flat_map(|c| [c[0], c[1], c[2], 255])
+            .collect(),
+    }
+}
+
+fn frame_image(frame: &Frame) -> Image {
+    Image {
+        size: frame.size,
+        rgba: frame.rgba.clone(),
+    }
+}
+
+/// What happened to one method in a comparison.
+#[derive(Clone, Debug, Serialize)]
+#[serde(untagged)]
+pub enum MethodReport {
+    /// It rendered; its metrics and timing.
+    Measured {
+        /// Accuracy against the ground truth.
+        #[serde(flatten)]
+        metrics: Metrics,
+        /// GPU time of the method's passes; `None` where not measured (see `note`).
+        gpu_ms: Option<f64>,
+        /// Wall-clock time of the whole render call: pipeline creation, upload, draw and
+        /// readback included.
+        wall_ms: f64,
+        /// How the timing was taken.
+        note: String,
+    },
+    /// It could not run on this adapter.
+    Skipped {
+        /// Why.
+        skipped: String,
+    },
+}
+
+/// The content of `report.json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct Report {
+    /// Image size.
+    pub size: [u32; 2],
+    /// Triangles in the mesh.
+    pub triangles: usize,
+    /// Per method (JSON key: the method's name with `-` as `_`), in [`Method::ALL`] order.
+    pub methods: serde_json::Map<String, serde_json::Value>,
+    /// The same, typed, for the table.
+    #[serde(skip)]
+    pub rows: Vec<(Method, MethodReport)>,
+    /// Seconds the ground truth took.
+    #[serde(skip)]
+    pub reference_seconds: f64,
+}
+
+/// What `wall_ms` measures.
+const WALL_NOTE: &str = "wall_ms times the whole render call (pipeline creation, upload, draw, \
+readback) on this adapter";
+
+/// Frames timed for `gpu_ms`, after [`WARM_UP_FRAMES`] untimed ones.
+const TIMED_FRAMES: usize = 20;
+/// Frames drawn before timing starts.
+const WARM_UP_FRAMES: usize = 3;
+
+/// GPU time of `method`'s passes for `scene` in milliseconds (median over frames), with a note
+/// on how it was taken; `None` where the method or the adapter cannot be timed.
+fn gpu_time(ctx: &GpuContext, scene: &Scene<'_>, method: Method) -> (Option<f64>, String) {
+    if !ctx
+        .device
+        .features()
+        .contains(wgpu::Features::TIMESTAMP_QUERY)
+    {
+        return (
+            None,
+            format!("gpu_ms not measured: the adapter lacks TIMESTAMP_QUERY; {WALL_NOTE}"),
+        );
+    }
+    match method {
+        Method::Deferred => match time_deferred(ctx, scene) {
+            Ok(ms) => (
+                Some(ms),
+                format!(
+                    "gpu_ms: median over {TIMED_FRAMES} frames (after {WARM_UP_FRAMES} warm-up) of \
+                     the visibility and edge passes' timestamp spans; {WALL_NOTE}"
+                ),
+            ),
+            Err(e) => (None, format!("gpu_ms not measured: {e}; {WALL_NOTE}")),
+        },
+        _ => (
+            None,
+            format!(
+                "gpu_ms not measured: this method has no timed encoder yet (timestamp writes \
+                 belong inside its passes); {WALL_NOTE}"
+            ),
+        ),
+    }
+}
+
+/// Median GPU time of the deferred pass's visibility + edge passes (shaded output).
+fn time_deferred(ctx: &GpuContext, scene: &Scene<'_>) -> Result<f64> {
+    use crate::gpu::{DeferredPass, GpuMesh, GpuTimer, OutputTarget, PassOptions};
+    let device = &ctx.device;
+    let mut pass = DeferredPass::new(device, PassOptions::default())?;
+    let mesh = GpuMesh::new(device, scene.mesh, scene.edges)?;
+    pass.prepare(
+        device,
+        &ctx.queue,
+        &mesh,
+        &scene.camera,
+        &scene.style,
+        scene.size,
+    )?;
+    let output = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("wirepass compare timing"),
+        size: wgpu::Extent3d {
+            width: scene.size.0,
+            height: scene.size.1,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: pass.output_format(),
+        usage: wgpu::TextureUsages::STORAGE_BINDING,
+        view_formats: &[],
+    });
+    let view = output.create_view(&Default::default());
+    let mut timer = GpuTimer::new(device, &ctx.queue, 2)?;
+    let mut times = Vec::with_capacity(TIMED_FRAMES);
+    for frame in 0..WARM_UP_FRAMES + TIMED_FRAMES {
+        let mut encoder = device.create_command_encoder(&Default::default());
+        pass.encode_timed(
+            device,
+            &mut encoder,
+            &mesh,
+            OutputTarget::Shaded(&view),
+            &mut timer,
+        )?;
+        timer.resolve(&mut encoder);
+        ctx.queue.submit([encoder.finish()]);
+        let spans = timer.read(device)?;
+        ctx.finish()?;
+        if frame >= WARM_UP_FRAMES {
+            times.push(spans.iter().map(|(_, ms)| ms).sum::<f64>());
+        }
+    }
+    times.sort_by(f64::total_cmp);
+    Ok(times[times.len() / 2])
+}
+
+/// Renders `scene` with the ground truth and every GPU method, writes the images, heat maps,
+/// `sheet.png` and `report.json` into `out`, and returns the report.
+pub fn run(ctx: &GpuContext, scene: &Scene<'_>, out: &Path) -> Result<Report> {
+    std::fs::create_dir_all(out).map_err(|source| Error::Io {
+        path: out.to_owned(),
+        source,
+    })?;
+    let start = Instant::now();
+    let reference = render_raycast(scene)?;
+    let reference_seconds = start.elapsed().as_secs_f64();
+    reference.save_png(&out.join(format!("{}.png", Method::Raycast.name())))?;
+
+    let mut rows = Vec::new();
+    let mut panels: Vec<(String, Option<[Image; 3]>)> = Vec::new();
+    for &method in Method::ALL {
+        if method == Method::Raycast {
+            continue;
+        }
+        let name = method.name();
+        let start = Instant::now();
+        let report = match render(ctx, scene, method) {
+            Err(e) => {
+                panels.push((name.to_string(), None));
+                MethodReport::Skipped {
+                    skipped: e.to_string(),
+                }
+            }
+            Ok(frame) => {
+                let wall_ms = start.elapsed().as_secs_f64() * 1e3;
+                let key = name.replace('-', "_");
+                frame.save_png(&out.join(format!("{name}.png")))?;
+                let heat = distance_error_image(&reference, &frame);
+                heat.save_png(&out.join(format!("{key}_distance_error.png")))?;
+                let flip = flip_error_image(&reference, &frame);
+                flip.save_png(&out.join(format!("{key}_flip.png")))?;
+                panels.push((name.to_string(), Some([frame_image(&frame), heat, flip])));
+                let (gpu_ms, note) = gpu_time(ctx, scene, method);
+                MethodReport::Measured {
+                    metrics: metrics(&reference, &frame),
+                    gpu_ms,
+                    wall_ms,
+                    note,
+                }
+            }
+        };
+        rows.push((method, report));
+    }
+    let sheet = sheet(&frame_image(&reference), &panels);
+    sheet.save_png(&out.join("sheet.png"))?;
+
+    let mut methods = serde_json::Map::new();
+    for (m, r) in &rows {
+        let value = serde_json::to_value(r).map_err(|e| Error::Device(e.to_string()))?;
+        methods.insert(m.name().replace('-', "_"), value);
+    }
+    let report = Report {
+        size: [scene.size.0, scene.size.1],
+        triangles: scene.mesh.triangle_count(),
+        methods,
+        rows,
+        reference_seconds,
+    };
+    let path = out.join("report.json");
+    let text = serde_json::to_string_pretty(&report).unwrap_or_default();
+    std::fs::write(&path, text + "\n").map_err(|source| Error::Io { path, source })?;
+    Ok(report)
+}
+
+/// One labelled sheet: a column for the ground truth and one per method; rows: the image,
+/// the distance-error heat map, the FLIP map.
+fn sheet(reference: &Image, panels: &[(String, Option<[Image; 3]>)]) -> Image {
+    let (w, h) = reference.size;
+    let scale = if w >= 240 { 2 } else { 1 };
+    let label = font::LINE * scale + 4;
+    let gap = 8;
+    let heights: [u32; 3] = std::array::from_fn(|r| {
+        panels
+            .iter()
+            .filter_map(|(_, p)| p.as_ref().map(|p| p[r].size.1))
+            .max()
+            .unwrap_or(h)
+            .max(h)
+    });
+    let columns = 1 + panels.len() as u32;
+    let width = columns * w + (columns + 1) * gap;
+    let height = heights.iter().map(|r| r + label + gap).sum::<u32>() + gap;
+    let mut sheet = Image::new((width, height), WHITE);
+    let row_top = |r: usize| gap + heights[..r].iter().map(|x| x + label + gap).sum::<u32>();
+    let x_of = |c: u32| gap + c * (w + gap);
+    sheet.text((x_of(0), row_top(0)), "raycast reference", scale, BLACK);
+    sheet.blit(reference, (x_of(0), row_top(0) + label));
+    let notes = [
+        (1, "edge distance"),
+        (1, "error vs raycast ->"),
+        (2, "flip error map"),
+        (2, "vs raycast ->"),
+    ];
+    for (k, (row, text)) in notes.into_iter().enumerate() {
+        let y = row_top(row) + (k as u32 % 2) * label;
+        sheet.text((x_of(0), y), text, scale, BLACK);
+    }
+    for (c, (name, p)) in panels.iter().enumerate() {
+        let x = x_of(c as u32 + 1);
+        match p {
+            Some(images) => {
+                let titles = [
+                    name.clone(),
+                    format!("{name} distance"),
+                    format!("{name} flip"),
+                ];
+                for (r, (img, title)) in images.iter().zip(titles).enumerate() {
+                    sheet.text((x, row_top(r)), &title, scale, BLACK);
+                    sheet.blit(img, (x, row_top(r) + label));
+                }
+            }
+            None => {
+                sheet.text((x, row_top(0)), &format!("{name} skipped"), scale, BLACK);
+                sheet.blit(&Image::new((w, h), GREY), (x, row_top(0) + label));
+            }
+        }
+    }
+    sheet
+}
+
+/// The report as an aligned text table.
+pub fn table(report: &Report) -> String {
+    let fmt = |v: Option<f64>| match v {
+        Some(v) if v.is_finite() => format!("{v:.2e}"),
+        Some(_) => "inf".into(),
+        None => "-".into(),
+    };
+    let mut lines = vec![format!(
+        "{:<10} {:>9} {:>9} {:>9} {:>9} {:>9} {:>8} {:>8} {:>9} {:>9}",
+        "method",
+        "id agree",
+        "coverage",
+        "d mean",
+        "d p99",
+        "d max",
+        "flip",
+        "flip p99",
+        "gpu ms",
+        "wall ms"
+    )];
+    for (m, r) in &report.rows {
+        lines.push(match r {
+            MethodReport::Measured {
+                metrics,
+                gpu_ms,
+                wall_ms,
+                ..
+            } => format!(
+                "{:<10} {:>9.5} {:>9.5} {:>9} {:>9} {:>9} {:>8.4} {:>8.4} {:>9} {:>9.1}",
+                m.name(),
+                metrics.id_agreement,
+                metrics.coverage_agreement,
+                fmt(metrics.distance_error_px.mean),
+                fmt(metrics.distance_error_px.p99),
+                fmt(metrics.distance_error_px.max),
+                metrics.image_difference.flip_mean,
+                metrics.image_difference.flip_p99,
+                gpu_ms.map_or("-".into(), |v| format!("{v:.3}")),
+                wall_ms
+            ),
+            MethodReport::Skipped { skipped } => format!(
+                "{:<10} skipped: {}",
+                m.name(),
+                skipped.lines().next().unwrap_or_default()
+            ),
+        });
+    }
+    lines.join("\n")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn frame(ids: Vec<u32>, d: Vec<f32>) -> Frame {
+        let n = ids.len();
+        Frame {
+            size: (n as u32, 1),
+            rgba: vec![200; 4 * n],
+            ids,
+            depth: vec![0.5; n],
+            edge_distance: d,
+        }
+    }
+
+    #[test]
+    fn metrics_count_the_right_pixels() {
+        let inf = f32::INFINITY;
+        let bg = BACKGROUND;
+        let reference = frame(
+            vec![1, 1, 2, 2, bg, bg, 3, 3],
+            vec![0.5, 3.0, 5.0, 1.0, inf, inf, inf, 2.0],
+        );
+        let test = frame(
+            vec![1, 1, 2, 9, bg, 4, bg, 3],
+            vec![0.5, 3.25, 5.5, 1.0, inf, 0.0, inf, 2.0],
+        );
+        let m = metrics(&reference, &test);
+        // Either side foreground: 7 pixels; ids equal at 0, 1, 2, 7.
+        assert!((m.id_agreement - 4.0 / 7.0).abs() < 1e-12);
+        // Coverage differs at 5 and 6.
+        assert!((m.coverage_agreement - 6.0 / 8.0).abs() < 1e-12);
+        // Measured: 0 (0), 1 (0.25), 7 (0); pixel 2 is beyond the range.
+        let d = m.distance_error_px;
+        assert_eq!(d.pixels, 3);
+        assert_eq!(d.max, Some(0.25));
+        assert_eq!(d.p99, Some(0.25));
+        assert!((d.mean.unwrap() - 0.25 / 3.0).abs() < 1e-12);
+        assert_eq!(m.image_difference.flip_mean, 0.0);
+    }
+
+    #[test]
+    fn percentiles_are_nearest_rank() {
+        let v: Vec<f64> = (1..=200).map(f64::from).collect();
+        assert_eq!(percentile(&v, 0.99), Some(198.0));
+        assert_eq!(percentile(&v[..1], 0.99), Some(1.0));
+        assert_eq!(percentile(&[], 0.99), None);
+    }
+}
