@@ -55,7 +55,9 @@ struct RenderArgs {
     /// Background colour, #rrggbb (sRGB).
     #[arg(long, default_value = "#ffffff")]
     background: String,
-    /// How to draw: deferred (visibility buffer + compute edge pass).
+    /// How to draw: deferred (visibility buffer + compute edge pass), forward (single-pass
+    /// altitudes, Bærentzen et al. 2006; divides by w like the seeds), two-pass (biased fill,
+    /// then 1 px edge lines), raycast (the f64 CPU ground truth; slow).
     #[arg(long, default_value = "deferred", value_parser = parse_method)]
     method: Method,
     /// Which edges to draw.

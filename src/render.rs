@@ -2,7 +2,10 @@
 
 use crate::camera::Camera;
 use crate::error::{Error, Result};
-use crate::gpu::{read_texture, DeferredPass, GpuContext, GpuMesh, OutputTarget, PassOptions};
+use crate::gpu::{
+    read_texture, DeferredPass, EdgeLines, ForwardPass, GpuContext, GpuMesh, OutputTarget,
+    PassOptions, TwoPass,
+};
 use crate::mesh::{EdgeSelection, Mesh};
 use crate::style::Style;
 use std::path::Path;
@@ -35,7 +38,9 @@ pub struct Frame {
     /// and on background.
     pub depth: Vec<f32>,
     /// Pixels to the nearest drawn edge of the visible triangle; `inf` on background and
-    /// where no edge of the triangle is drawn.
+    /// where no edge of the triangle is drawn. [`Method::Forward`] reports its interpolated
+    /// altitudes as they come (NaN where they are NaN); [`Method::TwoPass`] measures no
+    /// distance and reports 0 where it drew a line fragment, `inf` elsewhere.
     pub edge_distance: Vec<f32>,
 }
 
@@ -46,17 +51,29 @@ pub enum Method {
     Raycast,
     /// Visibility buffer + compute edge pass (the subject of this crate).
     Deferred,
+    /// Forward single-pass baseline (Bærentzen et al. 2006): interpolated screen-space
+    /// altitudes, vertex-pulled; divides by w like the seeds.
+    Forward,
+    /// Two-pass baseline: shaded fill with depth bias, then the drawn edges as 1 px lines.
+    TwoPass,
 }
 
 impl Method {
     /// Every method, in report order.
-    pub const ALL: &'static [Method] = &[Method::Raycast, Method::Deferred];
+    pub const ALL: &'static [Method] = &[
+        Method::Raycast,
+        Method::Deferred,
+        Method::Forward,
+        Method::TwoPass,
+    ];
 
     /// The name used on the command line and in reports.
     pub fn name(self) -> &'static str {
         match self {
             Method::Raycast => "raycast",
             Method::Deferred => "deferred",
+            Method::Forward => "forward",
+            Method::TwoPass => "two-pass",
         }
     }
 }
@@ -80,6 +97,8 @@ pub fn render(ctx: &GpuContext, scene: &Scene<'_>, method: Method) -> Result<Fra
     match method {
         Method::Raycast => crate::raycast::render_raycast(scene),
         Method::Deferred => render_deferred(ctx, scene),
+        Method::Forward => render_forward(ctx, scene),
+        Method::TwoPass => render_two_pass(ctx, scene),
     }
 }
 
@@ -118,25 +137,36 @@ pub fn render_deferred(ctx: &GpuContext, scene: &Scene<'_>) -> Result<Frame> {
     ctx.queue.submit([encoder.finish()]);
     ctx.finish()?;
 
+    read_frame(
+        ctx,
+        scene.size,
+        &output,
+        pass.resolved_id_texture(),
+        pass.diagnostic_texture(),
+    )
+}
+
+/// Reads a rendered frame back: the 8-bit output `output`, the `R32Uint` ids and the
+/// diagnostic map, four f32 per pixel (`Rgba32Float`, or their bits in `Rgba32Uint` for the
+/// forward passes; r = distance in pixels, ≥ 1e38 meaning none; g = reverse-Z depth),
+/// converted to [`Frame`]'s conventions.
+fn read_frame(
+    ctx: &GpuContext,
+    size: (u32, u32),
+    output: &wgpu::Texture,
+    ids: Option<&wgpu::Texture>,
+    diagnostic: Option<&wgpu::Texture>,
+) -> Result<Frame> {
+    let device = &ctx.device;
     let all = wgpu::TextureAspect::All;
     let missing = || Error::Device("the pass has no targets after prepare".into());
-    let rgba = read_texture(device, &ctx.queue, &output, all)?;
-    let ids = read_texture(
-        device,
-        &ctx.queue,
-        pass.resolved_id_texture().ok_or_else(missing)?,
-        all,
-    )?;
-    let diagnostic = read_texture(
-        device,
-        &ctx.queue,
-        pass.diagnostic_texture().ok_or_else(missing)?,
-        all,
-    )?;
+    let rgba = read_texture(device, &ctx.queue, output, all)?;
+    let ids = read_texture(device, &ctx.queue, ids.ok_or_else(missing)?, all)?;
+    let diagnostic = read_texture(device, &ctx.queue, diagnostic.ok_or_else(missing)?, all)?;
     ctx.finish()?;
     let diagnostic: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&diagnostic);
     Ok(Frame {
-        size: scene.size,
+        size,
         rgba,
         ids: bytemuck::pod_collect_to_vec(&ids),
         // Reverse-Z back to the 0..1 convention.
@@ -149,6 +179,70 @@ pub fn render_deferred(ctx: &GpuContext, scene: &Scene<'_>) -> Result<Frame> {
             .map(|t| if t[0] >= 1e38 { f32::INFINITY } else { t[0] })
             .collect(),
     })
+}
+
+/// The forward baselines render to an sRGB render attachment: the hardware blends in linear
+/// space and stores sRGB bytes, like the deferred pass's in-shader encoding.
+const FORWARD_OUTPUT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
+
+fn forward_output(device: &wgpu::Device, (width, height): (u32, u32)) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("wirepass output"),
+        size: wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: FORWARD_OUTPUT,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    })
+}
+
+/// Renders `scene` with the forward single-pass baseline and reads back the image and maps.
+/// Its distance map is the interpolated altitudes' minimum (NaN where the method gives NaN).
+pub fn render_forward(ctx: &GpuContext, scene: &Scene<'_>) -> Result<Frame> {
+    let device = &ctx.device;
+    let options = PassOptions {
+        output_format: FORWARD_OUTPUT,
+    };
+    let mut pass = ForwardPass::new(device, options)?;
+    let mesh = GpuMesh::new(device, scene.mesh, scene.edges)?;
+    let style = &scene.style;
+    pass.prepare(device, &ctx.queue, &mesh, &scene.camera, style, scene.size)?;
+    let output = forward_output(device, scene.size);
+    let view = output.create_view(&Default::default());
+    let mut encoder = device.create_command_encoder(&Default::default());
+    pass.encode_with_maps(device, &mut encoder, &mesh, &view)?;
+    ctx.queue.submit([encoder.finish()]);
+    ctx.finish()?;
+    let (ids, diagnostic) = (pass.id_texture(), pass.diagnostic_texture());
+    read_frame(ctx, scene.size, &output, ids, diagnostic)
+}
+
+/// Renders `scene` with the two-pass baseline and reads back the image and maps. It measures
+/// no distance: its `edge_distance` is 0 where a line was drawn and `inf` elsewhere.
+pub fn render_two_pass(ctx: &GpuContext, scene: &Scene<'_>) -> Result<Frame> {
+    let device = &ctx.device;
+    let options = PassOptions {
+        output_format: FORWARD_OUTPUT,
+    };
+    let mut pass = TwoPass::new(device, options)?;
+    let mesh = GpuMesh::new(device, scene.mesh, scene.edges)?;
+    let lines = EdgeLines::new(device, scene.mesh, scene.edges)?;
+    let style = &scene.style;
+    pass.prepare(device, &ctx.queue, &mesh, &scene.camera, style, scene.size)?;
+    let output = forward_output(device, scene.size);
+    let view = output.create_view(&Default::default());
+    let mut encoder = device.create_command_encoder(&Default::default());
+    pass.encode_with_maps(device, &mut encoder, &mesh, &lines, &view)?;
+    ctx.queue.submit([encoder.finish()]);
+    ctx.finish()?;
+    let (ids, diagnostic) = (pass.id_texture(), pass.diagnostic_texture());
+    read_frame(ctx, scene.size, &output, ids, diagnostic)
 }
 
 impl Frame {

@@ -2,18 +2,22 @@
 
 mod context;
 mod deferred;
+mod forward;
 mod frame;
 mod mesh;
 mod readback;
 mod timing;
 pub mod shaders;
+mod two_pass;
 
 pub use context::{GpuContext, OPTIONAL_FEATURES};
 pub use deferred::{DeferredPass, OutputTarget, PassOptions};
+pub use forward::{forward_source, ForwardPass, MAPS_DIAGNOSTIC_FORMAT};
 pub use frame::{light_world_dir, FrameUniforms};
 pub use mesh::GpuMesh;
 pub use readback::read_texture;
 pub use timing::GpuTimer;
+pub use two_pass::{drawn_edges, two_pass_source, EdgeLines, TwoPass, FILL_DEPTH_BIAS};
 
 use crate::error::{Error, Result};
 

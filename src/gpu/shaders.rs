@@ -9,6 +9,10 @@ pub const VISIBILITY: &str = include_str!("../../shaders/visibility.wgsl");
 pub const VISIBILITY_PULLED: &str = include_str!("../../shaders/visibility_pulled.wgsl");
 /// The deferred edge pass (compute).
 pub const EDGE_PASS: &str = include_str!("../../shaders/edge_pass.wgsl");
+/// The forward single-pass baseline (vertex-pulled altitudes); see `gpu::ForwardPass`.
+pub const FORWARD: &str = include_str!("../../shaders/forward.wgsl");
+/// The two-pass baseline (fill + edge lines), assembled after [`FORWARD`]; see `gpu::TwoPass`.
+pub const TWO_PASS: &str = include_str!("../../shaders/two_pass.wgsl");
 
 /// Storage-texture formats the edge pass can write, with the WGSL name of each.
 pub fn storage_format_name(format: wgpu::TextureFormat) -> Option<&'static str> {
