@@ -72,12 +72,17 @@ fn edge_eval(c0: vec4<f32>, c1: vec4<f32>, c2: vec4<f32>, mask: u32, pixel: vec2
 // Distances to the three edge lines of `edge_eval`, applying the mask and the near-plane rule
 // (`clip_z` holds the corners' clip z; below 0 is behind the near plane).
 fn edge_distances(l0: vec3<f32>, l1: vec3<f32>, l2: vec3<f32>, clip_z: vec3<f32>, mask: u32) -> vec3<f32> {
+    let raw = vec3<f32>(line_distance(l0, true), line_distance(l1, true), line_distance(l2, true));
+    return drawn_distances(raw, clip_z, mask);
+}
+
+// `raw` (the distances to all three edge lines) with NO_EDGE for edges that are masked out
+// or have both ends behind the near plane.
+fn drawn_distances(raw: vec3<f32>, clip_z: vec3<f32>, mask: u32) -> vec3<f32> {
     let behind = clip_z < vec3<f32>(0.0);
-    return vec3<f32>(
-        line_distance(l0, (mask & 1u) != 0u && !(behind.x && behind.y)),
-        line_distance(l1, (mask & 2u) != 0u && !(behind.y && behind.z)),
-        line_distance(l2, (mask & 4u) != 0u && !(behind.z && behind.x)),
-    );
+    let masked = (vec3<u32>(mask) & vec3<u32>(1u, 2u, 4u)) == vec3<u32>(0u);
+    let hidden = behind & behind.yzx;
+    return select(raw, vec3<f32>(NO_EDGE), masked | hidden);
 }
 
 fn line_distance(l: vec3<f32>, drawn: bool) -> f32 {

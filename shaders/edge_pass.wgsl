@@ -44,7 +44,9 @@ struct Sample {
     bary: vec3<f32>,
     // The centre's ray hits the triangle between the near and far planes.
     covers: bool,
-    // Distance from the centre to the nearest edge line, drawn or not.
+    // Distances from the centre to the three edge lines, drawn or not.
+    lines: vec3<f32>,
+    // The smallest of them.
     margin: f32,
     // Clip w of the hit point (the view distance): smaller is nearer.
     w: f32,
@@ -69,7 +71,8 @@ fn sample(id: u32, pixel: vec2<f32>) -> Sample {
     let hit = s.bary.x * s.clip0 + s.bary.y * s.clip1 + s.bary.z * s.clip2;
     s.covers = all(s.bary >= vec3<f32>(0.0)) && hit.z >= 0.0 && hit.z <= hit.w;
     s.w = hit.w;
-    s.margin = min(line_distance(s.l0, true), min(line_distance(s.l1, true), line_distance(s.l2, true)));
+    s.lines = vec3<f32>(line_distance(s.l0, true), line_distance(s.l1, true), line_distance(s.l2, true));
+    s.margin = min(s.lines.x, min(s.lines.y, s.lines.z));
     return s;
 }
 
@@ -84,19 +87,13 @@ const WALK_STEPS: u32 = 6u;
 fn walk(start: Sample, pixel: vec2<f32>) -> Sample {
     var s = start;
     for (var step = 0u; step < WALK_STEPS; step++) {
-        if s.covers || any(s.bary == vec3<f32>(-1.0)) {
-            return s;
+        let b = s.bary;
+        // Corner k's weight is negative beyond the opposite edge k + 1 (mod 3).
+        let lowest = min(b.x, min(b.y, b.z));
+        if s.covers || lowest >= 0.0 || any(b == vec3<f32>(-1.0)) {
+            return s; // covered, or inside but beyond the near or far plane, or degenerate
         }
-        // Corner k's weight is negative beyond the opposite edge (k + 1) % 3.
-        var edge = 1u;
-        if s.bary.y < s.bary.x && s.bary.y <= s.bary.z {
-            edge = 2u;
-        } else if s.bary.z < s.bary.x && s.bary.z < s.bary.y {
-            edge = 0u;
-        }
-        if s.bary[(edge + 2u) % 3u] >= 0.0 {
-            return s; // inside the triangle but beyond the near or far plane
-        }
+        let edge = select(select(0u, 2u, b.y == lowest), 1u, b.x == lowest);
         let next = neighbours[3u * s.id + edge];
         if next == BACKGROUND_ID {
             return s;
@@ -108,29 +105,49 @@ fn walk(start: Sample, pixel: vec2<f32>) -> Sample {
 
 // The triangle whose surface the centre of pixel `xy` sees: the rasterizer's answer unless
 // the centre lies within COVERAGE_MARGIN of that triangle's boundary, or the pixel is
-// background. Then the neighbourhood's triangles are tested exactly and the nearest one
-// covering the centre wins; if none does, the pixel is background where background is next
-// to it, and keeps the rasterizer's triangle otherwise (the true one is not in reach).
+// background next to foreground. Then the neighbourhood's triangles (and those a walk from
+// them reaches) are tested exactly and the nearest one covering the centre wins; if none
+// does, the pixel is background where background is next to it, and keeps the rasterizer's
+// triangle otherwise (the true one is out of reach).
 fn resolve(xy: vec2<u32>, pixel: vec2<f32>) -> Sample {
     let raster = textureLoad(ids, xy, 0).x;
+    var own: Sample;
+    own.id = BACKGROUND_ID;
+    own.covers = false;
+    if raster != BACKGROUND_ID {
+        own = sample(raster, pixel);
+        if own.covers && own.margin >= COVERAGE_MARGIN {
+            return own;
+        }
+    } else if !foreground_next_to(xy) {
+        return own;
+    }
+    return refine(xy, pixel, own);
+}
+
+// True when one of the four edge-adjacent pixels is foreground.
+fn foreground_next_to(xy: vec2<u32>) -> bool {
+    let last = vec2<u32>(frame.size) - 1u;
+    let l = textureLoad(ids, vec2<u32>(max(xy.x, 1u) - 1u, xy.y), 0).x;
+    let r = textureLoad(ids, vec2<u32>(min(xy.x + 1u, last.x), xy.y), 0).x;
+    let u = textureLoad(ids, vec2<u32>(xy.x, max(xy.y, 1u) - 1u), 0).x;
+    let d = textureLoad(ids, vec2<u32>(xy.x, min(xy.y + 1u, last.y)), 0).x;
+    return min(min(l, r), min(u, d)) != BACKGROUND_ID;
+}
+
+// The slow path of `resolve`, taken by few pixels.
+fn refine(xy: vec2<u32>, pixel: vec2<f32>, own: Sample) -> Sample {
+    let raster = own.id;
     var best: Sample;
     best.id = BACKGROUND_ID;
     best.w = 3.0e38;
-    var fallback = best;
-    if raster != BACKGROUND_ID {
-        let s = sample(raster, pixel);
-        if s.covers && s.margin >= COVERAGE_MARGIN {
-            return s;
+    if own.covers {
+        best = own;
+    } else if raster != BACKGROUND_ID {
+        let found = walk(own, pixel);
+        if found.covers {
+            best = found;
         }
-        if s.covers {
-            best = s;
-        } else {
-            let found = walk(s, pixel);
-            if found.covers {
-                best = found;
-            }
-        }
-        fallback = s;
     }
     var background_near = raster == BACKGROUND_ID;
     let last = vec2<i32>(frame.size) - 1;
@@ -154,7 +171,7 @@ fn resolve(xy: vec2<u32>, pixel: vec2<f32>) -> Sample {
         }
     }
     if best.id == BACKGROUND_ID && !background_near {
-        return fallback;
+        return own;
     }
     return best;
 }
@@ -182,7 +199,7 @@ fn evaluate(xy: vec2<u32>) -> Pixel {
     }
     let id = s.id;
     let mask = (edge_masks[id >> 2u] >> ((id & 3u) * 8u)) & 7u;
-    let d = edge_distances(s.l0, s.l1, s.l2, vec3<f32>(s.clip0.z, s.clip1.z, s.clip2.z), mask);
+    let d = drawn_distances(s.lines, vec3<f32>(s.clip0.z, s.clip1.z, s.clip2.z), mask);
     out.distance = min(d.x, min(d.y, d.z));
 
     let v = vec3<u32>(indices[3u * id], indices[3u * id + 1u], indices[3u * id + 2u]);
