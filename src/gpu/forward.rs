@@ -4,7 +4,7 @@
 //! `3 × triangles` vertices pulls each triangle's three vertices from storage buffers instead.
 
 use super::deferred::{DEPTH_FORMAT, ID_FORMAT};
-use super::{check_size, shaders, FrameUniforms, GpuMesh, PassOptions};
+use super::{check_size, shaders, FrameUniforms, GpuMesh, GpuTimer, PassOptions};
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::style::{linear_to_srgb, Style};
@@ -259,6 +259,7 @@ impl Targets {
         output: &wgpu::TextureView,
         background: wgpu::Color,
         maps: bool,
+        timestamp_writes: Option<wgpu::RenderPassTimestampWrites<'_>>,
     ) -> wgpu::RenderPass<'e> {
         let ids = self.ids.create_view(&Default::default());
         let diagnostic = self.diagnostic.create_view(&Default::default());
@@ -306,7 +307,7 @@ impl Targets {
                 }),
                 stencil_ops: None,
             }),
-            timestamp_writes: None,
+            timestamp_writes,
             occlusion_query_set: None,
             multiview_mask: None,
         })
@@ -518,7 +519,19 @@ impl ForwardPass {
         mesh: &GpuMesh,
         output: &wgpu::TextureView,
     ) -> Result<()> {
-        self.record(device, encoder, mesh, output, false)
+        self.record(device, encoder, mesh, output, false, None)
+    }
+
+    /// [`encode`](Self::encode) with GPU timestamps around the pass, named `"draw"`.
+    pub fn encode_timed(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        mesh: &GpuMesh,
+        output: &wgpu::TextureView,
+        timer: &mut GpuTimer,
+    ) -> Result<()> {
+        self.record(device, encoder, mesh, output, false, Some(timer))
     }
 
     /// Like [`encode`](Self::encode), and also writes the triangle ids and the diagnostic map.
@@ -529,7 +542,7 @@ impl ForwardPass {
         mesh: &GpuMesh,
         output: &wgpu::TextureView,
     ) -> Result<()> {
-        self.record(device, encoder, mesh, output, true)
+        self.record(device, encoder, mesh, output, true, None)
     }
 
     fn record(
@@ -539,12 +552,14 @@ impl ForwardPass {
         mesh: &GpuMesh,
         output: &wgpu::TextureView,
         maps: bool,
+        timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
         let targets = Targets::get(&self.targets)?;
         targets.check_output(output, self.format)?;
         let group = mesh_group(device, &self.layout, &self.uniforms, mesh);
         let background = clear_color(self.format, self.background);
-        let mut pass = targets.begin(encoder, "wirepass forward", output, background, maps);
+        let writes = timer.and_then(|t| t.render_span("draw"));
+        let mut pass = targets.begin(encoder, "wirepass forward", output, background, maps, writes);
         pass.set_pipeline(if maps {
             &self.with_maps
         } else {

@@ -13,7 +13,7 @@ use super::forward::{
     check_vertex_storage, clear_color, color_targets, depth_state, encode_snippet, mesh_group,
     mesh_layout, Targets, Uniforms,
 };
-use super::{check_size, shaders, FrameUniforms, GpuMesh, PassOptions};
+use super::{check_size, shaders, FrameUniforms, GpuMesh, GpuTimer, PassOptions};
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::mesh::{EdgeSelection, Mesh};
@@ -125,6 +125,11 @@ impl EdgeLines {
     }
 
     /// Number of lines drawn.
+    /// GPU memory of the line index buffer, in bytes.
+    pub fn gpu_bytes(&self) -> u64 {
+        u64::from(self.edges) * 8
+    }
+
     pub fn edge_count(&self) -> u32 {
         self.edges
     }
@@ -347,7 +352,21 @@ impl TwoPass {
         lines: &EdgeLines,
         output: &wgpu::TextureView,
     ) -> Result<()> {
-        self.record(device, encoder, mesh, lines, output, false)
+        self.record(device, encoder, mesh, lines, output, false, None)
+    }
+
+    /// [`encode`](Self::encode) with GPU timestamps around the pass (fill and lines share
+    /// one render pass), named `"draw"`.
+    pub fn encode_timed(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        mesh: &GpuMesh,
+        lines: &EdgeLines,
+        output: &wgpu::TextureView,
+        timer: &mut GpuTimer,
+    ) -> Result<()> {
+        self.record(device, encoder, mesh, lines, output, false, Some(timer))
     }
 
     /// Like [`encode`](Self::encode), and also writes the triangle ids and the diagnostic map.
@@ -359,7 +378,7 @@ impl TwoPass {
         lines: &EdgeLines,
         output: &wgpu::TextureView,
     ) -> Result<()> {
-        self.record(device, encoder, mesh, lines, output, true)
+        self.record(device, encoder, mesh, lines, output, true, None)
     }
 
     fn record(
@@ -370,13 +389,16 @@ impl TwoPass {
         lines: &EdgeLines,
         output: &wgpu::TextureView,
         maps: bool,
+        timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
         let targets = Targets::get(&self.targets)?;
         targets.check_output(output, self.format)?;
         lines.check(mesh)?;
         let group = mesh_group(device, &self.layout, &self.uniforms, mesh);
         let background = clear_color(self.format, self.background);
-        let mut pass = targets.begin(encoder, "wirepass two-pass", output, background, maps);
+        let writes = timer.and_then(|t| t.render_span("draw"));
+        let mut pass =
+            targets.begin(encoder, "wirepass two-pass", output, background, maps, writes);
         pass.set_pipeline(if maps { &self.fill_maps } else { &self.fill });
         pass.set_bind_group(0, &group, &[]);
         pass.draw(0..3 * mesh.triangles, 0..1);
