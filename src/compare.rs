@@ -9,6 +9,7 @@ use crate::gpu::GpuContext;
 use crate::raycast::render_raycast;
 use crate::render::{render, Frame, Method, Scene};
 use serde::Serialize;
+use std::collections::BTreeMap;
 use std::path::Path;
 use std::time::Instant;
 
@@ -335,94 +336,28 @@ const WALL_NOTE: &str = "wall_ms times the whole render call (pipeline creation,
 readback) on this adapter";
 
 /// Frames timed for `gpu_ms`, after [`WARM_UP_FRAMES`] untimed ones.
-const TIMED_FRAMES: usize = 20;
+const TIMED_FRAMES: u32 = 20;
 /// Frames drawn before timing starts.
-const WARM_UP_FRAMES: usize = 3;
+const WARM_UP_FRAMES: u32 = 3;
 
-/// GPU time of `method`'s passes for `scene` in milliseconds (median over frames), with a note
-/// on how it was taken; `None` where the method or the adapter cannot be timed.
-fn gpu_time(ctx: &GpuContext, scene: &Scene<'_>, method: Method) -> (Option<f64>, String) {
-    if !ctx
-        .device
-        .features()
-        .contains(wgpu::Features::TIMESTAMP_QUERY)
-    {
-        return (
-            None,
-            format!("gpu_ms not measured: the adapter lacks TIMESTAMP_QUERY; {WALL_NOTE}"),
-        );
-    }
-    match method {
-        Method::Deferred => match time_deferred(ctx, scene) {
-            Ok(ms) => (
-                Some(ms),
-                format!(
-                    "gpu_ms: median over {TIMED_FRAMES} frames (after {WARM_UP_FRAMES} warm-up) of \
-                     the visibility and edge passes' timestamp spans; {WALL_NOTE}"
-                ),
-            ),
-            Err(e) => (None, format!("gpu_ms not measured: {e}; {WALL_NOTE}")),
-        },
-        _ => (
-            None,
+/// GPU time of each method's passes for `scene` in milliseconds (median over frames, methods
+/// interleaved frame by frame, see [`crate::bench`]), with a note on how it was taken.
+fn gpu_times(ctx: &GpuContext, scene: &Scene<'_>) -> (BTreeMap<String, f64>, String) {
+    match crate::bench::bench_scene(ctx, "compare", scene, TIMED_FRAMES, WARM_UP_FRAMES) {
+        Ok(runs) => (
+            runs.into_iter()
+                .map(|r| (r.method, r.total_median_ms))
+                .collect(),
             format!(
-                "gpu_ms not measured: this method has no timed encoder yet (timestamp writes \
-                 belong inside its passes); {WALL_NOTE}"
+                "gpu_ms: median over {TIMED_FRAMES} frames (after {WARM_UP_FRAMES} warm-up) of \
+                 the sum of the method's timestamped passes; {WALL_NOTE}"
             ),
         ),
+        Err(e) => (
+            BTreeMap::new(),
+            format!("gpu_ms not measured: {e}; {WALL_NOTE}"),
+        ),
     }
-}
-
-/// Median GPU time of the deferred pass's visibility + edge passes (shaded output).
-fn time_deferred(ctx: &GpuContext, scene: &Scene<'_>) -> Result<f64> {
-    use crate::gpu::{DeferredPass, GpuMesh, GpuTimer, OutputTarget, PassOptions};
-    let device = &ctx.device;
-    let mut pass = DeferredPass::new(device, PassOptions::default())?;
-    let mesh = GpuMesh::new(device, scene.mesh, scene.edges)?;
-    pass.prepare(
-        device,
-        &ctx.queue,
-        &mesh,
-        &scene.camera,
-        &scene.style,
-        scene.size,
-    )?;
-    let output = device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("wirepass compare timing"),
-        size: wgpu::Extent3d {
-            width: scene.size.0,
-            height: scene.size.1,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: pass.output_format(),
-        usage: wgpu::TextureUsages::STORAGE_BINDING,
-        view_formats: &[],
-    });
-    let view = output.create_view(&Default::default());
-    let mut timer = GpuTimer::new(device, &ctx.queue, 2)?;
-    let mut times = Vec::with_capacity(TIMED_FRAMES);
-    for frame in 0..WARM_UP_FRAMES + TIMED_FRAMES {
-        let mut encoder = device.create_command_encoder(&Default::default());
-        pass.encode_timed(
-            device,
-            &mut encoder,
-            &mesh,
-            OutputTarget::Shaded(&view),
-            &mut timer,
-        )?;
-        timer.resolve(&mut encoder);
-        ctx.queue.submit([encoder.finish()]);
-        let spans = timer.read(device)?;
-        ctx.finish()?;
-        if frame >= WARM_UP_FRAMES {
-            times.push(spans.iter().map(|(_, ms)| ms).sum::<f64>());
-        }
-    }
-    times.sort_by(f64::total_cmp);
-    Ok(times[times.len() / 2])
 }
 
 /// Renders `scene` with the ground truth and every GPU method, writes the images, heat maps,
@@ -437,6 +372,7 @@ pub fn run(ctx: &GpuContext, scene: &Scene<'_>, out: &Path) -> Result<Report> {
     let reference_seconds = start.elapsed().as_secs_f64();
     reference.save_png(&out.join(format!("{}.png", Method::Raycast.name())))?;
 
+    let (gpu_ms, note) = gpu_times(ctx, scene);
     let mut rows = Vec::new();
     let mut panels: Vec<(String, Option<[Image; 3]>)> = Vec::new();
     for &method in Method::ALL {
@@ -461,12 +397,11 @@ pub fn run(ctx: &GpuContext, scene: &Scene<'_>, out: &Path) -> Result<Report> {
                 let flip = flip_error_image(&reference, &frame);
                 flip.save_png(&out.join(format!("{key}_flip.png")))?;
                 panels.push((name.to_string(), Some([frame_image(&frame), heat, flip])));
-                let (gpu_ms, note) = gpu_time(ctx, scene, method);
                 MethodReport::Measured {
                     metrics: metrics(&reference, &frame),
-                    gpu_ms,
+                    gpu_ms: gpu_ms.get(name).copied(),
                     wall_ms,
-                    note,
+                    note: note.clone(),
                 }
             }
         };

@@ -10,6 +10,7 @@ pub mod mesh;
 
 pub use error::{Error, Result};
 pub use mesh::{EdgeSelection, Mesh};
+pub mod bench;
 pub mod camera;
 pub mod edge_math;
 pub mod gpu;
