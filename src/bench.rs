@@ -5,8 +5,8 @@
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::gpu::{
-    DeferredPass, EdgeLines, ForwardPass, GpuContext, GpuMesh, GpuTimer, OutputTarget,
-    PassOptions, TwoPass,
+    DeferredPass, EdgeLines, ForwardPass, GpuContext, GpuMesh, GpuTimer, OutputTarget, PassOptions,
+    TwoPass,
 };
 use crate::mesh::{EdgeSelection, Mesh};
 use crate::render::Scene;
@@ -302,5 +302,237 @@ mod tests {
         assert_eq!((s.p10_ms, s.median_ms, s.p90_ms), (1.0, 3.0, 5.0));
         let one = Stats::of(&[7.0]);
         assert_eq!((one.p10_ms, one.median_ms, one.p90_ms), (7.0, 7.0, 7.0));
+    }
+}
+
+/// The adapter a benchmark ran on, for the report.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct DeviceInfo {
+    /// Adapter name.
+    pub name: String,
+    /// wgpu backend.
+    pub backend: String,
+    /// Device type (discrete, integrated, CPU, …).
+    pub device_type: String,
+    /// Driver and its version, as reported.
+    pub driver: String,
+}
+
+impl DeviceInfo {
+    /// Reads the adapter's description.
+    pub fn of(ctx: &GpuContext) -> DeviceInfo {
+        let i = ctx.adapter.get_info();
+        DeviceInfo {
+            name: i.name,
+            backend: format!("{:?}", i.backend),
+            device_type: format!("{:?}", i.device_type),
+            driver: format!("{} {}", i.driver, i.driver_info).trim().to_owned(),
+        }
+    }
+
+    /// One line.
+    pub fn describe(&self) -> String {
+        format!(
+            "{} ({}, {}; {})",
+            self.name, self.backend, self.device_type, self.driver
+        )
+    }
+}
+
+/// Writes `bench.json`, `bench.csv`, `time_vs_triangles.png` and `time_vs_pixels.png` into
+/// `dir`.
+pub fn write_outputs(dir: &std::path::Path, device: &DeviceInfo, runs: &[Run]) -> Result<()> {
+    let io = |path: std::path::PathBuf| move |source| Error::Io { path, source };
+    std::fs::create_dir_all(dir).map_err(io(dir.to_owned()))?;
+    let json = serde_json::json!({ "device": device, "runs": runs });
+    let path = dir.join("bench.json");
+    let text = serde_json::to_string_pretty(&json)
+        .map_err(|e| Error::InvalidSetting(format!("bench.json: {e}")))?;
+    std::fs::write(&path, text).map_err(io(path.clone()))?;
+    let path = dir.join("bench.csv");
+    std::fs::write(&path, csv(runs)).map_err(io(path.clone()))?;
+    plot::time_against(
+        &dir.join("time_vs_triangles.png"),
+        runs,
+        "triangles",
+        |r| r.triangles as f64,
+        |r| format!("{}x{}", r.size[0], r.size[1]),
+    )?;
+    plot::time_against(
+        &dir.join("time_vs_pixels.png"),
+        runs,
+        "pixels",
+        |r| f64::from(r.size[0]) * f64::from(r.size[1]),
+        |r| r.scene.clone(),
+    )
+}
+
+/// One row per run and pass (plus a `total` row per run).
+pub fn csv(runs: &[Run]) -> String {
+    let mut out = String::from(
+        "scene,triangles,width,height,method,pass,median_ms,p10_ms,p90_ms,cpu_median_ms,gpu_bytes\n",
+    );
+    for r in runs {
+        let total = Stats {
+            median_ms: r.total_median_ms,
+            p10_ms: f64::NAN,
+            p90_ms: f64::NAN,
+        };
+        let rows = r.passes.iter().map(|(k, v)| (k.as_str(), v));
+        for (pass, s) in rows.chain([("total", &total)]) {
+            let num = |v: f64| {
+                if v.is_nan() {
+                    String::new()
+                } else {
+                    format!("{v:.6}")
+                }
+            };
+            out += &format!(
+                "{},{},{},{},{},{},{},{},{},{:.6},{}\n",
+                r.scene.replace(',', ";"),
+                r.triangles,
+                r.size[0],
+                r.size[1],
+                r.method,
+                pass,
+                num(s.median_ms),
+                num(s.p10_ms),
+                num(s.p90_ms),
+                r.cpu.median_ms,
+                r.gpu_bytes
+            );
+        }
+    }
+    out
+}
+
+mod plot {
+    //! Log-log plots of total GPU time per method, with plotters and an embedded font so
+    //! they draw the same on a machine without fonts.
+
+    use super::Run;
+    use crate::error::{Error, Result};
+    use plotters::prelude::*;
+    use std::path::Path;
+    use std::sync::Once;
+
+    fn register_font() {
+        static ONCE: Once = Once::new();
+        ONCE.call_once(|| {
+            // The bytes are a known-good embedded TTF; a failure would only lose the text.
+            let _ = plotters::style::register_font(
+                "sans-serif",
+                FontStyle::Normal,
+                dejavu::sans::regular(),
+            );
+        });
+    }
+
+    const COLORS: [RGBColor; 4] = [
+        RGBColor(120, 120, 120),
+        RGBColor(31, 119, 180),
+        RGBColor(214, 39, 40),
+        RGBColor(44, 160, 44),
+    ];
+
+    /// Total median GPU time against `x` (log-log): one colour per method, one line per
+    /// method and `group` (the variable held fixed along the line).
+    pub fn time_against(
+        path: &Path,
+        runs: &[Run],
+        x_name: &str,
+        x: impl Fn(&Run) -> f64,
+        group: impl Fn(&Run) -> String,
+    ) -> Result<()> {
+        register_font();
+        let fail = |e: String| Error::Image {
+            path: path.to_owned(),
+            message: e,
+        };
+        let points: Vec<(f64, f64)> = runs
+            .iter()
+            .map(|r| (x(r), r.total_median_ms))
+            .filter(|p| p.0 > 0.0 && p.1 > 0.0)
+            .collect();
+        if points.is_empty() {
+            return Ok(());
+        }
+        let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+        for &(px, py) in &points {
+            (x0, x1, y0, y1) = (x0.min(px), x1.max(px), y0.min(py), y1.max(py));
+        }
+        let root = BitMapBackend::new(path, (900, 560)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| fail(e.to_string()))?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(
+                format!("GPU time per frame against {x_name}"),
+                ("sans-serif", 22),
+            )
+            .margin(16)
+            .x_label_area_size(44)
+            .y_label_area_size(64)
+            .build_cartesian_2d(
+                (x0 * 0.8..x1 * 1.25).log_scale(),
+                (y0 * 0.8..y1 * 1.25).log_scale(),
+            )
+            .map_err(|e| fail(e.to_string()))?;
+        chart
+            .configure_mesh()
+            .x_desc(x_name)
+            .y_desc("median GPU ms (sum of passes)")
+            .draw()
+            .map_err(|e| fail(e.to_string()))?;
+        let mut methods: Vec<&str> = Vec::new();
+        let mut lines: Vec<(&str, String)> = Vec::new();
+        for r in runs {
+            if !methods.contains(&r.method.as_str()) {
+                methods.push(&r.method);
+            }
+            let key = (r.method.as_str(), group(r));
+            if !lines.contains(&key) {
+                lines.push(key);
+            }
+        }
+        let dashes = lines
+            .iter()
+            .map(|l| &l.1)
+            .collect::<std::collections::BTreeSet<_>>();
+        for (method, fixed) in &lines {
+            let m = methods.iter().position(|n| n == method).unwrap_or(0);
+            let color = COLORS[m % COLORS.len()];
+            let mut series: Vec<(f64, f64)> = runs
+                .iter()
+                .filter(|r| r.method == *method && group(r) == *fixed && r.total_median_ms > 0.0)
+                .map(|r| (x(r), r.total_median_ms))
+                .collect();
+            series.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let label = if dashes.len() > 1 {
+                format!("{method} ({fixed})")
+            } else {
+                (*method).to_owned()
+            };
+            chart
+                .draw_series(LineSeries::new(series.clone(), color.stroke_width(2)))
+                .map_err(|e| fail(e.to_string()))?
+                .label(label)
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2))
+                });
+            chart
+                .draw_series(
+                    series
+                        .into_iter()
+                        .map(|p| Circle::new(p, 4, color.filled())),
+                )
+                .map_err(|e| fail(e.to_string()))?;
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .position(SeriesLabelPosition::UpperLeft)
+            .draw()
+            .map_err(|e| fail(e.to_string()))?;
+        root.present().map_err(|e| fail(e.to_string()))
     }
 }

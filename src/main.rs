@@ -1,6 +1,6 @@
 //! `wirepass`: render mesh wireframes on the GPU from the command line.
 
-use clap::{Parser, Subcommand, ValueEnum};
+use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use wirepass::cli::{load_mesh, parse_size, CameraArgs};
@@ -26,14 +26,13 @@ enum Command {
     /// Render one scene with the CPU ray-cast ground truth and every GPU method, and report
     /// how closely each matches it (images, error maps, sheet.png, report.json).
     Compare(CompareArgs),
+    /// Time every method (and the floor: visibility + id-only compute) with GPU timestamps
+    /// on each scene and size; write bench.json, bench.csv and plots.
+    Bench(BenchArgs),
 }
 
-#[derive(Clone, Copy, ValueEnum)]
-enum Edges {
-    /// Every triangle edge.
-    All,
-    /// Only the edges of the file's polygons (no triangulation diagonals).
-    Polygon,
+fn parse_edges(s: &str) -> std::result::Result<EdgeSelection, String> {
+    s.parse().map_err(|e: wirepass::Error| e.to_string())
 }
 
 #[derive(clap::Args)]
@@ -60,9 +59,10 @@ struct RenderArgs {
     /// then 1 px edge lines), raycast (the f64 CPU ground truth; slow).
     #[arg(long, default_value = "deferred", value_parser = parse_method)]
     method: Method,
-    /// Which edges to draw.
-    #[arg(long, value_enum, default_value = "polygon")]
-    edges: Edges,
+    /// Which edges to draw: all, polygon (no triangulation diagonals), or
+    /// feature[:DEGREES] (creases sharper than DEGREES, default 1, plus boundaries).
+    #[arg(long, default_value = "polygon", value_parser = parse_edges)]
+    edges: EdgeSelection,
     /// Output PNG.
     #[arg(short, long, default_value = "wireframe.png")]
     output: PathBuf,
@@ -90,10 +90,7 @@ fn render_command(args: &RenderArgs) -> Result<()> {
     let mesh = load_mesh(args.mesh.as_deref())?;
     let camera = args.camera.camera(&mesh, size)?;
     let ctx = GpuContext::new()?;
-    let edges = match args.edges {
-        Edges::All => EdgeSelection::All,
-        Edges::Polygon => EdgeSelection::Polygon,
-    };
+    let edges = args.edges;
     let scene = Scene {
         mesh: &mesh,
         camera,
@@ -128,9 +125,10 @@ struct CompareArgs {
     /// Line width in pixels.
     #[arg(long, default_value_t = 1.5, allow_hyphen_values = true)]
     line_width: f32,
-    /// Which edges to draw.
-    #[arg(long, value_enum, default_value = "polygon")]
-    edges: Edges,
+    /// Which edges to draw: all, polygon (no triangulation diagonals), or
+    /// feature[:DEGREES] (creases sharper than DEGREES, default 1, plus boundaries).
+    #[arg(long, default_value = "polygon", value_parser = parse_edges)]
+    edges: EdgeSelection,
     /// Directory for the images, error maps, sheet.png and report.json.
     #[arg(long)]
     out: PathBuf,
@@ -148,10 +146,7 @@ fn compare_command(args: &CompareArgs) -> Result<()> {
     let mesh = load_mesh(args.mesh.as_deref())?;
     let camera = args.camera.camera(&mesh, size)?;
     let ctx = GpuContext::new()?;
-    let edges = match args.edges {
-        Edges::All => EdgeSelection::All,
-        Edges::Polygon => EdgeSelection::Polygon,
-    };
+    let edges = args.edges;
     let scene = Scene {
         mesh: &mesh,
         camera,
@@ -173,11 +168,74 @@ fn compare_command(args: &CompareArgs) -> Result<()> {
     Ok(())
 }
 
+#[derive(clap::Args)]
+struct BenchArgs {
+    /// Scenes: OBJ files or procedural meshes (`sphere:20000 sphere:2M`); default: the
+    /// built-in scene.
+    scenes: Vec<String>,
+    /// Image sizes, comma separated: 1280x720,1920x1080.
+    #[arg(long, default_value = "1280x720")]
+    size: String,
+    /// Timed frames per scene, size and method (after warm-up frames).
+    #[arg(long, default_value_t = 20)]
+    frames: u32,
+    /// Untimed frames first.
+    #[arg(long, default_value_t = 3)]
+    warmup: u32,
+    /// Directory for bench.json, bench.csv and the plots.
+    #[arg(long)]
+    out: PathBuf,
+}
+
+fn bench_command(args: &BenchArgs) -> Result<()> {
+    let sizes = args
+        .size
+        .split(',')
+        .map(parse_size)
+        .collect::<Result<Vec<_>>>()?;
+    let specs: Vec<Option<&str>> = if args.scenes.is_empty() {
+        vec![None]
+    } else {
+        args.scenes.iter().map(|s| Some(s.as_str())).collect()
+    };
+    let ctx = GpuContext::new()?;
+    let progress = indicatif::ProgressBar::new((specs.len() * sizes.len()) as u64);
+    if !std::io::IsTerminal::is_terminal(&std::io::stderr()) {
+        progress.set_draw_target(indicatif::ProgressDrawTarget::hidden());
+    }
+    let mut runs = Vec::new();
+    for spec in specs {
+        let name = spec.unwrap_or("built-in");
+        progress.set_message(format!("loading {name}"));
+        let mesh = load_mesh(spec)?;
+        for &size in &sizes {
+            progress.set_message(format!("{name} at {}x{}", size.0, size.1));
+            runs.extend(wirepass::bench::bench(
+                &ctx,
+                name,
+                &mesh,
+                size,
+                args.frames,
+                args.warmup,
+            )?);
+            progress.inc(1);
+        }
+    }
+    progress.finish_and_clear();
+    let device = wirepass::bench::DeviceInfo::of(&ctx);
+    println!("{}\n", device.describe());
+    println!("{}", wirepass::bench::markdown(&runs));
+    wirepass::bench::write_outputs(&args.out, &device, &runs)?;
+    eprintln!("wrote {}", args.out.display());
+    Ok(())
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Render(args) => render_command(args),
         Command::Compare(args) => compare_command(args),
+        Command::Bench(args) => bench_command(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -121,3 +121,89 @@ fn bad_settings_give_one_clear_line() {
         assert_eq!(lines.len(), 1, "{args:?}: {err}");
     }
 }
+
+#[test]
+fn bench_writes_table_json_csv_and_plots() {
+    let out = temp("bench");
+    let (ok, err) = wirepass(&[
+        "bench",
+        "sphere:2000",
+        "grid:500",
+        "--size",
+        "64x48,96x64",
+        "--frames",
+        "2",
+        "--warmup",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("bench.json")).unwrap()).unwrap();
+    assert!(json["device"]["name"].is_string());
+    let runs = json["runs"].as_array().unwrap();
+    // 2 scenes × 2 sizes × (floor, deferred, forward, two-pass).
+    assert_eq!(runs.len(), 16);
+    for run in runs {
+        for key in [
+            "scene",
+            "triangles",
+            "size",
+            "method",
+            "passes",
+            "total_median_ms",
+            "gpu_bytes",
+        ] {
+            assert!(run.get(key).is_some(), "run lacks {key}: {run}");
+        }
+        let total = run["total_median_ms"].as_f64().unwrap();
+        assert!(total.is_finite() && total >= 0.0);
+        for stats in run["passes"].as_object().unwrap().values() {
+            let (p10, median, p90) = (
+                stats["p10_ms"].as_f64().unwrap(),
+                stats["median_ms"].as_f64().unwrap(),
+                stats["p90_ms"].as_f64().unwrap(),
+            );
+            assert!(p10 <= median && median <= p90, "{stats}");
+        }
+    }
+    let methods: std::collections::BTreeSet<_> =
+        runs.iter().map(|r| r["method"].as_str().unwrap()).collect();
+    assert_eq!(
+        methods.into_iter().collect::<Vec<_>>(),
+        ["deferred", "floor", "forward", "two-pass"]
+    );
+    let csv = std::fs::read_to_string(out.join("bench.csv")).unwrap();
+    assert!(csv.lines().count() > 16);
+    for plot in ["time_vs_triangles.png", "time_vs_pixels.png"] {
+        let img = image::open(out.join(plot)).unwrap();
+        assert!(img.width() > 100, "{plot}");
+    }
+}
+
+#[test]
+fn feature_edges_from_the_command_line() {
+    let png = temp("fandisk.png");
+    let (ok, err) = wirepass(&[
+        "render",
+        concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes/fandisk.obj"),
+        "--edges",
+        "feature:30",
+        "--line-width",
+        "3",
+        "--size",
+        "128x96",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let (ok, err) = wirepass(&[
+        "render",
+        "--edges",
+        "feature:400",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert!(!ok && err.contains("feature:DEGREES"), "{err}");
+}
