@@ -559,7 +559,14 @@ impl ForwardPass {
         let group = mesh_group(device, &self.layout, &self.uniforms, mesh);
         let background = clear_color(self.format, self.background);
         let writes = timer.and_then(|t| t.render_span("draw"));
-        let mut pass = targets.begin(encoder, "wirepass forward", output, background, maps, writes);
+        let mut pass = targets.begin(
+            encoder,
+            "wirepass forward",
+            output,
+            background,
+            maps,
+            writes,
+        );
         pass.set_pipeline(if maps {
             &self.with_maps
         } else {

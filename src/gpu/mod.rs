@@ -6,8 +6,8 @@ mod forward;
 mod frame;
 mod mesh;
 mod readback;
-mod timing;
 pub mod shaders;
+mod timing;
 mod two_pass;
 
 pub use context::{GpuContext, OPTIONAL_FEATURES};

@@ -397,8 +397,14 @@ impl TwoPass {
         let group = mesh_group(device, &self.layout, &self.uniforms, mesh);
         let background = clear_color(self.format, self.background);
         let writes = timer.and_then(|t| t.render_span("draw"));
-        let mut pass =
-            targets.begin(encoder, "wirepass two-pass", output, background, maps, writes);
+        let mut pass = targets.begin(
+            encoder,
+            "wirepass two-pass",
+            output,
+            background,
+            maps,
+            writes,
+        );
         pass.set_pipeline(if maps { &self.fill_maps } else { &self.fill });
         pass.set_bind_group(0, &group, &[]);
         pass.draw(0..3 * mesh.triangles, 0..1);
