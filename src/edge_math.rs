@@ -62,7 +62,7 @@ pub fn edge_eval(clip: [DVec4; 3], mask: u8, pixel: DVec2, size: DVec2) -> EdgeE
 
 fn line_distance(l: DVec3, drawn: bool) -> f64 {
     let len = l.truncate().length();
-    if !drawn || !(len > 0.0) {
+    if !drawn || len.is_nan() || len <= 0.0 {
         return NO_EDGE;
     }
     l.z.abs() / len
@@ -126,8 +126,8 @@ mod tests {
             (1.0 - c.y / c.w) * 0.5 * SIZE.y,
         );
         let e = edge_eval(clip, 0b111, pixel, SIZE);
-        for i in 0..3 {
-            assert!((e.bary[i] - weights[i]).abs() < 1e-9, "{:?}", e.bary);
+        for (b, w) in e.bary.iter().zip(weights) {
+            assert!((b - w).abs() < 1e-9, "{:?}", e.bary);
         }
     }
 

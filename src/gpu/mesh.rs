@@ -46,8 +46,9 @@ impl GpuMesh {
             ("edge neighbours", neighbours.len() * 4),
         ] {
             let len = len as u64;
-            let limit =
-                u64::from(limits.max_storage_buffer_binding_size).min(limits.max_buffer_size);
+            let limit = limits
+                .max_storage_buffer_binding_size
+                .min(limits.max_buffer_size);
             if len > limit {
                 return Err(Error::OverLimit {
                     what: format!(

@@ -352,7 +352,7 @@ impl TwoPass {
         lines: &EdgeLines,
         output: &wgpu::TextureView,
     ) -> Result<()> {
-        self.record(device, encoder, mesh, lines, output, false, None)
+        self.record(device, encoder, mesh, (lines, output), false, None)
     }
 
     /// [`encode`](Self::encode) with GPU timestamps around the pass (fill and lines share
@@ -366,7 +366,7 @@ impl TwoPass {
         output: &wgpu::TextureView,
         timer: &mut GpuTimer,
     ) -> Result<()> {
-        self.record(device, encoder, mesh, lines, output, false, Some(timer))
+        self.record(device, encoder, mesh, (lines, output), false, Some(timer))
     }
 
     /// Like [`encode`](Self::encode), and also writes the triangle ids and the diagnostic map.
@@ -378,7 +378,7 @@ impl TwoPass {
         lines: &EdgeLines,
         output: &wgpu::TextureView,
     ) -> Result<()> {
-        self.record(device, encoder, mesh, lines, output, true, None)
+        self.record(device, encoder, mesh, (lines, output), true, None)
     }
 
     fn record(
@@ -386,8 +386,7 @@ impl TwoPass {
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
         mesh: &GpuMesh,
-        lines: &EdgeLines,
-        output: &wgpu::TextureView,
+        (lines, output): (&EdgeLines, &wgpu::TextureView),
         maps: bool,
         timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
