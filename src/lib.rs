@@ -5,6 +5,8 @@
 //! the exact screen-space distance to the visible triangle's edges and composites the shaded
 //! colour with the line. Its cost depends on the pixel count, not on the triangle count.
 
+#![warn(missing_docs)]
+
 pub mod error;
 pub mod mesh;
 

@@ -392,3 +392,47 @@ fn timer_reports_both_passes() {
         );
     }
 }
+
+#[test]
+fn vertex_pulling_fallback_matches_primitive_index() {
+    let ctx = gpu();
+    let device = &ctx.device;
+    let mesh = load("suzanne.obj");
+    let gpu_mesh = GpuMesh::new(device, &mesh, EdgeSelection::Polygon).unwrap();
+    let (lo, hi) = mesh.bounds();
+    let cam = Camera::framing(lo, hi, 1.0);
+    let size = (128, 128);
+    let read = |pulled: bool| {
+        let options = PassOptions::default();
+        let pass = if pulled {
+            DeferredPass::with_vertex_pulling(device, options)
+        } else {
+            DeferredPass::new(device, options)
+        };
+        let mut pass = pass.unwrap();
+        assert_eq!(
+            pass.uses_vertex_pulling(),
+            pulled || !device.features().contains(wgpu::Features::PRIMITIVE_INDEX)
+        );
+        pass.prepare(device, &ctx.queue, &gpu_mesh, &cam, &Style::default(), size)
+            .unwrap();
+        let mut encoder = device.create_command_encoder(&Default::default());
+        pass.encode_visibility(device, &mut encoder, &gpu_mesh)
+            .unwrap();
+        ctx.queue.submit([encoder.finish()]);
+        ctx.finish().unwrap();
+        let ids = pass.id_texture().unwrap();
+        wirepass::gpu::read_texture(device, &ctx.queue, ids, wgpu::TextureAspect::All).unwrap()
+    };
+    let pulled = read(true);
+    let indexed = read(false);
+    let covered = bytemuck::cast_slice::<u8, u32>(&pulled)
+        .iter()
+        .filter(|&&id| id != BACKGROUND)
+        .count();
+    assert!(covered > 1000);
+    assert_eq!(
+        pulled, indexed,
+        "the fallback visibility pass must give the same ids"
+    );
+}

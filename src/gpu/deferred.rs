@@ -133,13 +133,23 @@ impl DeferredPass {
     /// Builds the pipelines. Uses `@builtin(primitive_index)` where the device has
     /// `Features::PRIMITIVE_INDEX`, and a vertex-pulling visibility pass otherwise.
     pub fn new(device: &wgpu::Device, options: PassOptions) -> Result<Self> {
+        let pulled = !device.features().contains(wgpu::Features::PRIMITIVE_INDEX);
+        Self::build(device, options, pulled)
+    }
+
+    /// Builds the pipelines with the vertex-pulling visibility pass even where the device
+    /// has `PRIMITIVE_INDEX`, e.g. to test the path other adapters take.
+    pub fn with_vertex_pulling(device: &wgpu::Device, options: PassOptions) -> Result<Self> {
+        Self::build(device, options, true)
+    }
+
+    fn build(device: &wgpu::Device, options: PassOptions, pulled: bool) -> Result<Self> {
         let format = options.output_format;
         let edge_source = shaders::edge_pass(format).ok_or_else(|| {
             Error::InvalidSetting(format!(
                 "output format {format:?} is not one the edge pass can write (Rgba8Unorm, Rgba16Float, Rgba32Float)"
             ))
         })?;
-        let pulled = !device.features().contains(wgpu::Features::PRIMITIVE_INDEX);
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
 
         let vs = wgpu::ShaderStages::VERTEX;

@@ -124,12 +124,12 @@ impl EdgeLines {
         })
     }
 
-    /// Number of lines drawn.
     /// GPU memory of the line index buffer, in bytes.
     pub fn gpu_bytes(&self) -> u64 {
         u64::from(self.edges) * 8
     }
 
+    /// Number of lines drawn.
     pub fn edge_count(&self) -> u32 {
         self.edges
     }
