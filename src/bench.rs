@@ -5,8 +5,8 @@
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::gpu::{
-    DeferredPass, EdgeLines, ForwardPass, GpuContext, GpuMesh, GpuTimer, OutputTarget, PassOptions,
-    TwoPass,
+    texture_2d, DeferredPass, EdgeLines, ForwardPass, GpuContext, GpuMesh, GpuTimer, OutputTarget,
+    PassOptions, TwoPass,
 };
 use crate::mesh::{EdgeSelection, Mesh};
 use crate::render::Scene;
@@ -117,28 +117,6 @@ impl Subject {
     }
 }
 
-fn output(
-    device: &wgpu::Device,
-    (width, height): (u32, u32),
-    format: wgpu::TextureFormat,
-    usage: wgpu::TextureUsages,
-) -> wgpu::Texture {
-    device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("wirepass bench output"),
-        size: wgpu::Extent3d {
-            width,
-            height,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format,
-        usage,
-        view_formats: &[],
-    })
-}
-
 /// Times every method on `mesh` at `size`, with the framing camera and the default style:
 /// see [`bench_scene`].
 pub fn bench(
@@ -178,14 +156,26 @@ pub fn bench_scene(
     let gpu_mesh = GpuMesh::new(device, mesh, scene.edges)?;
     let storage = || {
         let usage = wgpu::TextureUsages::STORAGE_BINDING;
-        output(device, size, wgpu::TextureFormat::Rgba8Unorm, usage)
+        texture_2d(
+            device,
+            "wirepass bench output",
+            size,
+            wgpu::TextureFormat::Rgba8Unorm,
+            usage,
+        )
     };
     let forward_options = PassOptions {
         output_format: wgpu::TextureFormat::Rgba8UnormSrgb,
     };
     let attachment = || {
         let usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
-        output(device, size, forward_options.output_format, usage)
+        texture_2d(
+            device,
+            "wirepass bench output",
+            size,
+            forward_options.output_format,
+            usage,
+        )
     };
     let mut subjects = Vec::new();
     for floor in [true, false] {

@@ -196,17 +196,7 @@ impl Image {
 
     /// Writes the image as a PNG.
     pub fn save_png(&self, path: &Path) -> Result<()> {
-        image::save_buffer(
-            path,
-            &self.rgba,
-            self.size.0,
-            self.size.1,
-            image::ColorType::Rgba8,
-        )
-        .map_err(|e| Error::Image {
-            path: path.to_owned(),
-            message: e.to_string(),
-        })
+        crate::render::save_rgba_png(path, &self.rgba, self.size)
     }
 }
 

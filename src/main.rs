@@ -6,7 +6,7 @@ use std::process::ExitCode;
 use wirepass::cli::{load_mesh, parse_size, CameraArgs};
 use wirepass::gpu::GpuContext;
 use wirepass::render::{render, Method, Scene};
-use wirepass::{Color, EdgeSelection, Result, Style};
+use wirepass::{Camera, Color, EdgeSelection, Mesh, Result, Style};
 
 #[derive(Parser)]
 #[command(
@@ -35,8 +35,9 @@ fn parse_edges(s: &str) -> std::result::Result<EdgeSelection, String> {
     s.parse().map_err(|e: wirepass::Error| e.to_string())
 }
 
+/// What to draw and how it looks: shared by `render` and `compare`.
 #[derive(clap::Args)]
-struct RenderArgs {
+struct SceneArgs {
     /// OBJ file or procedural mesh (`sphere:20000`, `grid:1k`, `torus:5000`); default: built-in scene.
     mesh: Option<String>,
     /// Image size WIDTHxHEIGHT.
@@ -54,23 +55,47 @@ struct RenderArgs {
     /// Background colour, #rrggbb (sRGB).
     #[arg(long, default_value = "#ffffff")]
     background: String,
+    /// Which edges to draw: all, polygon (no triangulation diagonals), or
+    /// feature[:DEGREES] (creases sharper than DEGREES, default 1, plus boundaries).
+    #[arg(long, default_value = "polygon", value_parser = parse_edges)]
+    edges: EdgeSelection,
+    #[command(flatten)]
+    camera: CameraArgs,
+}
+
+impl SceneArgs {
+    /// Checks the settings, then loads the mesh and places the camera.
+    fn load(&self) -> Result<(Mesh, Camera, Style, (u32, u32))> {
+        let size = parse_size(&self.size)?;
+        let style = Style {
+            line_width: self.line_width,
+            wire_color: Color::from_hex(&self.wire_color)?,
+            fill_color: Color::from_hex(&self.fill_color)?,
+            background: Color::from_hex(&self.background)?,
+            ..Style::default()
+        };
+        style.validate()?;
+        let mesh = load_mesh(self.mesh.as_deref())?;
+        let camera = self.camera.camera(&mesh, size)?;
+        Ok((mesh, camera, style, size))
+    }
+}
+
+#[derive(clap::Args)]
+struct RenderArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
     /// How to draw: deferred (visibility buffer + compute edge pass), forward (single-pass
     /// altitudes, Bærentzen et al. 2006; divides by w like the seeds), two-pass (biased fill,
     /// then 1 px edge lines), raycast (the f64 CPU ground truth; slow).
     #[arg(long, default_value = "deferred", value_parser = parse_method)]
     method: Method,
-    /// Which edges to draw: all, polygon (no triangulation diagonals), or
-    /// feature[:DEGREES] (creases sharper than DEGREES, default 1, plus boundaries).
-    #[arg(long, default_value = "polygon", value_parser = parse_edges)]
-    edges: EdgeSelection,
     /// Output PNG.
     #[arg(short, long, default_value = "wireframe.png")]
     output: PathBuf,
     /// Also write ids.npy, depth.npy, edge_distance.npy and camera.json into this directory.
     #[arg(long)]
     dump: Option<PathBuf>,
-    #[command(flatten)]
-    camera: CameraArgs,
 }
 
 fn parse_method(s: &str) -> std::result::Result<Method, String> {
@@ -78,25 +103,14 @@ fn parse_method(s: &str) -> std::result::Result<Method, String> {
 }
 
 fn render_command(args: &RenderArgs) -> Result<()> {
-    let size = parse_size(&args.size)?;
-    let style = Style {
-        line_width: args.line_width,
-        wire_color: Color::from_hex(&args.wire_color)?,
-        fill_color: Color::from_hex(&args.fill_color)?,
-        background: Color::from_hex(&args.background)?,
-        ..Style::default()
-    };
-    style.validate()?;
-    let mesh = load_mesh(args.mesh.as_deref())?;
-    let camera = args.camera.camera(&mesh, size)?;
+    let (mesh, camera, style, size) = args.scene.load()?;
     let ctx = GpuContext::new()?;
-    let edges = args.edges;
     let scene = Scene {
         mesh: &mesh,
         camera,
         style,
         size,
-        edges,
+        edges: args.scene.edges,
     };
     let frame = render(&ctx, &scene, args.method)?;
     frame.save_png(&args.output)?;
@@ -117,42 +131,22 @@ fn render_command(args: &RenderArgs) -> Result<()> {
 
 #[derive(clap::Args)]
 struct CompareArgs {
-    /// OBJ file or procedural mesh (`sphere:20000`, `grid:1k`, `torus:5000`); default: built-in scene.
-    mesh: Option<String>,
-    /// Image size WIDTHxHEIGHT.
-    #[arg(long, default_value = "640x480")]
-    size: String,
-    /// Line width in pixels.
-    #[arg(long, default_value_t = 1.5, allow_hyphen_values = true)]
-    line_width: f32,
-    /// Which edges to draw: all, polygon (no triangulation diagonals), or
-    /// feature[:DEGREES] (creases sharper than DEGREES, default 1, plus boundaries).
-    #[arg(long, default_value = "polygon", value_parser = parse_edges)]
-    edges: EdgeSelection,
+    #[command(flatten)]
+    scene: SceneArgs,
     /// Directory for the images, error maps, sheet.png and report.json.
     #[arg(long)]
     out: PathBuf,
-    #[command(flatten)]
-    camera: CameraArgs,
 }
 
 fn compare_command(args: &CompareArgs) -> Result<()> {
-    let size = parse_size(&args.size)?;
-    let style = Style {
-        line_width: args.line_width,
-        ..Style::default()
-    };
-    style.validate()?;
-    let mesh = load_mesh(args.mesh.as_deref())?;
-    let camera = args.camera.camera(&mesh, size)?;
+    let (mesh, camera, style, size) = args.scene.load()?;
     let ctx = GpuContext::new()?;
-    let edges = args.edges;
     let scene = Scene {
         mesh: &mesh,
         camera,
         style,
         size,
-        edges,
+        edges: args.scene.edges,
     };
     let report = wirepass::compare::run(&ctx, &scene, &args.out)?;
     println!(

@@ -3,8 +3,8 @@
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::gpu::{
-    read_texture, DeferredPass, EdgeLines, ForwardPass, GpuContext, GpuMesh, OutputTarget,
-    PassOptions, TwoPass,
+    read_texture, texture_2d, DeferredPass, EdgeLines, ForwardPass, GpuContext, GpuMesh,
+    OutputTarget, PassOptions, TwoPass,
 };
 use crate::mesh::{EdgeSelection, Mesh};
 use crate::style::Style;
@@ -115,21 +115,14 @@ pub fn render_deferred(ctx: &GpuContext, scene: &Scene<'_>) -> Result<Frame> {
         &scene.style,
         scene.size,
     )?;
-    let (width, height) = scene.size;
-    let output = device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("wirepass output"),
-        size: wgpu::Extent3d {
-            width,
-            height,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: pass.output_format(),
-        usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
-        view_formats: &[],
-    });
+    let usage = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC;
+    let output = texture_2d(
+        device,
+        "wirepass output",
+        scene.size,
+        pass.output_format(),
+        usage,
+    );
     let view = output.create_view(&Default::default());
     let mut encoder = device.create_command_encoder(&Default::default());
     pass.encode(device, &mut encoder, &mesh, OutputTarget::Shaded(&view))?;
@@ -185,21 +178,9 @@ fn read_frame(
 /// space and stores sRGB bytes, like the deferred pass's in-shader encoding.
 const FORWARD_OUTPUT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
 
-fn forward_output(device: &wgpu::Device, (width, height): (u32, u32)) -> wgpu::Texture {
-    device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("wirepass output"),
-        size: wgpu::Extent3d {
-            width,
-            height,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: FORWARD_OUTPUT,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-        view_formats: &[],
-    })
+fn forward_output(device: &wgpu::Device, size: (u32, u32)) -> wgpu::Texture {
+    let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+    texture_2d(device, "wirepass output", size, FORWARD_OUTPUT, usage)
 }
 
 /// Renders `scene` with the forward single-pass baseline and reads back the image and maps.
@@ -245,20 +226,20 @@ pub fn render_two_pass(ctx: &GpuContext, scene: &Scene<'_>) -> Result<Frame> {
     read_frame(ctx, scene.size, &output, ids, diagnostic)
 }
 
+/// Writes 8-bit RGBA pixels, row 0 at the top, as a PNG.
+pub fn save_rgba_png(path: &Path, rgba: &[u8], (width, height): (u32, u32)) -> Result<()> {
+    image::save_buffer(path, rgba, width, height, image::ColorType::Rgba8).map_err(|e| {
+        Error::Image {
+            path: path.to_owned(),
+            message: e.to_string(),
+        }
+    })
+}
+
 impl Frame {
     /// Writes the image as an sRGB PNG.
     pub fn save_png(&self, path: &Path) -> Result<()> {
-        image::save_buffer(
-            path,
-            &self.rgba,
-            self.size.0,
-            self.size.1,
-            image::ColorType::Rgba8,
-        )
-        .map_err(|e| Error::Image {
-            path: path.to_owned(),
-            message: e.to_string(),
-        })
+        save_rgba_png(path, &self.rgba, self.size)
     }
 
     /// Writes `ids.npy`, `depth.npy`, `edge_distance.npy` and `camera.json` into `dir`.

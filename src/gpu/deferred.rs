@@ -1,7 +1,7 @@
 //! The deferred wireframe pass: a visibility raster pass (triangle id + depth) followed by a
 //! compute pass that reconstructs each pixel's distance to its triangle's edges.
 
-use super::{check_size, shaders, FrameUniforms, GpuMesh, GpuTimer};
+use super::{check_size, shaders, texture_2d, FrameUniforms, GpuMesh, GpuTimer};
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::style::Style;
@@ -356,22 +356,7 @@ impl DeferredPass {
         let uniforms = FrameUniforms::new(camera, style, size, mesh.origin());
         queue.write_buffer(&self.frame, 0, bytemuck::bytes_of(&uniforms));
         if self.targets.as_ref().map(|t| t.size) != Some(size) {
-            let make = |label, format, usage| {
-                device.create_texture(&wgpu::TextureDescriptor {
-                    label: Some(label),
-                    size: wgpu::Extent3d {
-                        width: size.0,
-                        height: size.1,
-                        depth_or_array_layers: 1,
-                    },
-                    mip_level_count: 1,
-                    sample_count: 1,
-                    dimension: wgpu::TextureDimension::D2,
-                    format,
-                    usage,
-                    view_formats: &[],
-                })
-            };
+            let make = |label, format, usage| texture_2d(device, label, size, format, usage);
             use wgpu::TextureUsages as U;
             self.targets = Some(Targets {
                 size,

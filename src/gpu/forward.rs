@@ -4,7 +4,7 @@
 //! `3 × triangles` vertices pulls each triangle's three vertices from storage buffers instead.
 
 use super::deferred::{DEPTH_FORMAT, ID_FORMAT};
-use super::{check_size, shaders, FrameUniforms, GpuMesh, GpuTimer, PassOptions};
+use super::{check_size, shaders, texture_2d, FrameUniforms, GpuMesh, GpuTimer, PassOptions};
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::style::{linear_to_srgb, Style};
@@ -180,22 +180,7 @@ impl Targets {
         if slot.as_ref().map(|t| t.size) == Some(size) {
             return;
         }
-        let make = |label, format, usage| {
-            device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d {
-                    width: size.0,
-                    height: size.1,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            })
-        };
+        let make = |label, format, usage| texture_2d(device, label, size, format, usage);
         use wgpu::TextureUsages as U;
         *slot = Some(Targets {
             size,

@@ -21,6 +21,30 @@ pub use two_pass::{drawn_edges, two_pass_source, EdgeLines, TwoPass, FILL_DEPTH_
 
 use crate::error::{Error, Result};
 
+/// A single-level 2D texture of `width × height`: the shape of every target and output here.
+pub fn texture_2d(
+    device: &wgpu::Device,
+    label: &str,
+    (width, height): (u32, u32),
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage,
+        view_formats: &[],
+    })
+}
+
 /// Checks an image size against the device: non-zero and within `max_texture_dimension_2d`.
 pub fn check_size(device: &wgpu::Device, (width, height): (u32, u32)) -> Result<()> {
     if width == 0 || height == 0 {
