@@ -7,6 +7,7 @@ mod font;
 use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
 use crate::raycast::render_raycast;
+use crate::regression;
 use crate::render::{render, Frame, Method, Scene};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -143,25 +144,20 @@ pub fn distance_errors(reference: &Frame, frame: &Frame) -> Vec<Option<f64>> {
         .collect()
 }
 
-fn rgb8(frame: &Frame) -> Vec<u8> {
-    frame
-        .rgba
-        .chunks_exact(4)
-        .flat_map(|p| [p[0], p[1], p[2]])
-        .collect()
+fn rgba(frame: &Frame) -> regression::Rgba<'_> {
+    regression::Rgba {
+        pixels: &frame.rgba,
+        size: frame.size,
+    }
 }
 
-/// The per-pixel FLIP error (0..1) of `frame` against `reference`.
+/// The per-pixel FLIP error (0..1) of `frame` against `reference`
+/// ([`regression::flip_map`]).
+///
+/// # Panics
+/// If the frames differ in size.
 pub fn flip_map(reference: &Frame, frame: &Frame) -> Vec<f32> {
-    flip_image(reference, frame).to_vec()
-}
-
-fn flip_image(reference: &Frame, frame: &Frame) -> nv_flip::FlipImageFloat {
-    assert_eq!(reference.size, frame.size, "frames of different sizes");
-    let (w, h) = reference.size;
-    let a = nv_flip::FlipImageRgb8::with_data(w, h, &rgb8(reference));
-    let b = nv_flip::FlipImageRgb8::with_data(w, h, &rgb8(frame));
-    nv_flip::flip(a, b, nv_flip::DEFAULT_PIXELS_PER_DEGREE)
+    regression::flip_map(rgba(reference), rgba(frame)).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// An RGBA image in memory.
@@ -260,16 +256,15 @@ pub fn distance_error_image(reference: &Frame, frame: &Frame) -> Image {
     img
 }
 
-/// The FLIP error map through nv-flip's magma LUT.
+/// The FLIP error map through nv-flip's magma LUT ([`regression::flip_error_rgba`]).
+///
+/// # Panics
+/// If the frames differ in size.
 pub fn flip_error_image(reference: &Frame, frame: &Frame) -> Image {
-    let map = flip_image(reference, frame);
-    let rgb = map.apply_color_lut(&nv_flip::magma_lut()).to_vec();
     Image {
         size: reference.size,
-        rgba: rgb
-            .chunks_exact(3)
-            .flat_map(|c| [c[0], c[1], c[2], 255])
-            .collect(),
+        rgba: regression::flip_error_rgba(rgba(reference), rgba(frame))
+            .unwrap_or_else(|e| panic!("{e}")),
     }
 }
 

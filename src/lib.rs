@@ -23,4 +23,5 @@ pub use style::{Color, Style};
 pub mod cli;
 pub mod compare;
 pub mod raycast;
+pub mod regression;
 pub mod render;

@@ -29,6 +29,8 @@ enum Command {
     /// Time every method (and the floor: visibility + id-only compute) with GPU timestamps
     /// on each scene and size; write bench.json, bench.csv and plots.
     Bench(BenchArgs),
+    /// Compare two images with FLIP: print mean, p99 and max; exit non-zero over the threshold.
+    Diff(DiffArgs),
 }
 
 fn parse_edges(s: &str) -> std::result::Result<EdgeSelection, String> {
@@ -224,12 +226,61 @@ fn bench_command(args: &BenchArgs) -> Result<()> {
     Ok(())
 }
 
+#[derive(clap::Args)]
+struct DiffArgs {
+    /// Reference image (PNG).
+    a: PathBuf,
+    /// Image to test against it (PNG).
+    b: PathBuf,
+    /// Largest accepted mean FLIP error (0..1).
+    #[arg(long, default_value_t = 0.001)]
+    threshold_mean: f32,
+    /// Largest accepted 99th-percentile FLIP error (0..1).
+    #[arg(long, default_value_t = 0.05)]
+    threshold_p99: f32,
+    /// Write the FLIP heat map (magma: black = same) to this PNG.
+    #[arg(long)]
+    out: Option<PathBuf>,
+}
+
+fn diff_command(args: &DiffArgs) -> Result<()> {
+    use wirepass::regression::{difference, heat_map, load_rgba, Rgba, Threshold};
+    let (a, a_size) = load_rgba(&args.a)?;
+    let (b, b_size) = load_rgba(&args.b)?;
+    let (a, b) = (Rgba::new(&a, a_size)?, Rgba::new(&b, b_size)?);
+    let diff = difference(a, b).map_err(|e| {
+        wirepass::Error::InvalidSetting(format!(
+            "{} and {}: {e}",
+            args.a.display(),
+            args.b.display()
+        ))
+    })?;
+    println!(
+        "mean {:.6} p99 {:.6} max {:.6}",
+        diff.mean, diff.p99, diff.max
+    );
+    if let Some(out) = &args.out {
+        heat_map(a, b, out)?;
+        eprintln!("wrote {}", out.display());
+    }
+    let threshold = Threshold {
+        mean: args.threshold_mean,
+        p99: args.threshold_p99,
+    };
+    if let Some(why) = diff.exceeds(&threshold) {
+        eprintln!("wirepass: images differ beyond the threshold: {why}");
+        std::process::exit(1);
+    }
+    Ok(())
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Render(args) => render_command(args),
         Command::Compare(args) => compare_command(args),
         Command::Bench(args) => bench_command(args),
+        Command::Diff(args) => diff_command(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,0 +1,211 @@
+//! Image regression: every case renders a shared mesh with one method, edge mode and camera
+//! at 256×256 and compares it with FLIP against a blessed PNG under `tests/reference/`.
+//! One test runs every case and reports all failing cases at once; each failure writes
+//! `<case>.actual.png` and `<case>.diff.png` under `target/regression/`.
+//!
+//! Re-bless (after checking the new images by eye):
+//! `WIREPASS_BLESS=1 cargo test --release --test regression`. References are blessed on
+//! lavapipe.
+
+mod common;
+
+use common::{gpu, load};
+use glam::Vec3;
+use std::path::PathBuf;
+use wirepass::regression::{check_against_reference, Outcome, Threshold};
+use wirepass::render::{render, Method, Scene};
+use wirepass::{Camera, EdgeSelection, Mesh, Style};
+
+const SIZE: (u32, u32) = (256, 256);
+
+/// The meshes, each with the edge modes worth a reference: `all` only where the file has
+/// polygons (Suzanne's quads); on the triangle-only bunny and fandisk it equals `polygon`.
+const MESHES: &[(&str, &[&str])] = &[
+    ("suzanne", &["polygon", "all", "feature:30"]),
+    ("fandisk", &["polygon", "feature:30"]),
+    ("stanford-bunny", &["polygon", "feature:30"]),
+];
+
+/// The GPU methods (the CPU ray cast is the accuracy tests' judge, not a regression case).
+const METHODS: &[Method] = &[Method::Deferred, Method::Forward, Method::TwoPass];
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum View {
+    /// `Camera::framing`: the whole mesh in view.
+    Framing,
+    /// Eye at the centre of the bounds looking outward, near plane 1e-3 of the mesh size:
+    /// the near plane cuts triangles, some vertices are behind the eye.
+    Inside,
+}
+
+impl View {
+    fn name(self) -> &'static str {
+        match self {
+            View::Framing => "framing",
+            View::Inside => "inside",
+        }
+    }
+
+    fn camera(self, mesh: &Mesh) -> Camera {
+        let (lo, hi) = mesh.bounds();
+        match self {
+            View::Framing => Camera::framing(lo, hi, SIZE.0 as f32 / SIZE.1 as f32),
+            View::Inside => {
+                let centre = (lo + hi) * 0.5;
+                let extent = (hi - lo).length();
+                Camera {
+                    eye: centre,
+                    target: centre + Vec3::new(-0.3, 0.4, 0.2) * extent,
+                    up: Vec3::Y,
+                    fov_y_deg: 70.0,
+                    near: 1e-3 * extent,
+                    far: 4.0 * extent,
+                }
+            }
+        }
+    }
+}
+
+/// Measured FLIP difference against the references, per case: `[mean, p99]` on lavapipe
+/// (Mesa 22.3.6, Vulkan; the adapter the references are blessed on, hence exactly 0) and on
+/// llvmpipe through wgpu's GL backend (`WGPU_BACKEND=gl`), rounded up to 1e-5. Both adapters
+/// render the same bytes on every run. Largest llvmpipe values: deferred mean 0.00003 / p99
+/// 0.00059, forward 0.0305 / 0.633 (fandisk, eye inside: the baseline divides by w, and
+/// where it breaks the adapters break differently), two-pass 0.078 / 0.50 (1 px hardware
+/// lines rasterise differently).
+#[rustfmt::skip]
+const MEASURED: &[(&str, [f32; 2], [f32; 2])] = &[
+    // (case, lavapipe [mean, p99], llvmpipe-GL [mean, p99])
+    ("fandisk_deferred_feature30_framing", [0.0, 0.0], [0.00000, 0.00000]),
+    ("fandisk_deferred_feature30_inside", [0.0, 0.0], [0.00001, 0.00000]),
+    ("fandisk_deferred_polygon_framing", [0.0, 0.0], [0.00002, 0.00026]),
+    ("fandisk_deferred_polygon_inside", [0.0, 0.0], [0.00002, 0.00041]),
+    ("fandisk_forward_feature30_framing", [0.0, 0.0], [0.00001, 0.00003]),
+    ("fandisk_forward_feature30_inside", [0.0, 0.0], [0.03050, 0.63325]),
+    ("fandisk_forward_polygon_framing", [0.0, 0.0], [0.00009, 0.00175]),
+    ("fandisk_forward_polygon_inside", [0.0, 0.0], [0.02985, 0.61738]),
+    ("fandisk_two-pass_feature30_framing", [0.0, 0.0], [0.00218, 0.06256]),
+    ("fandisk_two-pass_feature30_inside", [0.0, 0.0], [0.00090, 0.01562]),
+    ("fandisk_two-pass_polygon_framing", [0.0, 0.0], [0.04954, 0.42377]),
+    ("fandisk_two-pass_polygon_inside", [0.0, 0.0], [0.02902, 0.27023]),
+    ("stanford-bunny_deferred_feature30_framing", [0.0, 0.0], [0.00000, 0.00000]),
+    ("stanford-bunny_deferred_feature30_inside", [0.0, 0.0], [0.00001, 0.00000]),
+    ("stanford-bunny_deferred_polygon_framing", [0.0, 0.0], [0.00001, 0.00000]),
+    ("stanford-bunny_deferred_polygon_inside", [0.0, 0.0], [0.00003, 0.00049]),
+    ("stanford-bunny_forward_feature30_framing", [0.0, 0.0], [0.00001, 0.00019]),
+    ("stanford-bunny_forward_feature30_inside", [0.0, 0.0], [0.00002, 0.00032]),
+    ("stanford-bunny_forward_polygon_framing", [0.0, 0.0], [0.00003, 0.00047]),
+    ("stanford-bunny_forward_polygon_inside", [0.0, 0.0], [0.00021, 0.00350]),
+    ("stanford-bunny_two-pass_feature30_framing", [0.0, 0.0], [0.00434, 0.13679]),
+    ("stanford-bunny_two-pass_feature30_inside", [0.0, 0.0], [0.00041, 0.00350]),
+    ("stanford-bunny_two-pass_polygon_framing", [0.0, 0.0], [0.02181, 0.49665]),
+    ("stanford-bunny_two-pass_polygon_inside", [0.0, 0.0], [0.07779, 0.41234]),
+    ("suzanne_deferred_all_framing", [0.0, 0.0], [0.00001, 0.00005]),
+    ("suzanne_deferred_all_inside", [0.0, 0.0], [0.00003, 0.00059]),
+    ("suzanne_deferred_feature30_framing", [0.0, 0.0], [0.00001, 0.00000]),
+    ("suzanne_deferred_feature30_inside", [0.0, 0.0], [0.00002, 0.00018]),
+    ("suzanne_deferred_polygon_framing", [0.0, 0.0], [0.00001, 0.00000]),
+    ("suzanne_deferred_polygon_inside", [0.0, 0.0], [0.00002, 0.00037]),
+    ("suzanne_forward_all_framing", [0.0, 0.0], [0.00005, 0.00096]),
+    ("suzanne_forward_all_inside", [0.0, 0.0], [0.00008, 0.00160]),
+    ("suzanne_forward_feature30_framing", [0.0, 0.0], [0.00002, 0.00046]),
+    ("suzanne_forward_feature30_inside", [0.0, 0.0], [0.00005, 0.00105]),
+    ("suzanne_forward_polygon_framing", [0.0, 0.0], [0.00003, 0.00053]),
+    ("suzanne_forward_polygon_inside", [0.0, 0.0], [0.00005, 0.00099]),
+    ("suzanne_two-pass_all_framing", [0.0, 0.0], [0.01722, 0.27990]),
+    ("suzanne_two-pass_all_inside", [0.0, 0.0], [0.01853, 0.24999]),
+    ("suzanne_two-pass_feature30_framing", [0.0, 0.0], [0.00955, 0.22468]),
+    ("suzanne_two-pass_feature30_inside", [0.0, 0.0], [0.01084, 0.20464]),
+    ("suzanne_two-pass_polygon_framing", [0.0, 0.0], [0.01270, 0.24772]),
+    ("suzanne_two-pass_polygon_inside", [0.0, 0.0], [0.01397, 0.22556]),
+];
+
+/// Margin over the larger of the two adapters' measurements: ×1.5 plus a floor that keeps a
+/// case measured at 0 from failing on the next driver's rounding.
+const MARGIN: f32 = 1.5;
+const FLOOR_MEAN: f32 = 0.0005;
+const FLOOR_P99: f32 = 0.005;
+
+/// The threshold for `case`: `MARGIN × max(lavapipe, llvmpipe-GL) + floor`, for the mean and
+/// the p99 alike; `None` for a case nobody measured.
+fn threshold(case: &str) -> Option<Threshold> {
+    let &(_, lavapipe, llvmpipe) = MEASURED.iter().find(|(name, ..)| *name == case)?;
+    let worst = |i: usize| lavapipe[i].max(llvmpipe[i]) * MARGIN;
+    Some(Threshold {
+        mean: worst(0) + FLOOR_MEAN,
+        p99: worst(1) + FLOOR_P99,
+    })
+}
+
+fn reference_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/reference")
+}
+
+fn out_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/regression")
+}
+
+#[test]
+fn every_case_matches_its_reference() {
+    let ctx = gpu();
+    let adapter = ctx.describe();
+    let mut failures = Vec::new();
+    let mut cases = 0;
+    for &(mesh_name, modes) in MESHES {
+        let mesh = load(&format!("{mesh_name}.obj"));
+        for &mode in modes {
+            let edges: EdgeSelection = mode.parse().unwrap_or_else(|e| panic!("{e}"));
+            for view in [View::Framing, View::Inside] {
+                let scene = Scene {
+                    mesh: &mesh,
+                    camera: view.camera(&mesh),
+                    style: Style::default(),
+                    size: SIZE,
+                    edges,
+                };
+                for &method in METHODS {
+                    cases += 1;
+                    let case = format!(
+                        "{mesh_name}_{}_{}_{}",
+                        method.name(),
+                        mode.replace(':', ""),
+                        view.name()
+                    );
+                    let frame = match render(ctx, &scene, method) {
+                        Ok(frame) => frame,
+                        Err(e) => {
+                            failures.push(format!("{case}: render failed: {e}"));
+                            continue;
+                        }
+                    };
+                    let reference = reference_dir().join(format!("{case}.png"));
+                    let Some(t) = threshold(&case) else {
+                        failures.push(format!(
+                            "{case}: no threshold in MEASURED; measure it on both adapters"
+                        ));
+                        continue;
+                    };
+                    match check_against_reference(
+                        &frame.rgba,
+                        frame.size,
+                        &reference,
+                        &t,
+                        &out_dir(),
+                    ) {
+                        Ok(Outcome::Pass(d)) => {
+                            eprintln!("measured {case} {} {} {}", d.mean, d.p99, d.max)
+                        }
+                        Ok(Outcome::Blessed(path)) => eprintln!("blessed {}", path.display()),
+                        Err(e) => failures.push(format!("{case}: {e}")),
+                    }
+                }
+            }
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "{} of {cases} image regression cases failed on {adapter}:\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
+}
