@@ -1,0 +1,273 @@
+//! Impossible settings and device limits are `wirepass::Error` values, never aborts:
+//! cameras and styles that cannot make an image, image sizes of zero or over
+//! `max_texture_dimension_2d`, and meshes over `max_storage_buffer_binding_size` (tested on a
+//! device requested with a deliberately small limit).
+
+mod common;
+
+use common::gpu;
+use glam::Vec3;
+use wirepass::gpu::{DeferredPass, GpuMesh, PassOptions};
+use wirepass::mesh::Procedural;
+use wirepass::{Camera, Color, EdgeSelection, Error, Style};
+
+fn cam() -> Camera {
+    Camera {
+        eye: Vec3::new(0.0, 0.0, 3.0),
+        target: Vec3::ZERO,
+        up: Vec3::Y,
+        fov_y_deg: 45.0,
+        near: 0.1,
+        far: 10.0,
+    }
+}
+
+#[test]
+fn cameras_with_non_finite_or_negative_values_are_rejected() {
+    // src/camera.rs tests the geometric cases (eye on target, up parallel or zero, fov 0 and
+    // 180, near 0, far < near, NaN eye); these are the non-finite and negative ones.
+    let cases = [
+        Camera {
+            target: Vec3::new(0.0, f32::INFINITY, 0.0),
+            ..cam()
+        },
+        Camera {
+            up: Vec3::new(f32::NAN, 1.0, 0.0),
+            ..cam()
+        },
+        Camera {
+            fov_y_deg: f32::NAN,
+            ..cam()
+        },
+        Camera {
+            fov_y_deg: -30.0,
+            ..cam()
+        },
+        Camera {
+            fov_y_deg: 270.0,
+            ..cam()
+        },
+        Camera {
+            near: -0.1,
+            ..cam()
+        },
+        Camera {
+            near: f32::NAN,
+            ..cam()
+        },
+        Camera {
+            near: f32::INFINITY,
+            far: f32::INFINITY,
+            ..cam()
+        },
+        Camera {
+            far: f32::INFINITY,
+            ..cam()
+        },
+        Camera {
+            far: f32::NAN,
+            ..cam()
+        },
+        Camera { far: 0.1, ..cam() },
+        Camera {
+            // Eye and target a rounding error apart, far from the origin.
+            eye: Vec3::splat(1e30),
+            target: Vec3::splat(1e30),
+            ..cam()
+        },
+    ];
+    for c in cases {
+        let e = c.validate().expect_err(&format!("{c:?} was accepted"));
+        assert!(matches!(e, Error::InvalidCamera(_)), "{e:?}");
+        assert!(e.to_string().starts_with("invalid camera: "), "{e}");
+    }
+}
+
+#[test]
+fn styles_that_cannot_make_an_image_are_rejected() {
+    let nan = Color([f32::NAN, 0.0, 0.0, 1.0]);
+    let cases: Vec<(Style, &str)> = vec![
+        (
+            Style {
+                line_width: f32::INFINITY,
+                ..Style::default()
+            },
+            "line width",
+        ),
+        (
+            Style {
+                line_width: -0.5,
+                ..Style::default()
+            },
+            "line width",
+        ),
+        (
+            Style {
+                ambient: 1.5,
+                ..Style::default()
+            },
+            "ambient",
+        ),
+        (
+            Style {
+                ambient: -0.1,
+                ..Style::default()
+            },
+            "ambient",
+        ),
+        (
+            Style {
+                ambient: f32::NAN,
+                ..Style::default()
+            },
+            "ambient",
+        ),
+        (
+            Style {
+                light_view_dir: Vec3::ZERO,
+                ..Style::default()
+            },
+            "light direction",
+        ),
+        (
+            Style {
+                light_view_dir: Vec3::new(f32::NAN, 1.0, 0.0),
+                ..Style::default()
+            },
+            "light direction",
+        ),
+        (
+            Style {
+                wire_color: nan,
+                ..Style::default()
+            },
+            "colour",
+        ),
+        (
+            Style {
+                fill_color: Color([0.0, f32::INFINITY, 0.0, 1.0]),
+                ..Style::default()
+            },
+            "colour",
+        ),
+        (
+            Style {
+                background: nan,
+                ..Style::default()
+            },
+            "colour",
+        ),
+    ];
+    assert!(Style::default().validate().is_ok());
+    // A zero-width line is allowed: it draws no line.
+    let thin = Style {
+        line_width: 0.0,
+        ..Style::default()
+    };
+    assert!(thin.validate().is_ok());
+    for (style, word) in cases {
+        let e = style
+            .validate()
+            .expect_err(&format!("{style:?} was accepted"));
+        assert!(matches!(e, Error::InvalidSetting(_)), "{e:?}");
+        assert!(e.to_string().contains(word), "'{e}' lacks '{word}'");
+    }
+}
+
+#[test]
+fn image_sizes_are_checked_against_the_device() {
+    let ctx = gpu();
+    let device = &ctx.device;
+    let mesh = Procedural::Sphere(200).build().unwrap();
+    let gpu_mesh = GpuMesh::new(device, &mesh, EdgeSelection::Polygon).unwrap();
+    let mut pass = DeferredPass::new(device, PassOptions::default()).unwrap();
+    let style = Style::default();
+    for size in [(0, 10), (10, 0), (0, 0)] {
+        let e = pass
+            .prepare(device, &ctx.queue, &gpu_mesh, &cam(), &style, size)
+            .unwrap_err();
+        assert!(matches!(e, Error::InvalidSetting(_)), "{size:?}: {e:?}");
+        assert!(e.to_string().contains("zero side"), "{e}");
+    }
+    let limit = device.limits().max_texture_dimension_2d;
+    for (size, excess) in [((limit + 1, 16), 1), ((16, limit + 100), 100)] {
+        let e = pass
+            .prepare(device, &ctx.queue, &gpu_mesh, &cam(), &style, size)
+            .unwrap_err();
+        match &e {
+            Error::OverLimit {
+                limit_name,
+                value,
+                limit: l,
+                ..
+            } => {
+                assert_eq!(*limit_name, "max_texture_dimension_2d");
+                assert_eq!(*l, u64::from(limit));
+                assert_eq!(value - l, excess);
+            }
+            e => panic!("{size:?}: {e:?}"),
+        }
+        let msg = e.to_string();
+        assert!(
+            msg.contains(&format!("max_texture_dimension_2d = {limit}"))
+                && msg.contains(&format!("(by {excess})")),
+            "{msg}"
+        );
+    }
+    // The limit itself is fine, and a failed prepare leaves the pass usable.
+    pass.prepare(device, &ctx.queue, &gpu_mesh, &cam(), &style, (limit, 1))
+        .unwrap();
+    pass.prepare(device, &ctx.queue, &gpu_mesh, &cam(), &style, (32, 24))
+        .unwrap();
+    ctx.finish().unwrap();
+}
+
+#[test]
+fn a_mesh_over_the_storage_binding_limit_is_an_error_not_an_abort() {
+    let ctx = gpu();
+    let small: u32 = 1 << 16;
+    let (device, _queue) =
+        pollster::block_on(ctx.adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("wirepass small limits"),
+            required_limits: wgpu::Limits {
+                max_storage_buffer_binding_size: small.into(),
+                ..ctx.adapter.limits()
+            },
+            ..Default::default()
+        }))
+        .expect("a device with lower limits than the adapter's");
+    assert_eq!(
+        device.limits().max_storage_buffer_binding_size,
+        u64::from(small)
+    );
+    let mesh: wirepass::Mesh = "sphere:20000"
+        .parse::<Procedural>()
+        .unwrap()
+        .build()
+        .unwrap();
+    let e = match GpuMesh::new(&device, &mesh, EdgeSelection::Polygon) {
+        Ok(_) => panic!("a {}-triangle mesh fit in 64 KiB", mesh.triangle_count()),
+        Err(e) => e,
+    };
+    match &e {
+        Error::OverLimit {
+            limit_name,
+            value,
+            limit,
+            ..
+        } => {
+            assert_eq!(*limit_name, "max_storage_buffer_binding_size");
+            assert_eq!(*limit, u64::from(small));
+            assert!(value > limit);
+        }
+        e => panic!("{e:?}"),
+    }
+    let msg = e.to_string();
+    assert!(
+        msg.contains("max_storage_buffer_binding_size = 65536") && msg.contains("(by "),
+        "{msg}"
+    );
+    // A mesh that fits still uploads on the same device.
+    let tiny = Procedural::Sphere(200).build().unwrap();
+    GpuMesh::new(&device, &tiny, EdgeSelection::Polygon).unwrap();
+}
