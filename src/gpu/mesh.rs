@@ -25,6 +25,30 @@ pub struct GpuMesh {
 impl GpuMesh {
     /// Uploads `mesh`, drawing the edges that `edges` selects.
     pub fn new(device: &wgpu::Device, mesh: &Mesh, edges: EdgeSelection) -> Result<Self> {
+        // Limits first, from the counts alone, before any large allocation.
+        let limits = device.limits();
+        let limit = limits
+            .max_storage_buffer_binding_size
+            .min(limits.max_buffer_size);
+        let (vertices, triangles) = (mesh.positions().len() as u64, mesh.triangle_count() as u64);
+        for (what, len) in [
+            ("vertex positions", vertices * 12),
+            ("vertex normals", vertices * 12),
+            ("triangle indices", triangles * 12),
+            ("edge neighbours", triangles * 12),
+        ] {
+            if len > limit {
+                return Err(Error::OverLimit {
+                    what: format!(
+                        "the size in bytes of the {what} buffer of a {triangles}-triangle mesh"
+                    ),
+                    value: len,
+                    limit_name: "max_storage_buffer_binding_size",
+                    limit,
+                });
+            }
+        }
+
         let (lo, hi) = mesh.bounds();
         let origin = (lo.as_dvec3() + hi.as_dvec3()) * 0.5;
         let positions: Vec<f32> = mesh
@@ -37,30 +61,6 @@ impl GpuMesh {
         let mut masks = mesh.edge_mask(edges);
         masks.resize(masks.len().div_ceil(4) * 4, 0);
         let neighbours: &[u32] = bytemuck::cast_slice(mesh.edge_neighbours());
-
-        let limits = device.limits();
-        for (what, len) in [
-            ("vertex positions", positions.len() * 4),
-            ("vertex normals", normals.len() * 4),
-            ("triangle indices", indices.len() * 4),
-            ("edge neighbours", neighbours.len() * 4),
-        ] {
-            let len = len as u64;
-            let limit = limits
-                .max_storage_buffer_binding_size
-                .min(limits.max_buffer_size);
-            if len > limit {
-                return Err(Error::OverLimit {
-                    what: format!(
-                        "the {what} buffer of a {}-triangle mesh, in bytes",
-                        mesh.triangle_count()
-                    ),
-                    value: len,
-                    limit_name: "max_storage_buffer_binding_size",
-                    limit,
-                });
-            }
-        }
         let storage = wgpu::BufferUsages::STORAGE;
         let create = |label, contents: &[u8], usage| {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -69,8 +69,8 @@ impl GpuMesh {
                 usage,
             })
         };
-        let bytes =
-            (positions.len() + normals.len() + indices.len()) as u64 * 4 + masks.len() as u64;
+        let bytes = (positions.len() + normals.len() + indices.len() + neighbours.len()) as u64 * 4
+            + masks.len() as u64;
         Ok(Self {
             positions: create(
                 "wirepass positions",
