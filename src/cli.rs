@@ -75,17 +75,26 @@ impl CameraArgs {
     /// With an explicit eye, near and far default to values that enclose the mesh.
     pub fn camera(&self, mesh: &Mesh, size: (u32, u32)) -> Result<Camera> {
         let (lo, hi) = mesh.bounds();
+        // Finite coordinates can still span more than f32 holds; framing such a mesh would
+        // overflow to an infinite eye, which the camera check reports in confusing terms.
+        if (hi.as_dvec3() - lo.as_dvec3()).length() > f64::from(f32::MAX) {
+            return Err(Error::InvalidMesh(format!(
+                "the mesh spans {lo} to {hi}, more than f32 coordinates can hold"
+            )));
+        }
         let framed = Camera::framing(lo, hi, size.0 as f32 / size.1 as f32);
         let mut cam = framed;
         if let Some(eye) = self.eye {
             cam.eye = eye;
             cam.target = self.target.unwrap_or(framed.target);
-            // Near and far that enclose the mesh seen from this eye.
-            let centre = (lo + hi) * 0.5;
-            let radius = (hi - lo).length() * 0.5;
-            let dist = (centre - eye).length();
-            cam.far = (dist + radius) * 1.5 + 1e-3;
-            cam.near = (dist - radius).max(cam.far * 1e-5).max(1e-6) * 0.5;
+            // Near and far that enclose the mesh seen from this eye, in f64: the squares in
+            // an f32 length overflow for a far eye such as 1e30,1e30,1e30.
+            let (lo64, hi64) = (lo.as_dvec3(), hi.as_dvec3());
+            let radius = (hi64 - lo64).length() * 0.5;
+            let dist = ((lo64 + hi64) * 0.5 - eye.as_dvec3()).length();
+            let far = (dist + radius) * 1.5 + 1e-3;
+            cam.far = far as f32;
+            cam.near = ((dist - radius).max(far * 1e-5).max(1e-6) * 0.5) as f32;
         } else if let Some(target) = self.target {
             cam.eye += target - cam.target;
             cam.target = target;

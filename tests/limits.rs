@@ -271,3 +271,44 @@ fn a_mesh_over_the_storage_binding_limit_is_an_error_not_an_abort() {
     let tiny = Procedural::Sphere(200).build().unwrap();
     GpuMesh::new(&device, &tiny, EdgeSelection::Polygon).unwrap();
 }
+
+#[test]
+fn a_mesh_too_wide_for_f32_is_reported_as_such() {
+    // Every coordinate is finite, but the extent overflows f32: framing it used to give an
+    // infinite eye and the message "invalid camera: eye [inf, inf, inf] is not finite".
+    let mesh = wirepass::Mesh::new(
+        vec![
+            Vec3::new(-3e38, 0.0, 0.0),
+            Vec3::new(3e38, 0.0, 0.0),
+            Vec3::new(0.0, 3e38, 0.0),
+        ],
+        None,
+        vec![[0, 1, 2]],
+        None,
+    )
+    .unwrap();
+    for args in [
+        wirepass::cli::CameraArgs::default(),
+        wirepass::cli::CameraArgs {
+            eye: Some(Vec3::new(0.0, 0.0, 1e3)),
+            ..Default::default()
+        },
+    ] {
+        let e = args.camera(&mesh, (64, 48)).unwrap_err();
+        assert!(matches!(e, Error::InvalidMesh(_)), "{e:?}");
+        assert!(e.to_string().contains("more than f32"), "{e}");
+    }
+}
+
+#[test]
+fn a_far_explicit_eye_gets_finite_planes() {
+    // The distance to the mesh used to be an f32 length whose squares overflowed, giving
+    // "invalid camera: near inf must be > 0" for --eye 1e30,1e30,1e30.
+    let mesh = Procedural::Sphere(200).build().unwrap();
+    let args = wirepass::cli::CameraArgs {
+        eye: Some(Vec3::splat(1e30)),
+        ..Default::default()
+    };
+    let cam = args.camera(&mesh, (64, 48)).unwrap();
+    assert!(cam.near.is_finite() && cam.far.is_finite() && cam.near < cam.far);
+}
