@@ -59,12 +59,27 @@ pub struct Metrics {
     pub image_difference: ImageDifference,
 }
 
-/// Compares `frame` against `reference` (the ground truth). Both must have the same size.
-///
-/// # Panics
-/// If the frames differ in size or their maps have the wrong length.
-pub fn metrics(reference: &Frame, frame: &Frame) -> Metrics {
-    let errors = distance_errors(reference, frame);
+/// Checks that two frames can be compared pixel for pixel.
+fn check_same_shape(reference: &Frame, frame: &Frame) -> Result<()> {
+    let n = reference.size.0 as usize * reference.size.1 as usize;
+    let whole = |f: &Frame| {
+        f.ids.len() == n
+            && f.edge_distance.len() == n
+            && f.depth.len() == n
+            && f.rgba.len() == 4 * n
+    };
+    if reference.size != frame.size || !whole(reference) || !whole(frame) {
+        return Err(Error::InvalidSetting(format!(
+            "cannot compare a {}x{} frame with a {}x{} one (or a frame's maps are incomplete)",
+            reference.size.0, reference.size.1, frame.size.0, frame.size.1
+        )));
+    }
+    Ok(())
+}
+
+/// Compares `frame` against `reference` (the ground truth); an error if their sizes differ.
+pub fn metrics(reference: &Frame, frame: &Frame) -> Result<Metrics> {
+    let errors = distance_errors(reference, frame)?;
     let mut measured: Vec<f64> = errors.iter().flatten().copied().collect();
     measured.sort_by(f64::total_cmp);
     let distance_error_px = DistanceError {
@@ -83,13 +98,13 @@ pub fn metrics(reference: &Frame, frame: &Frame) -> Metrics {
             same_id += usize::from(a == b);
         }
     }
-    let mut flip: Vec<f64> = flip_map(reference, frame)
+    let mut flip: Vec<f64> = flip_map(reference, frame)?
         .into_iter()
         .map(f64::from)
         .collect();
     let flip_mean = flip.iter().sum::<f64>() / flip.len().max(1) as f64;
     flip.sort_by(f64::total_cmp);
-    Metrics {
+    Ok(Metrics {
         id_agreement: if either == 0 {
             1.0
         } else {
@@ -101,7 +116,7 @@ pub fn metrics(reference: &Frame, frame: &Frame) -> Metrics {
             flip_mean,
             flip_p99: percentile(&flip, 0.99).unwrap_or(0.0),
         },
-    }
+    })
 }
 
 /// Nearest-rank percentile of sorted values.
@@ -115,16 +130,9 @@ fn percentile(sorted: &[f64], q: f64) -> Option<f64> {
 
 /// Per pixel, `|d − d_true|` where it is measured (ids agree, true distance finite and under
 /// [`DISTANCE_RANGE_PX`]), `None` elsewhere.
-pub fn distance_errors(reference: &Frame, frame: &Frame) -> Vec<Option<f64>> {
-    assert_eq!(reference.size, frame.size, "frames of different sizes");
-    let n = reference.ids.len();
-    assert!(
-        frame.ids.len() == n
-            && frame.edge_distance.len() == n
-            && reference.edge_distance.len() == n,
-        "maps of the wrong length"
-    );
-    (0..n)
+pub fn distance_errors(reference: &Frame, frame: &Frame) -> Result<Vec<Option<f64>>> {
+    check_same_shape(reference, frame)?;
+    Ok((0..reference.ids.len())
         .map(|i| {
             let id = reference.ids[i];
             let truth = f64::from(reference.edge_distance[i]);
@@ -141,7 +149,7 @@ pub fn distance_errors(reference: &Frame, frame: &Frame) -> Vec<Option<f64>> {
                 }
             })
         })
-        .collect()
+        .collect())
 }
 
 fn rgba(frame: &Frame) -> regression::Rgba<'_> {
@@ -154,10 +162,9 @@ fn rgba(frame: &Frame) -> regression::Rgba<'_> {
 /// The per-pixel FLIP error (0..1) of `frame` against `reference`
 /// ([`regression::flip_map`]).
 ///
-/// # Panics
-/// If the frames differ in size.
-pub fn flip_map(reference: &Frame, frame: &Frame) -> Vec<f32> {
-    regression::flip_map(rgba(reference), rgba(frame)).unwrap_or_else(|e| panic!("{e}"))
+/// An error if the frames differ in size.
+pub fn flip_map(reference: &Frame, frame: &Frame) -> Result<Vec<f32>> {
+    regression::flip_map(rgba(reference), rgba(frame))
 }
 
 /// An RGBA image in memory.
@@ -210,7 +217,7 @@ const BLACK: [u8; 4] = [0, 0, 0, 255];
 
 /// The edge-distance error as a heat map: magma on a log scale from 1e-6 px (dark) to 1 px
 /// and beyond (bright), grey where not measured, with a labelled scale below the image.
-pub fn distance_error_image(reference: &Frame, frame: &Frame) -> Image {
+pub fn distance_error_image(reference: &Frame, frame: &Frame) -> Result<Image> {
     let lut = magma();
     let (w, h) = reference.size;
     let (lo, hi) = HEAT_LOG10;
@@ -221,7 +228,7 @@ pub fn distance_error_image(reference: &Frame, frame: &Frame) -> Image {
     };
     let legend = 2 * font::LINE + 14;
     let mut img = Image::new((w, h + legend), WHITE);
-    for (i, e) in distance_errors(reference, frame).into_iter().enumerate() {
+    for (i, e) in distance_errors(reference, frame)?.into_iter().enumerate() {
         let c = e.map_or(GREY, colour);
         img.rgba[4 * i..4 * i + 4].copy_from_slice(&c);
     }
@@ -253,19 +260,17 @@ pub fn distance_error_image(reference: &Frame, frame: &Frame) -> Image {
         1,
         BLACK,
     );
-    img
+    Ok(img)
 }
 
 /// The FLIP error map through nv-flip's magma LUT ([`regression::flip_error_rgba`]).
 ///
-/// # Panics
-/// If the frames differ in size.
-pub fn flip_error_image(reference: &Frame, frame: &Frame) -> Image {
-    Image {
+/// An error if the frames differ in size.
+pub fn flip_error_image(reference: &Frame, frame: &Frame) -> Result<Image> {
+    Ok(Image {
         size: reference.size,
-        rgba: regression::flip_error_rgba(rgba(reference), rgba(frame))
-            .unwrap_or_else(|e| panic!("{e}")),
-    }
+        rgba: regression::flip_error_rgba(rgba(reference), rgba(frame))?,
+    })
 }
 
 fn frame_image(frame: &Frame) -> Image {
@@ -377,13 +382,13 @@ pub fn run(ctx: &GpuContext, scene: &Scene<'_>, out: &Path) -> Result<Report> {
                 let wall_ms = start.elapsed().as_secs_f64() * 1e3;
                 let key = name.replace('-', "_");
                 frame.save_png(&out.join(format!("{name}.png")))?;
-                let heat = distance_error_image(&reference, &frame);
+                let heat = distance_error_image(&reference, &frame)?;
                 heat.save_png(&out.join(format!("{key}_distance_error.png")))?;
-                let flip = flip_error_image(&reference, &frame);
+                let flip = flip_error_image(&reference, &frame)?;
                 flip.save_png(&out.join(format!("{key}_flip.png")))?;
                 panels.push((name.to_string(), Some([frame_image(&frame), heat, flip])));
                 MethodReport::Measured {
-                    metrics: metrics(&reference, &frame),
+                    metrics: metrics(&reference, &frame)?,
                     gpu_ms: gpu_ms.get(name).copied(),
                     wall_ms,
                     note: note.clone(),
@@ -535,6 +540,15 @@ mod tests {
     }
 
     #[test]
+    fn frames_of_different_sizes_are_an_error_not_a_panic() {
+        let a = frame(vec![0; 4], vec![1.0; 4]);
+        let b = frame(vec![0; 3], vec![1.0; 3]);
+        assert!(metrics(&a, &b).is_err());
+        assert!(flip_error_image(&a, &b).is_err());
+        assert!(distance_error_image(&a, &b).is_err());
+    }
+
+    #[test]
     fn metrics_count_the_right_pixels() {
         let inf = f32::INFINITY;
         let bg = BACKGROUND;
@@ -546,7 +560,7 @@ mod tests {
             vec![1, 1, 2, 9, bg, 4, bg, 3],
             vec![0.5, 3.25, 5.5, 1.0, inf, 0.0, inf, 2.0],
         );
-        let m = metrics(&reference, &test);
+        let m = metrics(&reference, &test).unwrap();
         // Either side foreground: 7 pixels; ids equal at 0, 1, 2, 7.
         assert!((m.id_agreement - 4.0 / 7.0).abs() < 1e-12);
         // Coverage differs at 5 and 6.

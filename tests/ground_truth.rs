@@ -157,7 +157,7 @@ fn measure(mesh: &Mesh, shot: Shot) -> Metrics {
     };
     let truth = render_raycast(&scene).unwrap_or_else(|e| panic!("{e}"));
     let frame = render(gpu(), &scene, Method::Deferred).unwrap_or_else(|e| panic!("{e}"));
-    metrics(&truth, &frame)
+    metrics(&truth, &frame).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// Measures every shot of `name`, prints the numbers, then checks the bounds (all shots are
