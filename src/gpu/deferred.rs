@@ -1,7 +1,7 @@
 //! The deferred wireframe pass: a visibility raster pass (triangle id + depth) followed by a
 //! compute pass that reconstructs each pixel's distance to its triangle's edges.
 
-use super::{check_size, shaders, texture_2d, FrameUniforms, GpuMesh, GpuTimer};
+use super::{shaders, texture_2d, FrameUniforms, GpuMesh, GpuTimer};
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::style::Style;
@@ -350,11 +350,8 @@ impl DeferredPass {
         style: &Style,
         size: (u32, u32),
     ) -> Result<()> {
-        check_size(device, size)?;
-        camera.validate()?;
-        style.validate()?;
-        let uniforms = FrameUniforms::new(camera, style, size, mesh.origin());
-        queue.write_buffer(&self.frame, 0, bytemuck::bytes_of(&uniforms));
+        let view = (camera, style, size);
+        FrameUniforms::validate_and_write(device, queue, &self.frame, mesh, view)?;
         if self.targets.as_ref().map(|t| t.size) != Some(size) {
             let make = |label, format, usage| texture_2d(device, label, size, format, usage);
             use wgpu::TextureUsages as U;

@@ -4,7 +4,7 @@
 //! `3 × triangles` vertices pulls each triangle's three vertices from storage buffers instead.
 
 use super::deferred::{DEPTH_FORMAT, ID_FORMAT};
-use super::{check_size, shaders, texture_2d, FrameUniforms, GpuMesh, GpuTimer, PassOptions};
+use super::{shaders, texture_2d, FrameUniforms, GpuMesh, GpuTimer, PassOptions};
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::style::{linear_to_srgb, Style};
@@ -460,11 +460,8 @@ impl ForwardPass {
         style: &Style,
         size: (u32, u32),
     ) -> Result<()> {
-        check_size(device, size)?;
-        camera.validate()?;
-        style.validate()?;
-        let uniforms = FrameUniforms::new(camera, style, size, mesh.origin());
-        queue.write_buffer(&self.uniforms.frame, 0, bytemuck::bytes_of(&uniforms));
+        let view = (camera, style, size);
+        FrameUniforms::validate_and_write(device, queue, &self.uniforms.frame, mesh, view)?;
         self.background = style.background.0;
         Targets::ensure(&mut self.targets, device, size);
         Ok(())

@@ -21,6 +21,23 @@ pub struct FrameUniforms {
 }
 
 impl FrameUniforms {
+    /// Checks the size against `device`, the camera and the style, then writes the frame's
+    /// uniforms for `mesh` into `buffer`: the shared first step of every pass's `prepare`.
+    pub(crate) fn validate_and_write(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        buffer: &wgpu::Buffer,
+        mesh: &super::GpuMesh,
+        (camera, style, size): (&Camera, &Style, (u32, u32)),
+    ) -> crate::Result<()> {
+        super::check_size(device, size)?;
+        camera.validate()?;
+        style.validate()?;
+        let uniforms = Self::new(camera, style, size, mesh.origin());
+        queue.write_buffer(buffer, 0, bytemuck::bytes_of(&uniforms));
+        Ok(())
+    }
+
     /// Uniforms for one frame. `origin` is the mesh-local origin its positions were rebased to
     /// (see [`crate::gpu::GpuMesh`]): the translation is folded into the matrix in f64, so
     /// meshes far from the world origin keep their precision.

@@ -13,7 +13,7 @@ use super::forward::{
     check_vertex_storage, clear_color, color_targets, depth_state, encode_snippet, mesh_group,
     mesh_layout, Targets, Uniforms,
 };
-use super::{check_size, shaders, FrameUniforms, GpuMesh, GpuTimer, PassOptions};
+use super::{shaders, FrameUniforms, GpuMesh, GpuTimer, PassOptions};
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::mesh::{EdgeSelection, Mesh};
@@ -307,11 +307,8 @@ impl TwoPass {
         style: &Style,
         size: (u32, u32),
     ) -> Result<()> {
-        check_size(device, size)?;
-        camera.validate()?;
-        style.validate()?;
-        let uniforms = FrameUniforms::new(camera, style, size, mesh.origin());
-        queue.write_buffer(&self.uniforms.frame, 0, bytemuck::bytes_of(&uniforms));
+        let view = (camera, style, size);
+        FrameUniforms::validate_and_write(device, queue, &self.uniforms.frame, mesh, view)?;
         self.background = style.background.0;
         self.draw_lines = style.line_width > 0.0;
         Targets::ensure(&mut self.targets, device, size);
