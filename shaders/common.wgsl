@@ -116,6 +116,21 @@ fn shade(base: vec3<f32>, normal: vec3<f32>, to_eye: vec3<f32>, light_dir: vec3<
     return base * (ambient + (1.0 - ambient) * diffuse);
 }
 
+// The shaded colour of the surface point `world` of a triangle: the interpolated normal,
+// falling back to the face normal where it vanishes, then to the view direction. Every method
+// shades through this; the ground truth (src/raycast.rs) follows the same steps in f64.
+fn surface_color(f: Frame, world: vec3<f32>, normal: vec3<f32>, face_normal: vec3<f32>) -> vec3<f32> {
+    let to_eye = f.eye.xyz - world;
+    var n = normal;
+    if !(dot(n, n) > 1e-12) {
+        n = face_normal;
+    }
+    if !(dot(n, n) > 0.0) {
+        n = to_eye;
+    }
+    return shade(f.fill_color.rgb, normalize(n), to_eye, f.light_dir.xyz, f.ambient);
+}
+
 fn linear_to_srgb(c: vec3<f32>) -> vec3<f32> {
     let x = clamp(c, vec3<f32>(0.0), vec3<f32>(1.0));
     return select(1.055 * pow(x, vec3<f32>(1.0 / 2.4)) - 0.055, 12.92 * x, x <= vec3<f32>(0.0031308));

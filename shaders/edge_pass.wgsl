@@ -209,15 +209,8 @@ fn evaluate(xy: vec2<u32>) -> Pixel {
     let b = s.bary;
     let world = b.x * w0 + b.y * w1 + b.z * w2;
     out.depth = dot(frame.depth_row, vec4<f32>(world, 1.0)) / s.w;
-    let to_eye = frame.eye.xyz - world;
-    var n = b.x * normal(v.x) + b.y * normal(v.y) + b.z * normal(v.z);
-    if !(dot(n, n) > 1e-12) {
-        n = cross(w1 - w0, w2 - w0);
-    }
-    if !(dot(n, n) > 0.0) {
-        n = to_eye;
-    }
-    out.surface = shade(frame.fill_color.rgb, normalize(n), to_eye, frame.light_dir.xyz, frame.ambient);
+    let n = b.x * normal(v.x) + b.y * normal(v.y) + b.z * normal(v.z);
+    out.surface = surface_color(frame, world, n, cross(w1 - w0, w2 - w0));
     return out;
 }
 

@@ -49,19 +49,6 @@ fn triangle_mask(t: u32) -> u32 {
     return (edge_masks[t >> 2u] >> ((t & 3u) * 8u)) & 7u;
 }
 
-// The shaded surface colour, as the deferred pass computes it (edge_pass.wgsl `evaluate`):
-// interpolated normal, falling back to the face normal, then to the view direction.
-fn surface_color(world: vec3<f32>, normal_in: vec3<f32>, face_normal: vec3<f32>) -> vec3<f32> {
-    let to_eye = frame.eye.xyz - world;
-    var n = normal_in;
-    if !(dot(n, n) > 1e-12) {
-        n = face_normal;
-    }
-    if !(dot(n, n) > 0.0) {
-        n = to_eye;
-    }
-    return shade(frame.fill_color.rgb, normalize(n), to_eye, frame.light_dir.xyz, frame.ambient);
-}
 
 struct Varyings {
     @builtin(position) clip: vec4<f32>,
@@ -141,7 +128,7 @@ fn nearest(in: Varyings) -> f32 {
 }
 
 fn shaded(in: Varyings, d: f32) -> vec4<f32> {
-    let surface = surface_color(in.world, in.normal, in.face_normal);
+    let surface = surface_color(frame, in.world, in.normal, in.face_normal);
     let i = line_intensity(d, frame.line_width);
     return vec4<f32>(mix(surface, frame.wire_color.rgb, i * frame.wire_color.a), 1.0);
 }

@@ -37,7 +37,7 @@ fn vs_fill(@builtin(vertex_index) k: u32) -> FillVaryings {
 }
 
 fn fill_color(in: FillVaryings) -> vec4<f32> {
-    return vec4<f32>(surface_color(in.world, in.normal, in.face_normal), 1.0);
+    return vec4<f32>(surface_color(frame, in.world, in.normal, in.face_normal), 1.0);
 }
 
 @fragment
