@@ -312,3 +312,16 @@ fn a_far_explicit_eye_gets_finite_planes() {
     let cam = args.camera(&mesh, (64, 48)).unwrap();
     assert!(cam.near.is_finite() && cam.far.is_finite() && cam.near < cam.far);
 }
+
+#[test]
+fn device_loss_is_reported_as_an_error() {
+    let ctx = wirepass::gpu::GpuContext::new().unwrap_or_else(|e| panic!("{e}"));
+    ctx.finish().expect("a fresh device has nothing to report");
+    ctx.device.destroy();
+    match ctx.finish() {
+        Err(wirepass::Error::Device(message)) => {
+            assert!(message.contains("device lost"), "{message}")
+        }
+        other => panic!("expected a device-lost error, got {other:?}"),
+    }
+}
