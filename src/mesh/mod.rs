@@ -6,7 +6,7 @@ mod obj;
 mod procedural;
 
 pub use obj::load_obj;
-pub use procedural::{default_scene, grid, sphere, torus, Procedural};
+pub use procedural::{default_scene, grid, layers, sphere, torus, Procedural, LAYER_TRIANGLES};
 
 use crate::error::{Error, Result};
 use glam::Vec3;

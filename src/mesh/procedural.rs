@@ -26,7 +26,12 @@ pub enum Procedural {
     Grid(usize),
     /// [`torus`] with about this many triangles.
     Torus(usize),
+    /// [`layers`]: this many parallel grids one behind the other (depth complexity).
+    Layers(usize),
 }
+
+/// Triangles in each grid of [`layers`] (8 × 8 quads).
+pub const LAYER_TRIANGLES: usize = 128;
 
 impl Procedural {
     /// Builds the mesh.
@@ -35,6 +40,7 @@ impl Procedural {
             Procedural::Sphere(n) => sphere(n),
             Procedural::Grid(n) => grid(n),
             Procedural::Torus(n) => torus(n),
+            Procedural::Layers(k) => layers(k),
         }
     }
 
@@ -42,6 +48,17 @@ impl Procedural {
     pub fn triangle_target(&self) -> usize {
         match *self {
             Procedural::Sphere(n) | Procedural::Grid(n) | Procedural::Torus(n) => n,
+            Procedural::Layers(k) => k.saturating_mul(LAYER_TRIANGLES),
+        }
+    }
+
+    /// The number after the colon: a triangle count, or for `layers` the layer count.
+    fn parameter(&self) -> usize {
+        match *self {
+            Procedural::Sphere(n)
+            | Procedural::Grid(n)
+            | Procedural::Torus(n)
+            | Procedural::Layers(n) => n,
         }
     }
 
@@ -50,6 +67,7 @@ impl Procedural {
             Procedural::Sphere(_) => "sphere",
             Procedural::Grid(_) => "grid",
             Procedural::Torus(_) => "torus",
+            Procedural::Layers(_) => "layers",
         }
     }
 
@@ -59,6 +77,7 @@ impl Procedural {
             Procedural::Sphere(_) => 8,
             Procedural::Grid(_) => 2,
             Procedural::Torus(_) => 18,
+            Procedural::Layers(_) => LAYER_TRIANGLES,
         }
     }
 
@@ -76,20 +95,21 @@ impl Procedural {
 
 impl fmt::Display for Procedural {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}:{}", self.name(), self.triangle_target())
+        write!(f, "{}:{}", self.name(), self.parameter())
     }
 }
 
 impl FromStr for Procedural {
     type Err = Error;
 
-    /// Parses `sphere:N`, `grid:N` or `torus:N`; `N` may use `_` separators and a `k`
-    /// (thousand) or `M` (million) suffix, as in `sphere:20M` or `grid:1_000`.
+    /// Parses `sphere:N`, `grid:N`, `torus:N` (N triangles) or `layers:K` (K layers); the
+    /// number may use `_` separators and a `k` (thousand) or `M` (million) suffix, as in
+    /// `sphere:20M` or `grid:1_000`.
     fn from_str(s: &str) -> Result<Self> {
         let bad = || {
             Error::InvalidSetting(format!(
                 "'{s}' is not a procedural mesh; expected sphere:N, grid:N or torus:N with N \
-                 a triangle count such as 5000, 20_000, 50k or 20M"
+                 a triangle count such as 5000, 20_000, 50k or 20M, or layers:K"
             ))
         };
         let (shape, count) = s.trim().split_once(':').ok_or_else(bad)?;
@@ -98,6 +118,7 @@ impl FromStr for Procedural {
             "sphere" => Procedural::Sphere(n),
             "grid" => Procedural::Grid(n),
             "torus" => Procedural::Torus(n),
+            "layers" => Procedural::Layers(n),
             _ => return Err(bad()),
         };
         p.check()?;
@@ -152,6 +173,34 @@ pub fn grid(n: usize) -> Result<Mesh> {
     for j in 0..k {
         for i in 0..k {
             parts.quad([v(i, j), v(i + 1, j), v(i + 1, j + 1), v(i, j + 1)]);
+        }
+    }
+    parts.into_mesh()
+}
+
+/// `k` square 8 × 8-quad grids over [-1, 1]² parallel to the XY plane, one behind the other
+/// between z = 0 and z = −1: every pixel that sees the stack has depth complexity up to `k`,
+/// for measuring how methods cope with overdraw.
+pub fn layers(k: usize) -> Result<Mesh> {
+    Procedural::Layers(k).check()?;
+    const CELLS: usize = 8;
+    let mut parts = Parts::with_capacity(k * (CELLS + 1) * (CELLS + 1), k * LAYER_TRIANGLES);
+    let step = 2.0 / CELLS as f64;
+    for layer in 0..k {
+        let z = -(layer as f64) / k as f64;
+        let base = (layer * (CELLS + 1) * (CELLS + 1)) as u32;
+        for j in 0..=CELLS {
+            for i in 0..=CELLS {
+                let x = i as f64 * step - 1.0;
+                let y = j as f64 * step - 1.0;
+                parts.vertex(Vec3::new(x as f32, y as f32, z as f32), Vec3::Z);
+            }
+        }
+        let v = |i: usize, j: usize| base + (j * (CELLS + 1) + i) as u32;
+        for j in 0..CELLS {
+            for i in 0..CELLS {
+                parts.quad([v(i, j), v(i + 1, j), v(i + 1, j + 1), v(i, j + 1)]);
+            }
         }
     }
     parts.into_mesh()
@@ -408,12 +457,30 @@ mod tests {
     }
 
     #[test]
+    fn layers_stack_grids_one_behind_the_other() {
+        let m = layers(4).unwrap();
+        assert_eq!(m.triangle_count(), 4 * LAYER_TRIANGLES);
+        assert_eq!(Procedural::Layers(4).triangle_target(), m.triangle_count());
+        let (lo, hi) = m.bounds();
+        assert_eq!((lo.z, hi.z), (-0.75, 0.0));
+        // Quads: each grid shows its 8 x 8 cells, no diagonals.
+        let drawn: u32 = m
+            .edge_mask(crate::mesh::EdgeSelection::Polygon)
+            .iter()
+            .map(|b| b.count_ones())
+            .sum();
+        // Two drawn edges per triangle: each quad's diagonal is masked.
+        assert_eq!(drawn as usize, 2 * 4 * LAYER_TRIANGLES);
+    }
+
+    #[test]
     fn parses_procedural_names() {
         let ok = [
             ("sphere:20M", Procedural::Sphere(20_000_000)),
             ("grid:1_000", Procedural::Grid(1000)),
             ("torus:50k", Procedural::Torus(50_000)),
             (" Sphere:1_5K ", Procedural::Sphere(15_000)),
+            ("layers:16", Procedural::Layers(16)),
         ];
         for (s, p) in ok {
             assert_eq!(s.parse::<Procedural>().unwrap(), p, "{s}");
@@ -435,6 +502,7 @@ mod tests {
             "sphere:99999999999999999999",
             "sphere:1000000M",
             "sphere:20m",
+            "layers:0",
         ] {
             let e = s.parse::<Procedural>().unwrap_err();
             assert!(matches!(e, Error::InvalidSetting(_)), "{s}: {e:?}");
