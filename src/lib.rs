@@ -7,21 +7,20 @@
 
 #![warn(missing_docs)]
 
-pub mod error;
-pub mod mesh;
-
-pub use error::{Error, Result};
-pub use mesh::{EdgeSelection, Mesh};
 pub mod bench;
 pub mod camera;
-pub mod edge_math;
-pub mod gpu;
-pub mod style;
-
-pub use camera::Camera;
-pub use style::{Color, Style};
 pub mod cli;
 pub mod compare;
+pub mod edge_math;
+pub mod error;
+pub mod gpu;
+pub mod mesh;
 pub mod raycast;
 pub mod regression;
 pub mod render;
+pub mod style;
+
+pub use camera::Camera;
+pub use error::{Error, Result};
+pub use mesh::{EdgeSelection, Mesh};
+pub use style::{Color, Style};
