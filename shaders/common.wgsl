@@ -21,6 +21,15 @@ struct Frame {
     line_width: f32,
     // Share of ambient light in the shading, 0..1.
     ambient: f32,
+    // Depth fade (start, end) in view depth; (0, 0) for none. See `depth_fade`.
+    fade: vec2<f32>,
+    // Triangles in the first binding of the per-triangle buffers (indices, neighbours), which
+    // meshes past max_storage_buffer_binding_size split over two (src/gpu/mesh.rs).
+    index_split: u32,
+    // 1: draw outlines at full width (outline.wgsl); 0: every edge inside its own triangles.
+    silhouettes: u32,
+    // Triangles in the mesh.
+    triangles: u32,
 }
 
 // Distance returned for an edge that is not drawn or not visible.
@@ -103,6 +112,33 @@ fn line_intensity(d: f32, width: f32) -> f32 {
         return 0.0;
     }
     return min(0.5 * width, 1.0) * exp2(-2.0 * t * t);
+}
+
+// How far from its centre a line of `width` pixels colours pixels.
+fn line_reach(width: f32) -> f32 {
+    return max(0.5 * width - 1.0, 0.0) + 2.0;
+}
+
+// A line's strength at view depth `w`: 1 up to fade.x, falling linearly to 0 at fade.y;
+// 1 everywhere when fade.y <= fade.x (no fade).
+fn depth_fade(w: f32, fade: vec2<f32>) -> f32 {
+    if !(fade.y > fade.x) {
+        return 1.0;
+    }
+    return clamp((fade.y - w) / (fade.y - fade.x), 0.0, 1.0);
+}
+
+// True when the edge a -> b, shared by a triangle with third corner c and a neighbour with a
+// point d off the edge, is a silhouette seen from `eye`: both triangles lie on the same side
+// of the plane through the eye and the edge, so on screen they fold onto one side of it and
+// the other side shows something else. Independent of winding. Each side is the triple
+// product of (a - eye) with a triangle's own edge vectors, which stay small and exact for a
+// far eye. An edge-on triangle (side 0) counts as folded.
+fn is_silhouette(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>, d: vec3<f32>, eye: vec3<f32>) -> bool {
+    let to_edge = a - eye;
+    let side_c = dot(to_edge, cross(b - a, c - a));
+    let side_d = dot(to_edge, cross(b - a, d - a));
+    return !(side_c * side_d < 0.0);
 }
 
 // Diffuse key light plus ambient; the normal is turned towards the viewer so back faces

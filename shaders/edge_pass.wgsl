@@ -15,7 +15,31 @@
 // BACKGROUND_ID for boundary and non-manifold edges.
 @group(0) @binding(6) var<storage, read> neighbours: array<u32>;
 
+// The second halves of `indices` and `neighbours`, for meshes split over two bindings.
+@group(0) @binding(7) var<storage, read> indices_hi: array<u32>;
+@group(0) @binding(8) var<storage, read> neighbours_hi: array<u32>;
+
 const BACKGROUND_ID: u32 = 0xffffffffu;
+
+// What the outline pass wrote (outline.wgsl), read when frame.silhouettes is 1.
+@group(2) @binding(0) var<storage, read> outline: array<u32>;
+
+// Vertex indices of triangle t.
+fn corners(t: u32) -> vec3<u32> {
+    if t < frame.index_split {
+        return vec3<u32>(indices[3u * t], indices[3u * t + 1u], indices[3u * t + 2u]);
+    }
+    let k = 3u * (t - frame.index_split);
+    return vec3<u32>(indices_hi[k], indices_hi[k + 1u], indices_hi[k + 2u]);
+}
+
+// The triangle across edge i of triangle t.
+fn neighbour(t: u32, i: u32) -> u32 {
+    if t < frame.index_split {
+        return neighbours[3u * t + i];
+    }
+    return neighbours_hi[3u * (t - frame.index_split) + i];
+}
 
 fn position(v: u32) -> vec3<f32> {
     return vec3<f32>(positions[3u * v], positions[3u * v + 1u], positions[3u * v + 2u]);
@@ -55,7 +79,7 @@ struct Sample {
 fn sample(id: u32, pixel: vec2<f32>) -> Sample {
     var s: Sample;
     s.id = id;
-    let v = vec3<u32>(indices[3u * id], indices[3u * id + 1u], indices[3u * id + 2u]);
+    let v = corners(id);
     s.clip0 = frame.view_proj * vec4<f32>(position(v.x), 1.0);
     s.clip1 = frame.view_proj * vec4<f32>(position(v.y), 1.0);
     s.clip2 = frame.view_proj * vec4<f32>(position(v.z), 1.0);
@@ -94,7 +118,7 @@ fn walk(start: Sample, pixel: vec2<f32>) -> Sample {
             return s; // covered, or inside but beyond the near or far plane, or degenerate
         }
         let edge = select(select(0u, 2u, b.y == lowest), 1u, b.x == lowest);
-        let next = neighbours[3u * s.id + edge];
+        let next = neighbour(s.id, edge);
         if next == BACKGROUND_ID {
             return s;
         }
@@ -179,20 +203,48 @@ fn refine(xy: vec2<u32>, pixel: vec2<f32>, own: Sample) -> Sample {
 struct Pixel {
     // The visible triangle, BACKGROUND_ID on background.
     id: u32,
-    // Distance in pixels to the nearest drawn edge of the visible triangle.
+    // Distance in pixels to the nearest line: a drawn edge of the visible triangle, or an
+    // outline within reach (see outline.wgsl).
     distance: f32,
+    // The line's intensity at this pixel (profile × depth fade), before the wire alpha.
+    line: f32,
     // Linear shaded surface colour.
     surface: vec3<f32>,
     // Reverse-Z depth of the visible point (0 on background).
     depth: f32,
 }
 
+// Distances are kept in 1/4096 px steps in the high 20 bits (complemented, so the atomic max
+// keeps the least), the line's depth fade in the low 12 bits. 0 means no outline.
+const OUTLINE_STEPS: f32 = 4096.0;
+const OUTLINE_MAX: u32 = 0xfffffu;
+
+fn pack_outline(d: f32, fade: f32) -> u32 {
+    let q = u32(clamp(d * OUTLINE_STEPS, 0.0, f32(OUTLINE_MAX)));
+    return ((OUTLINE_MAX - q) << 12u) | u32(round(clamp(fade, 0.0, 1.0) * 4095.0));
+}
+
+// What the outline pass left for this pixel: (distance, depth fade), or (NO_EDGE, 0).
+fn outline_at(xy: vec2<u32>) -> vec2<f32> {
+    if frame.silhouettes == 0u {
+        return vec2<f32>(NO_EDGE, 0.0);
+    }
+    let v = outline[xy.y * u32(frame.size.x) + xy.x];
+    if v == 0u {
+        return vec2<f32>(NO_EDGE, 0.0);
+    }
+    let steps = OUTLINE_MAX - (v >> 12u);
+    return vec2<f32>((f32(steps) + 0.5) / OUTLINE_STEPS, f32(v & 0xfffu) / 4095.0);
+}
+
 fn evaluate(xy: vec2<u32>) -> Pixel {
     var out: Pixel;
     let pixel = vec2<f32>(xy) + 0.5;
     let s = resolve(xy, pixel);
+    let outline = outline_at(xy);
     out.id = s.id;
-    out.distance = NO_EDGE;
+    out.distance = outline.x;
+    out.line = line_intensity(outline.x, frame.line_width) * outline.y;
     out.depth = 0.0;
     if s.id == BACKGROUND_ID {
         return out;
@@ -200,9 +252,12 @@ fn evaluate(xy: vec2<u32>) -> Pixel {
     let id = s.id;
     let mask = (edge_masks[id >> 2u] >> ((id & 3u) * 8u)) & 7u;
     let d = drawn_distances(s.lines, vec3<f32>(s.clip0.z, s.clip1.z, s.clip2.z), mask);
-    out.distance = min(d.x, min(d.y, d.z));
+    let own = min(d.x, min(d.y, d.z));
+    out.distance = min(own, out.distance);
+    // Nothing is drawn twice: the stronger of the own edge and the outline wins.
+    out.line = max(out.line, line_intensity(own, frame.line_width) * depth_fade(s.w, frame.fade));
 
-    let v = vec3<u32>(indices[3u * id], indices[3u * id + 1u], indices[3u * id + 2u]);
+    let v = corners(id);
     let w0 = position(v.x);
     let w1 = position(v.y);
     let w2 = position(v.z);
@@ -227,11 +282,12 @@ fn shade_main(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let p = evaluate(gid.xy);
-    var color = frame.background;
+    var base = frame.background;
     if p.id != BACKGROUND_ID {
-        let i = line_intensity(p.distance, frame.line_width);
-        color = vec4<f32>(mix(p.surface, frame.wire_color.rgb, i * frame.wire_color.a), 1.0);
+        base = vec4<f32>(p.surface, 1.0);
     }
+    let i = p.line * frame.wire_color.a;
+    let color = vec4<f32>(mix(base.rgb, frame.wire_color.rgb, i), max(base.a, i));
     textureStore(shaded_out, gid.xy, encode_output(color));
 }
 
@@ -245,11 +301,9 @@ fn overlay_main(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let p = evaluate(gid.xy);
-    var color = textureLoad(host_color, gid.xy, 0);
-    if p.id != BACKGROUND_ID {
-        let i = line_intensity(p.distance, frame.line_width) * frame.wire_color.a;
-        color = vec4<f32>(mix(color.rgb, frame.wire_color.rgb, i), max(color.a, i));
-    }
+    let host = textureLoad(host_color, gid.xy, 0);
+    let i = p.line * frame.wire_color.a;
+    let color = vec4<f32>(mix(host.rgb, frame.wire_color.rgb, i), max(host.a, i));
     textureStore(overlay_out, gid.xy, encode_output(color));
 }
 

@@ -31,6 +31,17 @@ struct Draw {
 @group(0) @binding(4) var<storage, read> indices: array<u32>;
 // Edge masks, 8 bits per triangle, 4 triangles per word; bit i = edge i (corner i -> i+1).
 @group(0) @binding(5) var<storage, read> edge_masks: array<u32>;
+// The second half of `indices`, for meshes split over two bindings (src/gpu/mesh.rs).
+@group(0) @binding(6) var<storage, read> indices_hi: array<u32>;
+
+// Vertex indices of triangle t.
+fn corners(t: u32) -> vec3<u32> {
+    if t < frame.index_split {
+        return vec3<u32>(indices[3u * t], indices[3u * t + 1u], indices[3u * t + 2u]);
+    }
+    let k = 3u * (t - frame.index_split);
+    return vec3<u32>(indices_hi[k], indices_hi[k + 1u], indices_hi[k + 2u]);
+}
 
 // Seed 004's Q ("max edge width", 100 there): the distance a masked edge's component
 // carries. Beyond the reach of any line a sane width draws, and small enough that the
@@ -64,7 +75,7 @@ struct Varyings {
 fn vs_main(@builtin(vertex_index) k: u32) -> Varyings {
     let t = k / 3u;
     let corner = k - 3u * t;
-    let v = vec3<u32>(indices[3u * t], indices[3u * t + 1u], indices[3u * t + 2u]);
+    let v = corners(t);
     let w0 = position(v.x);
     let w1 = position(v.y);
     let w2 = position(v.z);

@@ -21,11 +21,11 @@ struct FillVaryings {
 fn vs_fill(@builtin(vertex_index) k: u32) -> FillVaryings {
     let t = k / 3u;
     let corner = k - 3u * t;
-    let v = vec3<u32>(indices[3u * t], indices[3u * t + 1u], indices[3u * t + 2u]);
+    let v = corners(t);
     let w0 = position(v.x);
     let w1 = position(v.y);
     let w2 = position(v.z);
-    let own_index = indices[k];
+    let own_index = v[corner];
     let own = position(own_index);
     var out: FillVaryings;
     out.clip = reverse_z(frame.view_proj, frame.depth_row, own);

@@ -128,18 +128,15 @@ fn percentile(sorted: &[f64], q: f64) -> Option<f64> {
     Some(sorted[rank.clamp(1, sorted.len()) - 1])
 }
 
-/// Per pixel, `|d − d_true|` where it is measured (ids agree, true distance finite and under
-/// [`DISTANCE_RANGE_PX`]), `None` elsewhere.
+/// Per pixel, `|d − d_true|` where it is measured (ids agree, background included, which
+/// outlines reach; true distance finite and under [`DISTANCE_RANGE_PX`]), `None` elsewhere.
 pub fn distance_errors(reference: &Frame, frame: &Frame) -> Result<Vec<Option<f64>>> {
     check_same_shape(reference, frame)?;
     Ok((0..reference.ids.len())
         .map(|i| {
             let id = reference.ids[i];
             let truth = f64::from(reference.edge_distance[i]);
-            let measured = id != BACKGROUND
-                && frame.ids[i] == id
-                && truth.is_finite()
-                && truth < DISTANCE_RANGE_PX;
+            let measured = frame.ids[i] == id && truth.is_finite() && truth < DISTANCE_RANGE_PX;
             measured.then(|| {
                 let d = f64::from(frame.edge_distance[i]);
                 if d.is_finite() {

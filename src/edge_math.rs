@@ -60,6 +60,19 @@ pub fn edge_eval(clip: [DVec4; 3], mask: u8, pixel: DVec2, size: DVec2) -> EdgeE
     EdgeEval { distance, bary }
 }
 
+/// Twin of `is_silhouette` in common.wgsl: the edge `a → b`, shared by a triangle with third
+/// corner `c` and a neighbour with a point `d` off the edge, is a silhouette seen from `eye`
+/// when both triangles lie on the same side of the plane through the eye and the edge (so on
+/// screen they fold onto one side of it). Independent of winding; an edge-on triangle counts
+/// as folded.
+#[allow(clippy::neg_cmp_op_on_partial_ord)] // as in WGSL: NaN sides count as folded
+pub fn is_silhouette(a: DVec3, b: DVec3, c: DVec3, d: DVec3, eye: DVec3) -> bool {
+    let to_edge = a - eye;
+    let side_c = to_edge.dot((b - a).cross(c - a));
+    let side_d = to_edge.dot((b - a).cross(d - a));
+    !(side_c * side_d < 0.0)
+}
+
 fn line_distance(l: DVec3, drawn: bool) -> f64 {
     let len = l.truncate().length();
     if !drawn || len.is_nan() || len <= 0.0 {

@@ -15,6 +15,7 @@ pub mod edge_math;
 pub mod error;
 pub mod gpu;
 pub mod mesh;
+pub mod outline;
 pub mod raycast;
 pub mod regression;
 pub mod render;

@@ -6,6 +6,7 @@ use std::process::ExitCode;
 use wirepass::cli::{load_mesh, parse_size, CameraArgs};
 use wirepass::gpu::GpuContext;
 use wirepass::render::{render, Method, Scene};
+use wirepass::style::DepthFade;
 use wirepass::{Camera, Color, EdgeSelection, Mesh, Result, Style};
 
 #[derive(Parser)]
@@ -61,8 +62,33 @@ struct SceneArgs {
     /// feature[:DEGREES] (creases sharper than DEGREES, default 1, plus boundaries).
     #[arg(long, default_value = "polygon", value_parser = parse_edges)]
     edges: EdgeSelection,
+    /// Outlines (silhouettes and boundaries) at full width over the background and farther
+    /// surfaces, whatever --edges selects: on or off. Only deferred and raycast draw them.
+    #[arg(long, default_value = "on", value_parser = parse_switch, action = clap::ArgAction::Set)]
+    silhouettes: bool,
+    /// Fade lines from full strength at view depth START to nothing at END (world units).
+    #[arg(long, value_name = "START:END", value_parser = parse_fade)]
+    depth_fade: Option<DepthFade>,
     #[command(flatten)]
     camera: CameraArgs,
+}
+
+fn parse_switch(s: &str) -> std::result::Result<bool, String> {
+    match s {
+        "on" => Ok(true),
+        "off" => Ok(false),
+        _ => Err(format!("{s:?} is not on or off")),
+    }
+}
+
+fn parse_fade(s: &str) -> std::result::Result<DepthFade, String> {
+    let bad = || format!("{s:?} is not START:END, two numbers");
+    let (start, end) = s.split_once(':').ok_or_else(bad)?;
+    let number = |t: &str| t.trim().parse::<f32>().map_err(|_| bad());
+    Ok(DepthFade {
+        start: number(start)?,
+        end: number(end)?,
+    })
 }
 
 impl SceneArgs {
@@ -74,6 +100,8 @@ impl SceneArgs {
             wire_color: Color::from_hex(&self.wire_color)?,
             fill_color: Color::from_hex(&self.fill_color)?,
             background: Color::from_hex(&self.background)?,
+            silhouettes: self.silhouettes,
+            depth_fade: self.depth_fade,
             ..Style::default()
         };
         style.validate()?;

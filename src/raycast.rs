@@ -231,6 +231,7 @@ pub fn render_raycast(scene: &Scene<'_>) -> Result<Frame> {
     let caster = RayCaster::new(mesh);
     let masks = mesh.edge_mask(scene.edges);
     let shading = Shading::new(scene);
+    let outline = crate::outline::outline_map(&caster, &scene.camera, &scene.style, scene.size);
 
     let pixels = u64::from(width) * u64::from(height);
     let bar = progress_bar(u64::from(height), pixels);
@@ -241,7 +242,9 @@ pub fn render_raycast(scene: &Scene<'_>) -> Result<Frame> {
             let row = (0..width)
                 .map(|x| {
                     let pixel = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
-                    sample(&caster, &vp, &inv, &masks, &shading, pixel, size)
+                    let k = (y * width + x) as usize;
+                    let line = (outline.distance[k], outline.fade[k]);
+                    sample(&caster, &vp, &inv, &masks, &shading, pixel, size, line)
                 })
                 .collect();
             bar.inc(1);
@@ -291,6 +294,7 @@ struct Shading {
     background: Color,
     ambient: f64,
     line_width: f64,
+    fade: [f64; 2],
 }
 
 impl Shading {
@@ -305,10 +309,14 @@ impl Shading {
             background: s.background,
             ambient: f64::from(s.ambient),
             line_width: f64::from(s.line_width),
+            fade: s.fade_range().map(f64::from),
         }
     }
 }
 
+/// The ground truth at one pixel centre; `outline` is the pixel's (distance, fade) from the
+/// outline map.
+#[allow(clippy::too_many_arguments)]
 fn sample(
     caster: &RayCaster<'_>,
     vp: &DMat4,
@@ -317,19 +325,23 @@ fn sample(
     shading: &Shading,
     pixel: DVec2,
     size: DVec2,
+    outline: (f64, f64),
 ) -> Sample {
     let u = pixel.x / size.x * 2.0 - 1.0;
     let v = 1.0 - pixel.y / size.y * 2.0;
     let near = inv.project_point3(DVec3::new(u, v, 0.0));
     let far = inv.project_point3(DVec3::new(u, v, 1.0));
-    let background = Sample {
-        id: BACKGROUND,
-        depth: 1.0,
-        distance: f32::INFINITY,
-        rgba: shading.background.to_srgb8(),
-    };
+    let outline_line = style::line_intensity(outline.0, shading.line_width) * outline.1;
     let Some(hit) = caster.cast(near, far) else {
-        return background;
+        let bg = shading.background.0.map(f64::from);
+        let i = outline_line * shading.wire[3];
+        let mix = |k: usize| (bg[k] + (shading.wire[k] - bg[k]) * i) as f32;
+        return Sample {
+            id: BACKGROUND,
+            depth: 1.0,
+            distance: outline.0 as f32,
+            rgba: Color([mix(0), mix(1), mix(2), bg[3].max(i) as f32]).to_srgb8(),
+        };
     };
     let mesh = caster.mesh();
     let tri = mesh.triangles()[hit.id as usize];
@@ -359,12 +371,15 @@ fn sample(
         shading.light,
         shading.ambient,
     );
-    let i = style::line_intensity(distance, shading.line_width) * shading.wire[3];
+    // As the edge pass: the stronger of the own edge and the outline.
+    let own =
+        style::line_intensity(distance, shading.line_width) * style::depth_fade(c.w, shading.fade);
+    let i = own.max(outline_line) * shading.wire[3];
     let mix = |k: usize| (surface[k] + (shading.wire[k] - surface[k]) * i) as f32;
     Sample {
         id: hit.id,
         depth: depth as f32,
-        distance: distance as f32,
+        distance: distance.min(outline.0) as f32,
         rgba: Color([mix(0), mix(1), mix(2), 1.0]).to_srgb8(),
     }
 }

@@ -68,7 +68,29 @@ pub struct Style {
     /// Direction towards the key light in view space (x right, y up, z towards the viewer),
     /// so the lighting follows the camera.
     pub light_view_dir: Vec3,
+    /// Draw the outline (silhouette and boundary edges) at full width, over the background
+    /// and farther surfaces too, and always, whatever the edge selection. Only the deferred
+    /// pass and the ground truth can; the forward baselines draw each edge inside its own
+    /// triangles, so their outlines are half as wide. See `shaders/outline.wgsl`.
+    pub silhouettes: bool,
+    /// Fade lines with their distance from the eye; `None` draws every line at full strength.
+    pub depth_fade: Option<DepthFade>,
 }
+
+/// Lines fade linearly from full strength at view depth `start` to nothing at `end` (depth
+/// along the view direction, in world units), which keeps dense far geometry from turning
+/// into a solid mass of line colour.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DepthFade {
+    /// View depth where lines start to fade.
+    pub start: f32,
+    /// View depth where they have faded out; greater than `start`.
+    pub end: f32,
+}
+
+/// Widest line a style may ask for, in pixels: a line's reach bounds how far the edge pass
+/// and the outline pass look around a pixel.
+pub const MAX_LINE_WIDTH: f32 = 256.0;
 
 impl Default for Style {
     fn default() -> Self {
@@ -79,6 +101,8 @@ impl Default for Style {
             background: Color([1.0, 1.0, 1.0, 1.0]),
             ambient: 0.3,
             light_view_dir: Vec3::new(-0.4, 0.6, 1.0),
+            silhouettes: true,
+            depth_fade: None,
         }
     }
 }
@@ -86,11 +110,18 @@ impl Default for Style {
 impl Style {
     /// Rejects settings that cannot produce a sensible image.
     pub fn validate(&self) -> Result<()> {
-        if !(self.line_width >= 0.0 && self.line_width.is_finite()) {
+        if !(self.line_width >= 0.0 && self.line_width <= MAX_LINE_WIDTH) {
             return Err(Error::InvalidSetting(format!(
-                "line width {} must be a finite number >= 0",
+                "line width {} is not in 0..={MAX_LINE_WIDTH} pixels",
                 self.line_width
             )));
+        }
+        if let Some(DepthFade { start, end }) = self.depth_fade {
+            if !(start >= 0.0 && end > start && end.is_finite()) {
+                return Err(Error::InvalidSetting(format!(
+                    "depth fade {start}:{end} must have 0 <= start < end, both finite"
+                )));
+            }
         }
         if !(0.0..=1.0).contains(&self.ambient) {
             return Err(Error::InvalidSetting(format!(
@@ -123,6 +154,24 @@ pub fn line_intensity(d: f64, width: f64) -> f64 {
         return 0.0;
     }
     (0.5 * width).min(1.0) * (-2.0 * t * t).exp2()
+}
+
+/// Twin of `depth_fade` in common.wgsl: the strength of a line at view depth `w`, for the
+/// fade `fade` = (start, end); 1 where `end <= start` (no fade).
+#[allow(clippy::neg_cmp_op_on_partial_ord)] // as in WGSL: NaN ends mean no fade
+pub fn depth_fade(w: f64, fade: [f64; 2]) -> f64 {
+    let [start, end] = fade;
+    if !(end > start) {
+        return 1.0;
+    }
+    ((end - w) / (end - start)).clamp(0.0, 1.0)
+}
+
+impl Style {
+    /// The fade as the shaders take it: (start, end), or (0, 0) for none.
+    pub fn fade_range(&self) -> [f32; 2] {
+        self.depth_fade.map_or([0.0; 2], |f| [f.start, f.end])
+    }
 }
 
 /// How far from an edge its line can colour a pixel, in pixels.
@@ -205,16 +254,33 @@ mod tests {
     }
 
     #[test]
+    fn fade_is_linear_between_its_ends() {
+        assert_eq!(depth_fade(5.0, [0.0, 0.0]), 1.0);
+        assert_eq!(depth_fade(1.0, [2.0, 4.0]), 1.0);
+        assert_eq!(depth_fade(3.0, [2.0, 4.0]), 0.5);
+        assert_eq!(depth_fade(9.0, [2.0, 4.0]), 0.0);
+    }
+
+    #[test]
     fn rejects_bad_style() {
         let s = Style {
             line_width: -1.0,
             ..Style::default()
         };
         assert!(s.validate().is_err());
-        let s = Style {
-            line_width: f32::NAN,
-            ..Style::default()
-        };
-        assert!(s.validate().is_err());
+        for line_width in [f32::NAN, f32::INFINITY, MAX_LINE_WIDTH * 2.0] {
+            let s = Style {
+                line_width,
+                ..Style::default()
+            };
+            assert!(s.validate().is_err());
+        }
+        for (start, end) in [(2.0, 1.0), (1.0, 1.0), (-1.0, 1.0), (0.0, f32::NAN)] {
+            let s = Style {
+                depth_fade: Some(DepthFade { start, end }),
+                ..Style::default()
+            };
+            assert!(s.validate().is_err(), "{start}:{end}");
+        }
     }
 }

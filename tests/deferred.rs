@@ -11,8 +11,15 @@ use wirepass::{Camera, EdgeSelection, Mesh, Style};
 
 const BACKGROUND: u32 = u32::MAX;
 
+/// Draws without outlines: the tests here check each triangle's own edges against the CPU
+/// definition; outlines are checked against the ground truth (tests/ground_truth.rs,
+/// tests/outline.rs).
 fn draw(mesh: &Mesh, camera: Camera, size: (u32, u32), edges: EdgeSelection) -> Frame {
-    draw_styled(mesh, camera, size, edges, Style::default())
+    let style = Style {
+        silhouettes: false,
+        ..Style::default()
+    };
+    draw_styled(mesh, camera, size, edges, style)
 }
 
 fn draw_styled(
@@ -77,6 +84,7 @@ fn suzanne_draws_no_quad_diagonal() {
     // 3 px lines: full line colour within 0.5 px of an edge.
     let style = Style {
         line_width: 3.0,
+        silhouettes: false,
         ..Style::default()
     };
     let polygon = draw_styled(&mesh, cam, size, EdgeSelection::Polygon, style.clone());
@@ -350,7 +358,7 @@ fn overlay_blends_lines_over_the_host_image_and_resizes() {
 }
 
 #[test]
-fn timer_reports_both_passes() {
+fn timer_reports_every_pass() {
     let ctx = gpu();
     let device = &ctx.device;
     let mesh = wirepass::mesh::default_scene();
@@ -385,7 +393,7 @@ fn timer_reports_both_passes() {
         ctx.queue.submit([encoder.finish()]);
         let spans = timer.read(device).unwrap();
         let names: Vec<_> = spans.iter().map(|s| s.0).collect();
-        assert_eq!(names, ["visibility", "edge"]);
+        assert_eq!(names, ["visibility", "outline", "edge"]);
         assert!(
             spans.iter().all(|s| s.1.is_finite() && s.1 >= 0.0),
             "{spans:?}"

@@ -13,9 +13,9 @@ mod common;
 
 use common::{gpu, load};
 use glam::{DVec3, Vec3};
-use wirepass::compare::{metrics, Metrics};
+use wirepass::compare::{distance_errors, metrics, Metrics};
 use wirepass::raycast::{render_raycast, RayCaster};
-use wirepass::render::{render, Method, Scene};
+use wirepass::render::{render, Frame, Method, Scene};
 use wirepass::{Camera, EdgeSelection, Mesh, Style};
 
 const SIZE: (u32, u32) = (320, 240);
@@ -147,7 +147,7 @@ fn camera(mesh: &Mesh, shot: Shot) -> Camera {
     cam
 }
 
-fn measure(mesh: &Mesh, shot: Shot) -> Metrics {
+fn measure(mesh: &Mesh, shot: Shot) -> (Metrics, String) {
     let scene = Scene {
         mesh,
         camera: camera(mesh, shot),
@@ -157,7 +157,34 @@ fn measure(mesh: &Mesh, shot: Shot) -> Metrics {
     };
     let truth = render_raycast(&scene).unwrap_or_else(|e| panic!("{e}"));
     let frame = render(gpu(), &scene, Method::Deferred).unwrap_or_else(|e| panic!("{e}"));
-    metrics(&truth, &frame).unwrap_or_else(|e| panic!("{e}"))
+    let m = metrics(&truth, &frame).unwrap_or_else(|e| panic!("{e}"));
+    (m, worst_pixels(&truth, &frame))
+}
+
+/// The pixels with the largest distance errors, for the failure message.
+fn worst_pixels(truth: &Frame, frame: &Frame) -> String {
+    let errors = distance_errors(truth, frame).unwrap_or_else(|e| panic!("{e}"));
+    let mut worst: Vec<(usize, f64)> = errors
+        .iter()
+        .enumerate()
+        .filter_map(|(i, e)| e.filter(|&e| e > MAX_ERROR_PX).map(|e| (i, e)))
+        .collect();
+    worst.sort_by(|a, b| b.1.total_cmp(&a.1));
+    let width = truth.size.0 as usize;
+    worst
+        .iter()
+        .take(5)
+        .map(|&(i, _)| {
+            format!(
+                "\n    pixel ({}, {}) id {}: truth {} measured {}",
+                i % width,
+                i / width,
+                truth.ids[i] as i64,
+                truth.edge_distance[i],
+                frame.edge_distance[i]
+            )
+        })
+        .collect()
 }
 
 /// Measures every shot of `name`, prints the numbers, then checks the bounds (all shots are
@@ -166,7 +193,7 @@ fn check(name: &str) {
     let mesh = load(name);
     let mut failures = Vec::new();
     for shot in SHOTS {
-        let m = measure(&mesh, shot);
+        let (m, worst) = measure(&mesh, shot);
         let d = m.distance_error_px;
         let line = format!(
             "{name:<20} {shot:<9} id {:.5} coverage {:.5} distance p99 {:.2e} max {:.2e} ({} px)",
@@ -188,7 +215,9 @@ fn check(name: &str) {
             failures.push(format!("{line}: distance p99 over {MAX_P99_PX} px"));
         }
         if d.max.is_some_and(|v| !(v <= MAX_ERROR_PX)) {
-            failures.push(format!("{line}: distance max over {MAX_ERROR_PX} px"));
+            failures.push(format!(
+                "{line}: distance max over {MAX_ERROR_PX} px{worst}"
+            ));
         }
     }
     assert!(failures.is_empty(), "\n{}", failures.join("\n"));

@@ -73,10 +73,17 @@ impl GpuContext {
             why += "; install a Vulkan driver (e.g. mesa-vulkan-drivers) or an EGL/GL driver";
             return Err(Error::NoAdapter(why));
         };
-        Self::from_adapter(adapter).await
+        let limits = adapter.limits();
+        Self::from_adapter(adapter, limits).await
     }
 
-    async fn from_adapter(adapter: wgpu::Adapter) -> Result<Self> {
+    /// Opens a device on `adapter` with `limits` in place of the adapter's own, e.g. lowered
+    /// ones to exercise how a mesh past a limit is handled.
+    pub fn with_limits(adapter: wgpu::Adapter, limits: wgpu::Limits) -> Result<Self> {
+        pollster::block_on(Self::from_adapter(adapter, limits))
+    }
+
+    async fn from_adapter(adapter: wgpu::Adapter, limits: wgpu::Limits) -> Result<Self> {
         let info = adapter.get_info();
         let downlevel = adapter.get_downlevel_capabilities();
         if !downlevel
@@ -92,7 +99,7 @@ impl GpuContext {
             .request_device(&wgpu::DeviceDescriptor {
                 label: Some("wirepass"),
                 required_features: adapter.features() & OPTIONAL_FEATURES,
-                required_limits: adapter.limits(),
+                required_limits: limits,
                 ..Default::default()
             })
             .await

@@ -18,6 +18,8 @@ pub const DIAGNOSTIC_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Fl
 pub const RESOLVED_ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 /// Edge-pass workgroup side (8 × 8 pixels).
 const TILE: u32 = 8;
+/// Outline-pass workgroup size (triangles), as in outline.wgsl.
+const OUTLINE_GROUP: u32 = 64;
 
 /// Construction options.
 #[derive(Clone, Copy, Debug)]
@@ -63,6 +65,8 @@ struct Targets {
     depth: wgpu::Texture,
     /// Present when diagnostics are enabled: (distance + depth map, resolved ids).
     diagnostic: Option<(wgpu::Texture, wgpu::Texture)>,
+    /// One u32 per pixel: what the outline pass leaves for the edge pass.
+    outline: wgpu::Buffer,
 }
 
 /// The deferred wireframe pass. Construct once with [`DeferredPass::new`], call
@@ -78,6 +82,12 @@ pub struct DeferredPass {
     overlay: (wgpu::ComputePipeline, wgpu::BindGroupLayout),
     diagnostic: (wgpu::ComputePipeline, wgpu::BindGroupLayout),
     floor: (wgpu::ComputePipeline, wgpu::BindGroupLayout),
+    /// The outline pass and the layout of its read-write buffer.
+    outline: (wgpu::ComputePipeline, wgpu::BindGroupLayout),
+    /// Layout of the edge pass's read-only view of the outline buffer.
+    outline_read: wgpu::BindGroupLayout,
+    /// Whether the last prepared style draws outlines (runs the outline pass).
+    silhouettes: bool,
     frame: wgpu::Buffer,
     draw: wgpu::Buffer,
     diagnostics: bool,
@@ -157,8 +167,7 @@ impl DeferredPass {
         let cs = wgpu::ShaderStages::COMPUTE;
         let mut vis_entries = vec![entry(0, vs, uniform()), entry(1, fs | vs, uniform())];
         if pulled {
-            vis_entries.push(entry(2, vs, storage()));
-            vis_entries.push(entry(3, vs, storage()));
+            vis_entries.extend([2, 3, 4].map(|b| entry(b, vs, storage())));
         }
         let visibility_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("wirepass visibility"),
@@ -226,31 +235,40 @@ impl DeferredPass {
                 entry(4, cs, storage()),
                 entry(5, cs, texture(wgpu::TextureSampleType::Uint)),
                 entry(6, cs, storage()),
+                entry(7, cs, storage()),
+                entry(8, cs, storage()),
             ],
         });
         let edge_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("wirepass edge pass"),
             source: wgpu::ShaderSource::Wgsl(edge_source.into()),
         });
-        let compute = |name: &str, entries: &[wgpu::BindGroupLayoutEntry]| {
-            let out_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some(name),
-                entries,
-            });
+        let outline_read = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("wirepass outline read"),
+            entries: &[entry(0, cs, storage())],
+        });
+        let pipeline = |name: &str, groups: &[Option<&wgpu::BindGroupLayout>]| {
             let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some(name),
-                bind_group_layouts: &[Some(&mesh_layout), Some(&out_layout)],
+                bind_group_layouts: groups,
                 immediate_size: 0,
             });
-            let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(name),
                 layout: Some(&layout),
                 module: &edge_module,
                 entry_point: Some(name),
                 compilation_options: Default::default(),
                 cache: None,
+            })
+        };
+        let compute = |name: &str, entries: &[wgpu::BindGroupLayoutEntry]| {
+            let out_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some(name),
+                entries,
             });
-            (pipeline, out_layout)
+            let groups = [Some(&mesh_layout), Some(&out_layout), Some(&outline_read)];
+            (pipeline(name, &groups), out_layout)
         };
         let shade = compute("shade_main", &[entry(0, cs, storage_texture(format))]);
         let overlay = compute(
@@ -272,6 +290,22 @@ impl DeferredPass {
             ],
         );
         let floor = compute("floor_main", &[entry(5, cs, storage_texture(format))]);
+        let outline_write = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("wirepass outline write"),
+            entries: &[entry(
+                6,
+                cs,
+                wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Storage { read_only: false },
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+            )],
+        });
+        let outline = (
+            pipeline("outline_main", &[Some(&mesh_layout), Some(&outline_write)]),
+            outline_write,
+        );
 
         let frame = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("wirepass frame"),
@@ -297,6 +331,9 @@ impl DeferredPass {
             overlay,
             diagnostic,
             floor,
+            outline,
+            outline_read,
+            silhouettes: false,
             frame,
             draw,
             diagnostics: false,
@@ -319,13 +356,14 @@ impl DeferredPass {
         if let Some((d, r)) = &t.diagnostic {
             textures.extend([d, r]);
         }
-        textures
+        let texels: u64 = textures
             .iter()
             .map(|x| {
                 let texel = x.format().block_copy_size(None).unwrap_or(4);
                 u64::from(x.width()) * u64::from(x.height()) * u64::from(texel)
             })
-            .sum()
+            .sum();
+        texels + t.outline.size()
     }
 
     /// True when the visibility pass pulls vertices because the device lacks
@@ -352,7 +390,21 @@ impl DeferredPass {
     ) -> Result<()> {
         let view = (camera, style, size);
         FrameUniforms::validate_and_write(device, queue, &self.frame, mesh, view)?;
+        self.silhouettes = style.silhouettes;
         if self.targets.as_ref().map(|t| t.size) != Some(size) {
+            let outline_bytes = u64::from(size.0) * u64::from(size.1) * 4;
+            let limit = device.limits().max_storage_buffer_binding_size;
+            if outline_bytes > limit {
+                return Err(Error::OverLimit {
+                    what: format!(
+                        "the size in bytes of the outline buffer of a {}x{} image",
+                        size.0, size.1
+                    ),
+                    value: outline_bytes,
+                    limit_name: "max_storage_buffer_binding_size",
+                    limit,
+                });
+            }
             let make = |label, format, usage| texture_2d(device, label, size, format, usage);
             use wgpu::TextureUsages as U;
             self.targets = Some(Targets {
@@ -376,6 +428,12 @@ impl DeferredPass {
                             U::STORAGE_BINDING | U::COPY_SRC,
                         ),
                     )
+                }),
+                outline: device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("wirepass outline"),
+                    size: u64::from(size.0) * u64::from(size.1) * 4,
+                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
                 }),
             });
         }
@@ -428,8 +486,8 @@ impl DeferredPass {
         self.edges(device, encoder, mesh, target, None)
     }
 
-    /// [`encode`](Self::encode) with GPU timestamps around the two passes, named
-    /// `"visibility"` and `"edge"` in `timer`.
+    /// [`encode`](Self::encode) with GPU timestamps around each pass, named `"visibility"`,
+    /// `"outline"` (when the style draws outlines) and `"edge"` in `timer`.
     pub fn encode_timed(
         &self,
         device: &wgpu::Device,
@@ -473,14 +531,14 @@ impl DeferredPass {
             },
         ];
         if self.pulled {
-            entries.push(wgpu::BindGroupEntry {
-                binding: 2,
-                resource: mesh.positions.as_entire_binding(),
-            });
-            entries.push(wgpu::BindGroupEntry {
-                binding: 3,
-                resource: mesh.indices.as_entire_binding(),
-            });
+            let [indices, indices_hi] = mesh.halves(&mesh.indices);
+            let pulled = [mesh.positions.as_entire_binding(), indices, indices_hi];
+            entries.extend(
+                pulled
+                    .into_iter()
+                    .zip(2..)
+                    .map(|(resource, binding)| wgpu::BindGroupEntry { binding, resource }),
+            );
         }
         let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("wirepass visibility"),
@@ -527,7 +585,8 @@ impl DeferredPass {
         Ok(())
     }
 
-    /// Records only the edge pass; the visibility pass of this frame must precede it.
+    /// Records only the edge pass (and the outline pass before it, when the style draws
+    /// outlines); the visibility pass of this frame must precede it.
     pub fn encode_edges(
         &self,
         device: &wgpu::Device,
@@ -548,39 +607,27 @@ impl DeferredPass {
     ) -> Result<()> {
         let targets = self.targets()?;
         let ids = targets.ids.create_view(&Default::default());
+        let [indices, indices_hi] = mesh.halves(&mesh.indices);
+        let [neighbours, neighbours_hi] = mesh.halves(&mesh.neighbours);
+        let resources = [
+            self.frame.as_entire_binding(),
+            mesh.positions.as_entire_binding(),
+            mesh.normals.as_entire_binding(),
+            indices,
+            mesh.edge_masks.as_entire_binding(),
+            wgpu::BindingResource::TextureView(&ids),
+            neighbours,
+            indices_hi,
+            neighbours_hi,
+        ];
         let mesh_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("wirepass edge pass mesh"),
             layout: &self.mesh_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: self.frame.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: mesh.positions.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: mesh.normals.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: mesh.indices.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: mesh.edge_masks.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 5,
-                    resource: wgpu::BindingResource::TextureView(&ids),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 6,
-                    resource: mesh.neighbours.as_entire_binding(),
-                },
-            ],
+            entries: &resources
+                .into_iter()
+                .zip(0..)
+                .map(|(resource, binding)| wgpu::BindGroupEntry { binding, resource })
+                .collect::<Vec<_>>(),
         });
         let check = |view: &wgpu::TextureView, what: &str| -> Result<()> {
             let t = view.texture();
@@ -596,6 +643,7 @@ impl DeferredPass {
             Ok(())
         };
         let (diagnostic_view, resolved_view);
+        let floor = matches!(target, OutputTarget::Floor(_));
         let (pipeline, layout, entries) = match target {
             OutputTarget::Shaded(out) => {
                 check(out, "the output texture")?;
@@ -666,6 +714,19 @@ impl DeferredPass {
             layout,
             entries: &entries,
         });
+        let mut timer = timer;
+        if self.silhouettes && !floor {
+            encoder.clear_buffer(&targets.outline, 0, None);
+            self.outline_pass(device, encoder, mesh, &mesh_group, timer.as_deref_mut())?;
+        }
+        let outline_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("wirepass outline read"),
+            layout: &self.outline_read,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: targets.outline.as_entire_binding(),
+            }],
+        });
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("wirepass edge pass"),
             timestamp_writes: timer.and_then(|t| t.compute_span("edge")),
@@ -673,11 +734,45 @@ impl DeferredPass {
         pass.set_pipeline(pipeline);
         pass.set_bind_group(0, &mesh_group, &[]);
         pass.set_bind_group(1, &out_group, &[]);
+        pass.set_bind_group(2, &outline_group, &[]);
         pass.dispatch_workgroups(
             targets.size.0.div_ceil(TILE),
             targets.size.1.div_ceil(TILE),
             1,
         );
+        Ok(())
+    }
+
+    /// The outline pass (outline.wgsl): one invocation per triangle, on a 2D grid of
+    /// workgroups since large meshes need more than one dimension allows.
+    fn outline_pass(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        mesh: &GpuMesh,
+        mesh_group: &wgpu::BindGroup,
+        timer: Option<&mut GpuTimer>,
+    ) -> Result<()> {
+        let targets = self.targets()?;
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("wirepass outline write"),
+            layout: &self.outline.1,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 6,
+                resource: targets.outline.as_entire_binding(),
+            }],
+        });
+        let groups = mesh.triangles.div_ceil(OUTLINE_GROUP);
+        let max = device.limits().max_compute_workgroups_per_dimension.max(1);
+        let (x, y) = (groups.min(max), groups.div_ceil(max));
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("wirepass outline pass"),
+            timestamp_writes: timer.and_then(|t| t.compute_span("outline")),
+        });
+        pass.set_pipeline(&self.outline.0);
+        pass.set_bind_group(0, mesh_group, &[]);
+        pass.set_bind_group(1, &group, &[]);
+        pass.dispatch_workgroups(x, y, 1);
         Ok(())
     }
 }

@@ -94,6 +94,7 @@ pub(super) fn mesh_layout(device: &wgpu::Device, label: &str) -> wgpu::BindGroup
             entry(3, vs, storage),
             entry(4, vs, storage),
             entry(5, vs, storage),
+            entry(6, vs, storage),
         ],
     })
 }
@@ -105,20 +106,22 @@ pub(super) fn mesh_group(
     uniforms: &Uniforms,
     mesh: &GpuMesh,
 ) -> wgpu::BindGroup {
-    let buffers = [
-        &uniforms.frame,
-        &uniforms.draw,
-        &mesh.positions,
-        &mesh.normals,
-        &mesh.indices,
-        &mesh.edge_masks,
+    let [indices, indices_hi] = mesh.halves(&mesh.indices);
+    let resources = [
+        uniforms.frame.as_entire_binding(),
+        uniforms.draw.as_entire_binding(),
+        mesh.positions.as_entire_binding(),
+        mesh.normals.as_entire_binding(),
+        indices,
+        mesh.edge_masks.as_entire_binding(),
+        indices_hi,
     ];
-    let entries: Vec<_> = buffers
-        .iter()
+    let entries: Vec<_> = resources
+        .into_iter()
         .enumerate()
-        .map(|(i, b)| wgpu::BindGroupEntry {
+        .map(|(i, resource)| wgpu::BindGroupEntry {
             binding: i as u32,
-            resource: b.as_entire_binding(),
+            resource,
         })
         .collect();
     device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -131,11 +134,11 @@ pub(super) fn mesh_group(
 /// Vertex pulling reads storage buffers in the vertex stage, which some downlevel adapters
 /// (WebGL 2, old GL ES) cannot do.
 pub(super) fn check_vertex_storage(device: &wgpu::Device) -> Result<()> {
-    if device.limits().max_storage_buffers_per_shader_stage < 4 {
+    if device.limits().max_storage_buffers_per_shader_stage < 5 {
         return Err(Error::MissingFeature {
             adapter: device.adapter_info().name,
             what:
-                "four storage buffers per shader stage, read in the vertex stage (vertex pulling)"
+                "five storage buffers per shader stage, read in the vertex stage (vertex pulling)"
                     .into(),
         });
     }

@@ -18,6 +18,11 @@ pub struct FrameUniforms {
     size: [f32; 2],
     line_width: f32,
     ambient: f32,
+    fade: [f32; 2],
+    index_split: u32,
+    silhouettes: u32,
+    triangles: u32,
+    _pad: [u32; 3],
 }
 
 impl FrameUniforms {
@@ -33,7 +38,11 @@ impl FrameUniforms {
         super::check_size(device, size)?;
         camera.validate()?;
         style.validate()?;
-        let uniforms = Self::new(camera, style, size, mesh.origin());
+        let uniforms = Self {
+            index_split: mesh.split,
+            triangles: mesh.triangles,
+            ..Self::new(camera, style, size, mesh.origin())
+        };
         queue.write_buffer(buffer, 0, bytemuck::bytes_of(&uniforms));
         Ok(())
     }
@@ -57,6 +66,11 @@ impl FrameUniforms {
             size: [size.0 as f32, size.1 as f32],
             line_width: style.line_width,
             ambient: style.ambient,
+            fade: style.fade_range(),
+            index_split: u32::MAX,
+            silhouettes: u32::from(style.silhouettes),
+            triangles: 0,
+            _pad: [0; 3],
         }
     }
 

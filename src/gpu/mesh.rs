@@ -18,6 +18,9 @@ pub struct GpuMesh {
     pub(crate) edge_masks: wgpu::Buffer,
     pub(crate) neighbours: wgpu::Buffer,
     pub(crate) triangles: u32,
+    /// Triangles in the first binding of `indices` and `neighbours`; the rest go in a second
+    /// (see [`GpuMesh::halves`]). Equal to `triangles` when one binding holds them all.
+    pub(crate) split: u32,
     pub(crate) origin: DVec3,
     pub(crate) bytes: u64,
 }
@@ -26,29 +29,8 @@ impl GpuMesh {
     /// Uploads `mesh`, drawing the edges that `edges` selects.
     pub fn new(device: &wgpu::Device, mesh: &Mesh, edges: EdgeSelection) -> Result<Self> {
         // Limits first, from the counts alone, before any large allocation.
-        let limits = device.limits();
-        let limit = limits
-            .max_storage_buffer_binding_size
-            .min(limits.max_buffer_size);
         let (vertices, triangles) = (mesh.positions().len() as u64, mesh.triangle_count() as u64);
-        for (what, len) in [
-            ("vertex positions", vertices * 12),
-            ("vertex normals", vertices * 12),
-            ("triangle indices", triangles * 12),
-            ("edge neighbours", triangles * 12),
-        ] {
-            if len > limit {
-                return Err(Error::OverLimit {
-                    what: format!(
-                        "the size in bytes of the {what} buffer of a {triangles}-triangle mesh"
-                    ),
-                    value: len,
-                    limit_name: "max_storage_buffer_binding_size",
-                    limit,
-                });
-            }
-        }
-
+        let split = split_point(&device.limits(), vertices, triangles)?;
         let (lo, hi) = mesh.bounds();
         let origin = (lo.as_dvec3() + hi.as_dvec3()) * 0.5;
         let positions: Vec<f32> = mesh
@@ -94,9 +76,33 @@ impl GpuMesh {
                 storage,
             ),
             triangles: mesh.triangle_count() as u32,
+            split,
             origin,
             bytes,
         })
+    }
+
+    /// The two bindings (first `split` triangles, then the rest) of a buffer of three u32s
+    /// per triangle, `indices` or `neighbours`. A shader reads element k from the first while
+    /// k < 3 × `Frame.index_split` and from the second after, so a mesh whose buffer exceeds
+    /// `max_storage_buffer_binding_size` still renders. Unsplit, both bind the whole buffer.
+    pub(crate) fn halves<'a>(&self, buffer: &'a wgpu::Buffer) -> [wgpu::BindingResource<'a>; 2] {
+        if self.split == self.triangles {
+            return [buffer.as_entire_binding(), buffer.as_entire_binding()];
+        }
+        let at = u64::from(self.split) * 12;
+        [
+            wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                buffer,
+                offset: 0,
+                size: wgpu::BufferSize::new(at),
+            }),
+            wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                buffer,
+                offset: at,
+                size: None,
+            }),
+        ]
     }
 
     /// Number of triangles.
@@ -127,5 +133,96 @@ impl GpuMesh {
         masks.resize(masks.len().div_ceil(4) * 4, 0);
         queue.write_buffer(&self.edge_masks, 0, &masks);
         Ok(())
+    }
+}
+
+/// Where the per-triangle buffers (indices, neighbours: 12 bytes a triangle) split into two
+/// bindings: the triangle count when one binding holds them, else the most triangles a
+/// binding holds with the second binding's offset aligned. Errors name the limit a mesh
+/// exceeds: per-vertex buffers must fit one binding, per-triangle buffers two, and every
+/// buffer `max_buffer_size`.
+pub(crate) fn split_point(limits: &wgpu::Limits, vertices: u64, triangles: u64) -> Result<u32> {
+    let binding = limits.max_storage_buffer_binding_size;
+    let over = |what: &str, value, limit_name, limit| Error::OverLimit {
+        what: format!("the size in bytes of the {what} of a {triangles}-triangle mesh"),
+        value,
+        limit_name,
+        limit,
+    };
+    for (what, len) in [
+        ("vertex positions buffer", vertices * 12),
+        ("vertex normals buffer", vertices * 12),
+        ("triangle indices buffer", triangles * 12),
+    ] {
+        if len > limits.max_buffer_size {
+            return Err(over(what, len, "max_buffer_size", limits.max_buffer_size));
+        }
+    }
+    for (what, len) in [
+        ("vertex positions buffer", vertices * 12),
+        ("vertex normals buffer", vertices * 12),
+    ] {
+        if len > binding {
+            return Err(over(what, len, "max_storage_buffer_binding_size", binding));
+        }
+    }
+    if triangles * 12 <= binding {
+        return Ok(triangles as u32);
+    }
+    // The second binding's offset must be a multiple of the alignment and of 12 bytes.
+    let align = u64::from(limits.min_storage_buffer_offset_alignment.max(4));
+    let unit = align / gcd(align, 12) * 12;
+    let first = binding / unit * unit / 12;
+    let rest = (triangles - first) * 12;
+    if first == 0 || rest > binding {
+        return Err(over(
+            "triangle indices buffer (split over two bindings)",
+            triangles * 12,
+            "max_storage_buffer_binding_size × 2",
+            2 * binding,
+        ));
+    }
+    Ok(first as u32)
+}
+
+fn gcd(a: u64, b: u64) -> u64 {
+    if b == 0 {
+        a
+    } else {
+        gcd(b, a % b)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn limits(binding: u64) -> wgpu::Limits {
+        wgpu::Limits {
+            max_storage_buffer_binding_size: binding,
+            max_buffer_size: 1 << 40,
+            min_storage_buffer_offset_alignment: 256,
+            ..wgpu::Limits::default()
+        }
+    }
+
+    #[test]
+    fn split_only_past_the_binding_limit() {
+        let l = limits(128 << 20);
+        assert_eq!(split_point(&l, 10, 1000).unwrap(), 1000);
+        let t = (128u64 << 20) / 12 + 1000;
+        let s = u64::from(split_point(&l, 10, t).unwrap());
+        assert!(s * 12 <= 128 << 20 && (s * 12) % 256 == 0 && s * 12 > (128 << 20) - 768);
+        // 20 M triangles (240 MB of indices) fit two 128 MiB bindings.
+        assert!(split_point(&l, 10_000_002, 20_000_000).is_ok());
+    }
+
+    #[test]
+    fn past_two_bindings_is_an_error_naming_the_limit() {
+        let l = limits(1 << 16);
+        let e = split_point(&l, 10, 12_000).unwrap_err().to_string();
+        assert!(e.contains("max_storage_buffer_binding_size × 2"), "{e}");
+        let e = split_point(&l, 6000, 10).unwrap_err().to_string();
+        assert!(e.contains("vertex positions"), "{e}");
     }
 }

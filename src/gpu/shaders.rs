@@ -9,6 +9,8 @@ pub const VISIBILITY: &str = include_str!("../../shaders/visibility.wgsl");
 pub const VISIBILITY_PULLED: &str = include_str!("../../shaders/visibility_pulled.wgsl");
 /// The deferred edge pass (compute).
 pub const EDGE_PASS: &str = include_str!("../../shaders/edge_pass.wgsl");
+/// The outline pass (compute), assembled after [`EDGE_PASS`] into the same module.
+pub const OUTLINE: &str = include_str!("../../shaders/outline.wgsl");
 /// The forward single-pass baseline (vertex-pulled altitudes); see `gpu::ForwardPass`.
 pub const FORWARD: &str = include_str!("../../shaders/forward.wgsl");
 /// The two-pass baseline (fill + edge lines), assembled after [`FORWARD`]; see `gpu::TwoPass`.
@@ -33,7 +35,7 @@ pub fn assemble(body: &str) -> String {
     format!("{}\n{COMMON}\n{}\n", enables.join("\n"), rest.join("\n"))
 }
 
-/// The edge pass for an output texture of `format`: 8-bit outputs are written sRGB-encoded
+/// The edge pass and the outline pass for an output texture of `format`: 8-bit outputs are written sRGB-encoded
 /// (storage textures cannot be sRGB), float outputs linear.
 pub fn edge_pass(format: wgpu::TextureFormat) -> Option<String> {
     let name = storage_format_name(format)?;
@@ -43,7 +45,7 @@ pub fn edge_pass(format: wgpu::TextureFormat) -> Option<String> {
         "fn encode_output(c: vec4<f32>) -> vec4<f32> { return c; }"
     };
     Some(assemble(&format!(
-        "{}\n{encode}\n",
+        "{}\n{OUTLINE}\n{encode}\n",
         EDGE_PASS.replace("OUTPUT_FORMAT", name)
     )))
 }

@@ -1,0 +1,401 @@
+//! Outlines for the ground truth, in f64: the definition `shaders/outline.wgsl` draws.
+//!
+//! An outline edge is a boundary edge (no neighbour, or more than one) or a silhouette
+//! ([`edge_math::is_silhouette`]). Pixel p lies at distance d from an outline when d is the
+//! distance from p's centre to the *visible part* of an outline edge's projection: the part
+//! in front of the near plane and not beyond the far one, inside the image, and not hidden by
+//! another surface. The line drawn there has the common profile and the depth fade of that
+//! nearest visible point.
+//!
+//! Visibility along an edge is found by casting a ray through points every 1/8 pixel of its
+//! projection and bisecting each change to 2⁻³⁰ of the edge. The GPU pass tests only the
+//! nearest point of each edge; the two agree wherever a nearer surface's own outline lies
+//! between a pixel and a hidden stretch of edge, which is where it can matter.
+
+// `!(a <= b)` is deliberate: NaN must take the rejecting branch.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+use crate::camera::Camera;
+use crate::edge_math;
+use crate::mesh::adjacency::NO_NEIGHBOUR;
+use crate::raycast::RayCaster;
+use crate::style::{depth_fade, line_reach, Style};
+use glam::{DMat4, DVec2, DVec3, DVec4};
+use rayon::prelude::*;
+
+/// A point on an outline edge is hidden when a surface there is nearer than this share of its
+/// view depth (as `HIDDEN_MARGIN` in outline.wgsl).
+const HIDDEN_MARGIN: f64 = 1e-4;
+/// Visibility samples per pixel of projected edge length.
+const SAMPLES_PER_PIXEL: f64 = 8.0;
+/// Bisection steps that place each change of visibility along an edge.
+const BISECTIONS: u32 = 30;
+
+/// Per pixel, the distance to the nearest visible outline within the line's reach
+/// (`INFINITY` where none) and the depth fade of its nearest point.
+pub struct OutlineMap {
+    /// Pixels, row-major.
+    pub distance: Vec<f64>,
+    /// Line strength from the depth fade, 0..1.
+    pub fade: Vec<f64>,
+}
+
+/// The outline edges of `mesh` seen from `eye`, as (triangle, edge) with edge `i` running
+/// from corner `i` to corner `i + 1`; an edge shared by two triangles appears once, under the
+/// lower id.
+pub fn outline_edges(mesh: &crate::Mesh, eye: DVec3) -> Vec<(u32, u32)> {
+    let p = mesh.positions();
+    let tris = mesh.triangles();
+    let neighbours = mesh.edge_neighbours();
+    let corner = |t: u32, k: usize| p[tris[t as usize][k % 3] as usize].as_dvec3();
+    (0..tris.len() as u32)
+        .into_par_iter()
+        .flat_map_iter(|t| {
+            (0..3).filter_map(move |i| {
+                let n = neighbours[t as usize][i];
+                let outline = n == NO_NEIGHBOUR
+                    || (t < n && {
+                        let d = (corner(n, 0) + corner(n, 1) + corner(n, 2)) / 3.0;
+                        let (a, b, c) = (corner(t, i), corner(t, i + 1), corner(t, i + 2));
+                        edge_math::is_silhouette(a, b, c, d, eye)
+                    });
+                outline.then_some((t, i as u32))
+            })
+        })
+        .collect()
+}
+
+/// A visible stretch of an outline edge on screen: pixel coordinates and 1/w at both ends.
+#[derive(Clone, Copy, Debug)]
+struct Stretch {
+    from: DVec2,
+    to: DVec2,
+    inv_w: [f64; 2],
+}
+
+/// The outline map of `caster`'s mesh for `camera`, `style` and `size`.
+pub fn outline_map(
+    caster: &RayCaster<'_>,
+    camera: &Camera,
+    style: &Style,
+    size: (u32, u32),
+) -> OutlineMap {
+    let (width, height) = size;
+    let n = width as usize * height as usize;
+    let mut map = OutlineMap {
+        distance: vec![f64::INFINITY; n],
+        fade: vec![0.0; n],
+    };
+    if !style.silhouettes {
+        return map;
+    }
+    let mesh = caster.mesh();
+    let vp = camera.view_projection(width, height);
+    let inv = vp.inverse();
+    let view = View {
+        caster,
+        vp,
+        inv,
+        size: DVec2::new(f64::from(width), f64::from(height)),
+    };
+    let stretches: Vec<Stretch> = outline_edges(mesh, camera.eye.as_dvec3())
+        .into_par_iter()
+        .flat_map_iter(|(t, i)| view.visible_stretches(t, i))
+        .collect();
+
+    let reach = line_reach(f64::from(style.line_width));
+    let fade = style.fade_range().map(f64::from);
+    map.distance
+        .par_chunks_mut(width as usize)
+        .zip(map.fade.par_chunks_mut(width as usize))
+        .enumerate()
+        .for_each(|(y, (dist_row, fade_row))| {
+            let cy = y as f64 + 0.5;
+            for s in &stretches {
+                if (s.from.y.min(s.to.y) - reach) > cy || (s.from.y.max(s.to.y) + reach) < cy {
+                    continue;
+                }
+                let x0 = (s.from.x.min(s.to.x) - reach).floor().max(0.0) as usize;
+                let x1 = ((s.from.x.max(s.to.x) + reach).ceil() as usize).min(width as usize);
+                for (x, (d_out, f_out)) in dist_row
+                    .iter_mut()
+                    .zip(fade_row.iter_mut())
+                    .enumerate()
+                    .take(x1)
+                    .skip(x0)
+                {
+                    let p = DVec2::new(x as f64 + 0.5, cy);
+                    let (d, at) = segment_distance(p, s.from, s.to);
+                    if d < reach && d < *d_out {
+                        *d_out = d;
+                        let w = 1.0 / (s.inv_w[0] + (s.inv_w[1] - s.inv_w[0]) * at);
+                        *f_out = depth_fade(w, fade);
+                    }
+                }
+            }
+        });
+    map
+}
+
+/// Distance from `p` to the segment `a → b`, and the parameter of its nearest point.
+pub fn segment_distance(p: DVec2, a: DVec2, b: DVec2) -> (f64, f64) {
+    let seg = b - a;
+    let len2 = seg.length_squared();
+    let at = if len2 > 0.0 {
+        ((p - a).dot(seg) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (p.distance(a + seg * at), at)
+}
+
+struct View<'a> {
+    caster: &'a RayCaster<'a>,
+    vp: DMat4,
+    inv: DMat4,
+    size: DVec2,
+}
+
+impl View<'_> {
+    /// The visible stretches of edge `i` of triangle `t`.
+    fn visible_stretches(&self, t: u32, i: u32) -> Vec<Stretch> {
+        let mesh = self.caster.mesh();
+        let tri = mesh.triangles()[t as usize];
+        let n = mesh.edge_neighbours()[t as usize][i as usize];
+        let a = mesh.positions()[tri[i as usize] as usize].as_dvec3();
+        let b = mesh.positions()[tri[(i as usize + 1) % 3] as usize].as_dvec3();
+        let (ca, cb) = (self.vp * a.extend(1.0), self.vp * b.extend(1.0));
+        // In front of the near plane (clip z >= 0), not beyond the far plane (w - z >= 0).
+        let mut s = (0.0, 1.0);
+        keep_positive(&mut s, ca.z, cb.z);
+        keep_positive(&mut s, ca.w - ca.z, cb.w - cb.z);
+        if !(s.0 <= s.1) {
+            return Vec::new();
+        }
+        let (p0, iw0) = self.project(ca.lerp(cb, s.0));
+        let (p1, iw1) = self.project(ca.lerp(cb, s.1));
+        // Inside the image.
+        let d = p1 - p0;
+        let mut u = (0.0, 1.0);
+        keep_between(&mut u, p0.x, d.x, self.size.x);
+        keep_between(&mut u, p0.y, d.y, self.size.y);
+        if !(u.0 <= u.1) {
+            return Vec::new();
+        }
+        let point = |k: f64| p0 + d * k;
+        let inv_w = |k: f64| iw0 + (iw1 - iw0) * k;
+        let visible = |k: f64| self.visible(point(k), 1.0 / inv_w(k), t, n);
+
+        let length = d.length() * (u.1 - u.0);
+        let steps = (length * SAMPLES_PER_PIXEL).ceil().clamp(1.0, 65536.0) as usize;
+        let at = |j: usize| u.0 + (u.1 - u.0) * j as f64 / steps as f64;
+        let mut out = Vec::new();
+        let mut start = visible(u.0).then_some(u.0);
+        let mut last = (u.0, start.is_some());
+        for j in 1..=steps {
+            let k = at(j);
+            let now = visible(k);
+            if now != last.1 {
+                // Bisect the change between last.0 and k.
+                let (mut lo, mut hi) = (last.0, k);
+                for _ in 0..BISECTIONS {
+                    let mid = 0.5 * (lo + hi);
+                    if visible(mid) == last.1 {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                if now {
+                    start = Some(hi);
+                } else if let Some(from) = start.take() {
+                    out.push((from, lo));
+                }
+            }
+            last = (k, now);
+        }
+        if let Some(from) = start {
+            out.push((from, u.1));
+        }
+        out.into_iter()
+            .map(|(k0, k1)| Stretch {
+                from: point(k0),
+                to: point(k1),
+                inv_w: [inv_w(k0), inv_w(k1)],
+            })
+            .collect()
+    }
+
+    /// Pixel coordinates and 1/w of a clip-space point with w > 0.
+    fn project(&self, c: DVec4) -> (DVec2, f64) {
+        let inv_w = 1.0 / c.w;
+        let ndc = DVec2::new(c.x, c.y) * inv_w;
+        let xy = DVec2::new(0.5 * (ndc.x + 1.0), 0.5 * (1.0 - ndc.y)) * self.size;
+        (xy, inv_w)
+    }
+
+    /// True unless a triangle other than `t` and `n` covers screen point `x` nearer than
+    /// view depth `w`.
+    fn visible(&self, x: DVec2, w: f64, t: u32, n: u32) -> bool {
+        let ndc = DVec2::new(x.x / self.size.x * 2.0 - 1.0, 1.0 - x.y / self.size.y * 2.0);
+        let near = self.inv.project_point3(ndc.extend(0.0));
+        let far = self.inv.project_point3(ndc.extend(1.0));
+        match self.caster.cast(near, far) {
+            None => true,
+            Some(hit) => {
+                hit.id == t
+                    || hit.id == n
+                    || (self.vp * hit.point.extend(1.0)).w >= w * (1.0 - HIDDEN_MARGIN)
+            }
+        }
+    }
+}
+
+/// Narrows `range` to the parameters s where f0 + s (f1 − f0) ≥ 0.
+fn keep_positive(range: &mut (f64, f64), f0: f64, f1: f64) {
+    if f0 < 0.0 && f1 < 0.0 {
+        *range = (1.0, 0.0);
+    } else if f0 < 0.0 {
+        range.0 = range.0.max(f0 / (f0 - f1));
+    } else if f1 < 0.0 {
+        range.1 = range.1.min(f0 / (f0 - f1));
+    }
+}
+
+/// Narrows `range` to the parameters u where 0 ≤ p0 + u·d ≤ hi.
+fn keep_between(range: &mut (f64, f64), p0: f64, d: f64, hi: f64) {
+    if d == 0.0 {
+        if !(0.0..=hi).contains(&p0) {
+            *range = (1.0, 0.0);
+        }
+        return;
+    }
+    let (u0, u1) = (-p0 / d, (hi - p0) / d);
+    range.0 = range.0.max(u0.min(u1));
+    range.1 = range.1.min(u0.max(u1));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Mesh;
+    use glam::Vec3;
+
+    fn camera(eye: Vec3) -> Camera {
+        Camera {
+            eye,
+            target: Vec3::ZERO,
+            up: Vec3::Y,
+            fov_y_deg: 60.0,
+            near: 0.1,
+            far: 100.0,
+        }
+    }
+
+    #[test]
+    fn a_quad_has_its_four_sides_as_outline() {
+        let p = vec![
+            Vec3::new(-1.0, -1.0, 0.0),
+            Vec3::new(1.0, -1.0, 0.0),
+            Vec3::new(1.0, 1.0, 0.0),
+            Vec3::new(-1.0, 1.0, 0.0),
+        ];
+        let mesh = Mesh::new(p, None, vec![[0, 1, 2], [0, 2, 3]], None).unwrap();
+        let edges = outline_edges(&mesh, DVec3::new(0.2, 0.1, 3.0));
+        assert_eq!(edges.len(), 4, "{edges:?}");
+        // The diagonal (0, 2) is not: the two triangles lie on either side of it.
+        assert!(!edges.contains(&(0, 2)));
+    }
+
+    #[test]
+    fn a_fold_is_a_silhouette_only_when_seen_folded() {
+        // Two triangles hinged on the y axis, opening towards +z like a book.
+        let p = vec![
+            Vec3::new(0.0, -1.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+            Vec3::new(-1.0, 0.0, 1.0),
+            Vec3::new(1.0, 0.0, 1.0),
+        ];
+        let mesh = Mesh::new(p, None, vec![[0, 1, 2], [1, 0, 3]], None).unwrap();
+        let hinge = |eye: DVec3| outline_edges(&mesh, eye).contains(&(0, 0));
+        // From in front of the book or behind its spine the pages show on either side of the
+        // hinge.
+        assert!(!hinge(DVec3::new(0.0, 0.0, 3.0)));
+        assert!(!hinge(DVec3::new(0.0, 0.0, -3.0)));
+        // From off to one side, past a page's plane, both fold onto one side of it.
+        assert!(hinge(DVec3::new(5.0, 0.0, 0.5)));
+    }
+
+    #[test]
+    fn distances_reach_past_the_edge_over_the_background() {
+        let p = vec![
+            Vec3::new(-1.0, -1.0, 0.0),
+            Vec3::new(1.0, -1.0, 0.0),
+            Vec3::new(1.0, 1.0, 0.0),
+            Vec3::new(-1.0, 1.0, 0.0),
+        ];
+        let mesh = Mesh::new(p, None, vec![[0, 1, 2], [0, 2, 3]], None).unwrap();
+        let caster = RayCaster::new(&mesh);
+        let style = Style {
+            line_width: 4.0,
+            ..Style::default()
+        };
+        let size = (64, 64);
+        let map = outline_map(&caster, &camera(Vec3::new(0.0, 0.0, 4.0)), &style, size);
+        // The right side of the quad projects to a vertical line; pixels on both sides of it
+        // within reach have finite distances, symmetric about it.
+        let vp = camera(Vec3::new(0.0, 0.0, 4.0)).view_projection(64, 64);
+        let c = vp * DVec4::new(1.0, 0.0, 0.0, 1.0);
+        let x_edge = 0.5 * (c.x / c.w + 1.0) * 64.0;
+        let row = 32 * 64;
+        for x in 0..64 {
+            let d = map.distance[row + x];
+            let expect = (x as f64 + 0.5 - x_edge).abs();
+            if expect < line_reach(4.0) - 1e-9 {
+                assert!((d - expect).abs() < 1e-9, "x {x}: {d} vs {expect}");
+                assert_eq!(map.fade[row + x], 1.0);
+            } else if x as f64 > x_edge {
+                assert!(d.is_infinite(), "x {x}: {d}");
+            }
+        }
+    }
+
+    #[test]
+    fn hidden_stretches_are_not_drawn() {
+        // A far quad's right side, half hidden behind a near quad covering y < 0.
+        let p = vec![
+            Vec3::new(-1.0, -1.0, 0.0),
+            Vec3::new(1.0, -1.0, 0.0),
+            Vec3::new(1.0, 1.0, 0.0),
+            Vec3::new(-1.0, 1.0, 0.0),
+            Vec3::new(-2.0, -2.0, 1.0),
+            Vec3::new(2.0, -2.0, 1.0),
+            Vec3::new(2.0, 0.0, 1.0),
+            Vec3::new(-2.0, 0.0, 1.0),
+        ];
+        let tris = vec![[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]];
+        let mesh = Mesh::new(p, None, tris, None).unwrap();
+        let caster = RayCaster::new(&mesh);
+        let cam = camera(Vec3::new(0.0, 0.0, 4.0));
+        let view = View {
+            caster: &caster,
+            vp: cam.view_projection(64, 64),
+            inv: cam.view_projection(64, 64).inverse(),
+            size: DVec2::new(64.0, 64.0),
+        };
+        // Triangle 0's edge 1 runs from (1, -1) to (1, 1): visible only above y = 0, i.e. on
+        // screen from the middle row up, ending where the near quad's top edge crosses it.
+        let s = view.visible_stretches(0, 1);
+        assert_eq!(s.len(), 1, "{s:?}");
+        let top_of_near = {
+            let c = view.vp * DVec4::new(1.0, 0.0, 1.0, 1.0);
+            0.5 * (1.0 - c.y / c.w) * 64.0
+        };
+        let ys = [s[0].from.y, s[0].to.y];
+        let lower_end = ys[0].max(ys[1]);
+        assert!(
+            (lower_end - top_of_near).abs() < 1e-6,
+            "{ys:?} vs {top_of_near}"
+        );
+    }
+}

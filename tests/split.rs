@@ -1,0 +1,169 @@
+//! Meshes whose per-triangle buffers exceed `max_storage_buffer_binding_size` are bound as
+//! two ranges of one buffer (src/gpu/mesh.rs). On a device with a lowered limit, every method
+//! must render such a mesh exactly as a device that binds it whole does.
+
+mod common;
+
+use common::gpu;
+use glam::Vec3;
+use std::sync::{Mutex, MutexGuard};
+use wirepass::cli::CameraArgs;
+use wirepass::gpu::{DeferredPass, GpuContext, GpuMesh, PassOptions};
+use wirepass::mesh::Procedural;
+use wirepass::render::{render, Method, Scene};
+use wirepass::{EdgeSelection, Error, Style};
+
+/// 64 KiB: 5461 triangles of indices per binding.
+const SMALL: u32 = 1 << 16;
+
+/// The tests here hold a second device beside the shared one. wgpu's GL backend gives both
+/// devices one EGL context, and using them from two threads at once loses draws, so these
+/// tests take turns.
+static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
+
+fn small_device() -> (GpuContext, MutexGuard<'static, ()>) {
+    let turn = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let ctx = gpu();
+    let limits = wgpu::Limits {
+        max_storage_buffer_binding_size: SMALL.into(),
+        ..ctx.adapter.limits()
+    };
+    let small = GpuContext::with_limits(ctx.adapter.clone(), limits);
+    (small.expect("a device with a lowered limit"), turn)
+}
+
+#[test]
+fn a_mesh_split_over_two_bindings_renders_as_if_whole() {
+    let (small, _turn) = small_device();
+    // 8000 triangles (96 000 bytes of indices), 4002 vertices (48 024 bytes of positions).
+    let mesh = Procedural::Sphere(8000).build().unwrap();
+    assert!(mesh.triangle_count() as u32 * 12 > SMALL);
+    assert!(mesh.positions().len() as u32 * 12 <= SMALL);
+    let size = (128, 96);
+    // From below, where the triangles past the split lie.
+    let below = CameraArgs {
+        eye: Some(Vec3::new(0.6, -2.5, 1.2)),
+        ..CameraArgs::default()
+    };
+    let scene = Scene {
+        mesh: &mesh,
+        camera: below.camera(&mesh, size).unwrap(),
+        style: Style::default(),
+        size,
+        edges: EdgeSelection::All,
+    };
+    for method in [Method::Deferred, Method::Forward, Method::TwoPass] {
+        let whole = render(gpu(), &scene, method).unwrap();
+        let split = render(&small, &scene, method).unwrap();
+        assert!(whole.ids.iter().filter(|&&id| id != u32::MAX).count() > 2000);
+        // Both halves are drawn: ids on either side of the split appear.
+        let high = split
+            .ids
+            .iter()
+            .filter(|&&id| id != u32::MAX && id > 5461)
+            .count();
+        assert!(
+            high > 1000,
+            "{method:?}: {high} pixels from the second binding"
+        );
+        assert_eq!(whole.ids, split.ids, "{method:?} ids");
+        assert_eq!(whole.rgba, split.rgba, "{method:?} image");
+        let same = |a: f32, b: f32| a == b || (a.is_nan() && b.is_nan());
+        let distances = whole.edge_distance.iter().zip(&split.edge_distance);
+        assert!(
+            distances.clone().all(|(&a, &b)| same(a, b)),
+            "{method:?} distances"
+        );
+    }
+    small.finish().unwrap();
+}
+
+#[test]
+fn the_pulled_visibility_pass_reads_both_halves() {
+    let (small, _turn) = small_device();
+    let device = &small.device;
+    let mesh = Procedural::Sphere(8000).build().unwrap();
+    let gpu_mesh = GpuMesh::new(device, &mesh, EdgeSelection::All).unwrap();
+    let size = (128, 96);
+    let camera = CameraArgs::default().camera(&mesh, size).unwrap();
+    let ids = |pulled: bool| {
+        let options = PassOptions::default();
+        let mut pass = if pulled {
+            DeferredPass::with_vertex_pulling(device, options)
+        } else {
+            DeferredPass::new(device, options)
+        }
+        .unwrap();
+        pass.prepare(
+            device,
+            &small.queue,
+            &gpu_mesh,
+            &camera,
+            &Style::default(),
+            size,
+        )
+        .unwrap();
+        let mut encoder = device.create_command_encoder(&Default::default());
+        pass.encode_visibility(device, &mut encoder, &gpu_mesh)
+            .unwrap();
+        small.queue.submit([encoder.finish()]);
+        small.finish().unwrap();
+        let t = pass.id_texture().unwrap();
+        wirepass::gpu::read_texture(device, &small.queue, t, wgpu::TextureAspect::All).unwrap()
+    };
+    assert_eq!(ids(true), ids(false));
+}
+
+#[test]
+fn a_mesh_past_two_bindings_is_a_clear_error() {
+    let (small, _turn) = small_device();
+    // 12 000 triangles (144 000 bytes of indices, more than two 64 KiB bindings) over 100
+    // vertices, so the indices are the one buffer past the limit.
+    let positions: Vec<Vec3> = (0..100)
+        .map(|i| Vec3::new((i % 10) as f32, (i / 10) as f32, (i % 7) as f32))
+        .collect();
+    let triangles: Vec<[u32; 3]> = (0..12_000u32)
+        .map(|t| [t % 100, (t * 7 + 1) % 100, (t * 13 + 5) % 100])
+        .filter(|[a, b, c]| a != b && b != c && a != c)
+        .collect();
+    assert!(triangles.len() * 12 > 2 * SMALL as usize);
+    let mesh = wirepass::Mesh::new(positions, None, triangles, None).unwrap();
+    let e = match GpuMesh::new(&small.device, &mesh, EdgeSelection::All) {
+        Ok(_) => panic!("{} triangles fit", mesh.triangle_count()),
+        Err(e) => e,
+    };
+    assert!(matches!(e, Error::OverLimit { .. }), "{e:?}");
+    let msg = e.to_string();
+    assert!(
+        msg.contains("max_storage_buffer_binding_size × 2 = 131072") && msg.contains("(by "),
+        "{msg}"
+    );
+}
+
+#[test]
+fn an_image_past_the_outline_buffer_limit_is_a_clear_error() {
+    let (small, _turn) = small_device();
+    let device = &small.device;
+    let mesh = Procedural::Sphere(200).build().unwrap();
+    let gpu_mesh = GpuMesh::new(device, &mesh, EdgeSelection::All).unwrap();
+    let mut pass = DeferredPass::new(device, PassOptions::default()).unwrap();
+    // 4 bytes a pixel: 160 × 120 needs 76 800 bytes, over 64 KiB.
+    let size = (160, 120);
+    let camera = CameraArgs::default().camera(&mesh, size).unwrap();
+    let e = pass
+        .prepare(
+            device,
+            &small.queue,
+            &gpu_mesh,
+            &camera,
+            &Style::default(),
+            size,
+        )
+        .unwrap_err();
+    let msg = e.to_string();
+    assert!(
+        msg.contains("outline buffer") && msg.contains("max_storage_buffer_binding_size = 65536"),
+        "{msg}"
+    );
+    small.finish().unwrap();
+}
