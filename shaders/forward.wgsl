@@ -140,7 +140,8 @@ fn nearest(in: Varyings) -> f32 {
 
 fn shaded(in: Varyings, d: f32) -> vec4<f32> {
     let surface = surface_color(frame, in.world, in.normal, in.face_normal);
-    let i = line_intensity(d, frame.line_width);
+    let w = (frame.view_proj * vec4<f32>(in.world, 1.0)).w;
+    let i = line_intensity(d, frame.line_width) * depth_fade(w, frame.fade);
     return vec4<f32>(mix(surface, frame.wire_color.rgb, i * frame.wire_color.a), 1.0);
 }
 

@@ -59,20 +59,28 @@ fn fs_fill_maps(in: FillVaryings) -> FillMaps {
     return FillMaps(encode_output(fill_color(in)), in.id, diag);
 }
 
-// Lines: the mesh's positions as a vertex buffer, the edge list as the index buffer.
-@vertex
-fn vs_line(@location(0) p: vec3<f32>) -> @builtin(position) vec4<f32> {
-    return reverse_z(frame.view_proj, frame.depth_row, p);
+struct LineVaryings {
+    @builtin(position) clip: vec4<f32>,
+    // View depth, for the depth fade; affine along the line, so interpolated exactly.
+    @location(0) w: f32,
 }
 
-// The wire colour with its alpha; the pipeline blends it over the fill.
-fn line_color() -> vec4<f32> {
-    return vec4<f32>(encode_output(vec4<f32>(frame.wire_color.rgb, 1.0)).rgb, frame.wire_color.a);
+// Lines: the mesh's positions as a vertex buffer, the edge list as the index buffer.
+@vertex
+fn vs_line(@location(0) p: vec3<f32>) -> LineVaryings {
+    let clip = reverse_z(frame.view_proj, frame.depth_row, p);
+    return LineVaryings(clip, clip.w);
+}
+
+// The wire colour with its alpha and the depth fade; the pipeline blends it over the fill.
+fn line_color(in: LineVaryings) -> vec4<f32> {
+    let alpha = frame.wire_color.a * depth_fade(in.w, frame.fade);
+    return vec4<f32>(encode_output(vec4<f32>(frame.wire_color.rgb, 1.0)).rgb, alpha);
 }
 
 @fragment
-fn fs_line() -> @location(0) vec4<f32> {
-    return line_color();
+fn fs_line(in: LineVaryings) -> @location(0) vec4<f32> {
+    return line_color(in);
 }
 
 struct LineMaps {
@@ -84,6 +92,6 @@ struct LineMaps {
 }
 
 @fragment
-fn fs_line_maps() -> LineMaps {
-    return LineMaps(line_color(), 0xffffffffu, vec4<u32>(0u)); // 0u = bits of 0.0
+fn fs_line_maps(in: LineVaryings) -> LineMaps {
+    return LineMaps(line_color(in), 0xffffffffu, vec4<u32>(0u)); // 0u = bits of 0.0
 }

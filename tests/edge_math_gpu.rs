@@ -256,22 +256,6 @@ fn cases() -> Vec<Case> {
 
 /// Runs the table through `edge_eval` and `line_intensity` on the GPU.
 fn run_gpu(cases: &[Case]) -> Vec<[Vec4; 2]> {
-    let ctx = gpu();
-    let device = &ctx.device;
-    let source = shaders::assemble(SHADER);
-    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("edge_eval test"),
-        source: wgpu::ShaderSource::Wgsl(source.into()),
-    });
-    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: Some("edge_eval test"),
-        layout: None,
-        module: &module,
-        entry_point: Some("main"),
-        compilation_options: Default::default(),
-        cache: None,
-    });
     let input: Vec<Vec4> = cases
         .iter()
         .flat_map(|c| {
@@ -284,12 +268,35 @@ fn run_gpu(cases: &[Case]) -> Vec<[Vec4; 2]> {
             ]
         })
         .collect();
+    let data = run_shader(SHADER, &input, cases.len() * 2);
+    data.chunks_exact(2).map(|c| [c[0], c[1]]).collect()
+}
+
+/// Runs `body` (assembled after common.wgsl; entry point `main`, storage `cases` in and
+/// `results` out, both arrays of vec4<f32>) over `input`, returning `outputs` vec4s.
+fn run_shader(body: &str, input: &[Vec4], outputs: usize) -> Vec<Vec4> {
+    let ctx = gpu();
+    let device = &ctx.device;
+    let source = shaders::assemble(body);
+    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("common.wgsl test"),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    });
+    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some("common.wgsl test"),
+        layout: None,
+        module: &module,
+        entry_point: Some("main"),
+        compilation_options: Default::default(),
+        cache: None,
+    });
     let input = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("cases"),
-        contents: bytemuck::cast_slice(&input),
+        contents: bytemuck::cast_slice(input),
         usage: wgpu::BufferUsages::STORAGE,
     });
-    let bytes = (cases.len() * 2 * 16) as u64;
+    let bytes = (outputs * 16) as u64;
     let output = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("results"),
         size: bytes,
@@ -324,14 +331,137 @@ fn run_gpu(cases: &[Case]) -> Vec<[Vec4; 2]> {
         let mut pass = encoder.begin_compute_pass(&Default::default());
         pass.set_pipeline(&pipeline);
         pass.set_bind_group(0, &group, &[]);
-        pass.dispatch_workgroups((cases.len() as u32).div_ceil(64), 1, 1);
+        pass.dispatch_workgroups((outputs as u32).div_ceil(64), 1, 1);
     }
     encoder.copy_buffer_to_buffer(&output, 0, &readback, 0, bytes);
     ctx.queue.submit([encoder.finish()]);
     readback.map_async(wgpu::MapMode::Read, .., |r| r.expect("map"));
     ctx.finish().unwrap_or_else(|e| panic!("{e}"));
-    let data: Vec<Vec4> = bytemuck::pod_collect_to_vec(&readback.get_mapped_range(..).unwrap());
-    data.chunks_exact(2).map(|c| [c[0], c[1]]).collect()
+    bytemuck::pod_collect_to_vec(&readback.get_mapped_range(..).unwrap())
+}
+
+const OUTLINE_SHADER: &str = r#"
+@group(0) @binding(0) var<storage, read> cases: array<vec4<f32>>;
+@group(0) @binding(1) var<storage, read_write> results: array<vec4<f32>>;
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if 6u * i >= arrayLength(&cases) {
+        return;
+    }
+    let a = cases[6u * i].xyz;
+    let b = cases[6u * i + 1u].xyz;
+    let c = cases[6u * i + 2u].xyz;
+    let d = cases[6u * i + 3u].xyz;
+    let eye = cases[6u * i + 4u].xyz;
+    let line = cases[6u * i + 5u];
+    let fold = select(0.0, 1.0, is_silhouette(a, b, c, d, eye));
+    results[i] = vec4<f32>(fold, depth_fade(line.x, line.yz), line_reach(line.w), 0.0);
+}
+"#;
+
+/// `is_silhouette`, `depth_fade` and `line_reach` in WGSL against their Rust twins, on
+/// random folds seen from random eyes (classification margins well above f32 rounding) and
+/// hand-picked ones: a flat pair, a fold seen edge-on, an eye far away.
+#[test]
+fn wgsl_outline_math_matches_rust() {
+    // A small deterministic generator: the cases must not change between runs.
+    let mut state = 0x2545_f491_4f6c_dd1d_u64;
+    let mut next = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+    };
+    let mut rows: Vec<[DVec3; 5]> = vec![
+        // Flat: the two triangles on either side of the edge, eye above.
+        [
+            DVec3::X * -1.0,
+            DVec3::X,
+            DVec3::Y,
+            -DVec3::Y,
+            DVec3::Z * 3.0,
+        ],
+        // A closed fold (both on one side), eye above.
+        [
+            DVec3::X * -1.0,
+            DVec3::X,
+            DVec3::new(0.0, 1.0, 0.1),
+            DVec3::new(0.0, 1.0, -0.1),
+            DVec3::Z * 3.0,
+        ],
+        // An open book seen from far away along its bisector.
+        [
+            DVec3::new(0.0, -1.0, 0.0),
+            DVec3::Y,
+            DVec3::new(-1.0, 0.0, 1.0),
+            DVec3::new(1.0, 0.0, 1.0),
+            DVec3::Z * 1e4,
+        ],
+    ];
+    for _ in 0..500 {
+        let mut v = || DVec3::new(next(), next(), next());
+        let row = [v(), v(), v(), v(), v() * 10.0];
+        let [a, b, c, d, eye] = row;
+        let side = |p: DVec3| (a - eye).dot((b - a).cross(p - a));
+        let scale = (a - eye).length() * (b - a).length();
+        // Keep cases whose sides are clear of rounding.
+        if side(c).abs() > 1e-3 * scale * (c - a).length()
+            && side(d).abs() > 1e-3 * scale * (d - a).length()
+        {
+            rows.push(row);
+        }
+    }
+    let fades: Vec<[f64; 4]> = (0..rows.len())
+        .map(|i| {
+            let w = 10.0 * (next() + 1.0);
+            let start = 5.0 * (next() + 1.0);
+            let end = if i % 5 == 0 {
+                start
+            } else {
+                start + 4.0 * (next() + 1.0)
+            };
+            [w, start, end, 8.0 * (next() + 1.0)]
+        })
+        .collect();
+    let input: Vec<Vec4> = rows
+        .iter()
+        .zip(&fades)
+        .flat_map(|(r, f)| {
+            let mut v: Vec<Vec4> = r.iter().map(|p| p.as_vec3().extend(0.0)).collect();
+            v.push(glam::DVec4::from_array(*f).as_vec4());
+            v
+        })
+        .collect();
+    let got = run_shader(OUTLINE_SHADER, &input, rows.len());
+    let mut folded = 0;
+    for (k, ((row, fade), g)) in rows.iter().zip(&fades).zip(&got).enumerate() {
+        // The Rust side gets the same f32-rounded inputs.
+        let [a, b, c, d, eye] = row.map(|p| p.as_vec3().as_dvec3());
+        let want = edge_math::is_silhouette(a, b, c, d, eye);
+        folded += usize::from(want);
+        assert_eq!(g.x == 1.0, want, "case {k}: is_silhouette");
+        let f = fade.map(|x| f64::from(x as f32));
+        let want_fade = wirepass::style::depth_fade(f[0], [f[1], f[2]]);
+        assert!((want_fade - f64::from(g.y)).abs() < 1e-6, "case {k}: fade");
+        let want_reach = wirepass::style::line_reach(f[3]);
+        assert!(
+            (want_reach - f64::from(g.z)).abs() < 1e-6,
+            "case {k}: reach"
+        );
+    }
+    assert!(!edge_math::is_silhouette(
+        rows[0][0], rows[0][1], rows[0][2], rows[0][3], rows[0][4]
+    ));
+    assert!(edge_math::is_silhouette(
+        rows[1][0], rows[1][1], rows[1][2], rows[1][3], rows[1][4]
+    ));
+    assert!(
+        folded > 50 && folded + 50 < rows.len(),
+        "{folded} of {}",
+        rows.len()
+    );
 }
 
 const EPS32: f64 = f32::EPSILON as f64;
