@@ -104,6 +104,10 @@ fn bad_settings_give_one_clear_line() {
             "/no/such/mesh.obj",
         ),
         (&["render", "--method", "magic", "-o", o], "method"),
+        (&["render", "--silhouettes", "maybe", "-o", o], "on or off"),
+        (&["render", "--depth-fade", "5", "-o", o], "START:END"),
+        (&["render", "--depth-fade", "5:1", "-o", o], "depth fade"),
+        (&["render", "--line-width", "1000", "-o", o], "line width"),
     ];
     for (args, expect) in cases {
         let (ok, err) = wirepass(args);

@@ -1,0 +1,152 @@
+//! Outlines and the depth fade, against the ground truth: the deferred pass draws outlines
+//! at full width, the forward baselines at half (their error), and every method fades lines
+//! with depth by the one profile.
+
+mod common;
+
+use common::{gpu, load};
+use wirepass::compare::metrics;
+use wirepass::raycast::render_raycast;
+use wirepass::render::{render, Frame, Method, Scene};
+use wirepass::style::{line_intensity, DepthFade};
+use wirepass::{Camera, EdgeSelection, Mesh, Style};
+
+const SIZE: (u32, u32) = (256, 256);
+
+fn scene<'a>(mesh: &'a Mesh, style: Style) -> Scene<'a> {
+    let (lo, hi) = mesh.bounds();
+    Scene {
+        mesh,
+        camera: Camera::framing(lo, hi, 1.0),
+        style,
+        size: SIZE,
+        edges: EdgeSelection::Feature(30.0),
+    }
+}
+
+fn draw(scene: &Scene<'_>, method: Method) -> Frame {
+    render(gpu(), scene, method).unwrap_or_else(|e| panic!("{method:?}: {e}"))
+}
+
+/// fandisk, feature edges at 3 px: the outer half of the outline lies over the background.
+/// The deferred pass draws it where the ground truth does; the forward baseline cannot
+/// colour pixels outside its triangles, so those pixels have no line at all. (The two-pass
+/// baseline's 1 px hardware lines spill either side of an edge at any width.)
+#[test]
+fn outlines_reach_over_the_background_in_deferred_only() {
+    let mesh = load("fandisk.obj");
+    let style = Style {
+        line_width: 3.0,
+        ..Style::default()
+    };
+    let scene = scene(&mesh, style);
+    let truth = render_raycast(&scene).unwrap_or_else(|e| panic!("{e}"));
+    let deferred = draw(&scene, Method::Deferred);
+    let forward = draw(&scene, Method::Forward);
+    // Background pixels in the core of the outline (full line colour: within 0.5 px).
+    let outer: Vec<usize> = (0..truth.ids.len())
+        .filter(|&i| truth.ids[i] == u32::MAX && truth.edge_distance[i] < 0.5)
+        .collect();
+    assert!(outer.len() > 200, "{} outer outline pixels", outer.len());
+    for &i in &outer {
+        assert_eq!(deferred.ids[i], u32::MAX);
+        let err = (deferred.edge_distance[i] - truth.edge_distance[i]).abs();
+        assert!(err < 0.01, "pixel {i}: deferred {}", deferred.edge_distance[i]);
+        assert!(forward.edge_distance[i].is_infinite() || forward.ids[i] != u32::MAX);
+    }
+    // The whole outline's width: pixels with full line colour, counted on each side.
+    let dark = |f: &Frame| {
+        (0..f.ids.len())
+            .filter(|&i| line_intensity(f64::from(f.edge_distance[i]), 3.0) > 0.99)
+            .count()
+    };
+    let (t, d, fw) = (dark(&truth), dark(&deferred), dark(&forward));
+    assert!(
+        (d as f64 - t as f64).abs() < 0.01 * t as f64,
+        "truth {t}, deferred {d}"
+    );
+    assert!(fw + outer.len() / 2 < t, "forward {fw} of {t}");
+    let m = metrics(&truth, &forward).unwrap();
+    assert!(m.distance_error_px.max.unwrap_or(0.0) > 1.0, "{m:?}");
+}
+
+/// With outlines off the deferred pass draws the edge inside its triangles, like the forward
+/// method: no background pixel has a line.
+#[test]
+fn outlines_off_keep_lines_inside_their_triangles() {
+    let mesh = load("fandisk.obj");
+    let style = Style {
+        line_width: 3.0,
+        silhouettes: false,
+        ..Style::default()
+    };
+    let scene = scene(&mesh, style);
+    let deferred = draw(&scene, Method::Deferred);
+    let truth = render_raycast(&scene).unwrap_or_else(|e| panic!("{e}"));
+    for f in [&deferred, &truth] {
+        let lined_background = (0..f.ids.len())
+            .filter(|&i| f.ids[i] == u32::MAX && f.edge_distance[i].is_finite())
+            .count();
+        assert_eq!(lined_background, 0);
+    }
+    let m = metrics(&truth, &deferred).unwrap();
+    assert!(m.distance_error_px.max.unwrap() < 0.1, "{m:?}");
+}
+
+/// The depth fade over the middle fifth of the visible depths. The deferred image matches
+/// the ground truth's; in every method the lines in front of the fade are untouched and those
+/// behind it are gone.
+#[test]
+fn lines_fade_with_depth_in_every_method() {
+    let mesh = load("suzanne.obj");
+    let base = Style {
+        line_width: 2.0,
+        silhouettes: false,
+        ..Style::default()
+    };
+    let plain = scene(&mesh, base.clone());
+    let without_truth = render_raycast(&plain).unwrap_or_else(|e| panic!("{e}"));
+    // View depth per covered pixel, from the 0..1 depth of `perspective_rh`.
+    let (n, f) = (f64::from(plain.camera.near), f64::from(plain.camera.far));
+    let view_depth = |frame: &Frame, i: usize| {
+        let z = f64::from(frame.depth[i]);
+        n * f / (f - z * (f - n))
+    };
+    let mut depths: Vec<f64> = (0..without_truth.ids.len())
+        .filter(|&i| without_truth.ids[i] != u32::MAX)
+        .map(|i| view_depth(&without_truth, i))
+        .collect();
+    depths.sort_by(f64::total_cmp);
+    let at = |q: f64| depths[(q * depths.len() as f64) as usize];
+    let (start, end) = (at(0.4), at(0.6));
+    let fading = scene(
+        &mesh,
+        Style {
+            depth_fade: Some(DepthFade {
+                start: start as f32,
+                end: end as f32,
+            }),
+            ..base
+        },
+    );
+    let truth = render_raycast(&fading).unwrap_or_else(|e| panic!("{e}"));
+    let deferred = draw(&fading, Method::Deferred);
+    let m = metrics(&truth, &deferred).unwrap();
+    assert!(m.image_difference.flip_mean < 2e-3, "{m:?}");
+    for method in [Method::Deferred, Method::Forward, Method::TwoPass] {
+        let with = draw(&fading, method);
+        let without = draw(&plain, method);
+        assert_eq!(with.ids, without.ids, "{method:?}: the fade changes no coverage");
+        // How much lighter the red channel gets, over pixels in front of the fade and behind.
+        let lightening = |keep: &dyn Fn(f64) -> bool| -> f64 {
+            (0..with.ids.len())
+                .filter(|&i| with.ids[i] != u32::MAX && keep(view_depth(&without, i)))
+                .map(|i| f64::from(with.rgba[4 * i]) - f64::from(without.rgba[4 * i]))
+                .sum()
+        };
+        let near = lightening(&|w| w < 0.99 * start);
+        let far = lightening(&|w| w > 1.01 * end);
+        assert!(near.abs() < 200.0, "{method:?}: in front of the fade {near}");
+        assert!(far > 10_000.0, "{method:?}: behind the fade {far}");
+    }
+}
