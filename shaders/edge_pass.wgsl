@@ -8,7 +8,8 @@
 @group(0) @binding(1) var<storage, read> positions: array<f32>;
 @group(0) @binding(2) var<storage, read> normals: array<f32>;
 @group(0) @binding(3) var<storage, read> indices: array<u32>;
-// Edge masks, 8 bits per triangle, 4 triangles per word.
+// A byte per triangle, 4 triangles per word: bits 0-2 the drawn edges, bits 3-7 the outline
+// hints (Mesh::outline_hints: bit 3 a boundary edge, bits 4-7 the fold bound).
 @group(0) @binding(4) var<storage, read> edge_masks: array<u32>;
 @group(0) @binding(5) var ids: texture_2d<u32>;
 // The triangle across each edge (3 per triangle, edge i = corner i -> i+1), or

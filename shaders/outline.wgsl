@@ -34,16 +34,37 @@ fn outline_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     }
     let v = corners(t);
     var p = array<vec3<f32>, 3>(position(v.x), position(v.y), position(v.z));
+    // Most triangles are seen well away from edge-on, further than their edges fold: none of
+    // their neighboured edges can be a silhouette (Mesh::outline_hints), and they skip the
+    // neighbours' vertices. The angle is taken from the triangle's farthest vertex, its least.
+    let hints = (edge_masks[t >> 2u] >> ((t & 3u) * 8u + 3u)) & 31u;
+    let boundary = (hints & 1u) != 0u;
+    // Decoded as adjacency::fold_bound: 0 flat, 2^(q - 14) with a margin, 15 never skip.
+    let q = hints >> 1u;
+    var fold_bound = exp2(f32(q) - 14.0) * 1.01 + 1e-6;
+    if q == 0u {
+        fold_bound = 1e-6;
+    } else if q == 15u {
+        fold_bound = 2.0;
+    }
+    let normal = cross(p[1] - p[0], p[2] - p[0]);
+    let eye = frame.eye.xyz;
+    let height = abs(dot(p[0] - eye, normal));
+    let farthest = sqrt(max(dot(p[0] - eye, p[0] - eye), max(dot(p[1] - eye, p[1] - eye), dot(p[2] - eye, p[2] - eye))));
+    let may_fold = !(height > fold_bound * farthest * length(normal));
+    if !may_fold && !boundary {
+        return;
+    }
     for (var i = 0u; i < 3u; i++) {
         let n = neighbour(t, i);
         let a = p[i];
         let b = p[(i + 1u) % 3u];
         var outline = n == BACKGROUND_ID;
-        if !outline && t < n {
+        if !outline && may_fold && t < n {
             // Shared edges are drawn by the lower id only.
             let w = corners(n);
             let d = (position(w.x) + position(w.y) + position(w.z)) / 3.0;
-            outline = is_silhouette(a, b, p[(i + 2u) % 3u], d, frame.eye.xyz);
+            outline = is_silhouette(a, b, p[(i + 2u) % 3u], d, eye);
         }
         if outline {
             draw_outline(t, n, a, b);

@@ -117,35 +117,43 @@ impl Subject {
     }
 }
 
-/// Times every method on `mesh` at `size`, with the framing camera and the default style:
-/// see [`bench_scene`].
+/// How many frames a benchmark times, after how many untimed ones.
+#[derive(Clone, Copy, Debug)]
+pub struct Timing {
+    /// Timed frames.
+    pub frames: u32,
+    /// Untimed frames first.
+    pub warmup: u32,
+}
+
+/// Times every method on `mesh` at `size`, with the framing camera and `style`: see
+/// [`bench_scene`].
 pub fn bench(
     ctx: &GpuContext,
     name: &str,
     mesh: &Mesh,
     size: (u32, u32),
-    frames: u32,
-    warmup: u32,
+    style: &Style,
+    timing: Timing,
 ) -> Result<Vec<Run>> {
     let (lo, hi) = mesh.bounds();
     let scene = Scene {
         mesh,
         camera: Camera::framing(lo, hi, size.0 as f32 / size.1 as f32),
-        style: Style::default(),
+        style: style.clone(),
         size,
         edges: EdgeSelection::Polygon,
     };
-    bench_scene(ctx, name, &scene, frames, warmup)
+    bench_scene(ctx, name, &scene, timing)
 }
 
-/// Times the floor and every GPU method on `scene`: `warmup` untimed frames, then `frames`
-/// timed frames, each frame running every method once, in turn.
+/// Times the floor and every GPU method on `scene`: `timing.warmup` untimed frames, then
+/// `timing.frames` timed frames, each frame running every method once, in turn.
 pub fn bench_scene(
     ctx: &GpuContext,
     name: &str,
     scene: &Scene<'_>,
-    frames: u32,
-    warmup: u32,
+    Timing { frames, warmup }: Timing,
 ) -> Result<Vec<Run>> {
     if frames == 0 {
         return Err(Error::InvalidSetting("--frames must be at least 1".into()));

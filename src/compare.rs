@@ -330,7 +330,11 @@ const WARM_UP_FRAMES: u32 = 3;
 /// GPU time of each method's passes for `scene` in milliseconds (median over frames, methods
 /// interleaved frame by frame, see [`crate::bench`]), with a note on how it was taken.
 fn gpu_times(ctx: &GpuContext, scene: &Scene<'_>) -> (BTreeMap<String, f64>, String) {
-    match crate::bench::bench_scene(ctx, "compare", scene, TIMED_FRAMES, WARM_UP_FRAMES) {
+    let timing = crate::bench::Timing {
+        frames: TIMED_FRAMES,
+        warmup: WARM_UP_FRAMES,
+    };
+    match crate::bench::bench_scene(ctx, "compare", scene, timing) {
         Ok(runs) => (
             runs.into_iter()
                 .map(|r| (r.method, r.total_median_ms))

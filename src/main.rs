@@ -209,6 +209,10 @@ struct BenchArgs {
     /// Directory for bench.json, bench.csv and the plots.
     #[arg(long)]
     out: PathBuf,
+    /// Time the deferred method with its outline pass (on) or without (off, the same lines
+    /// the forward baselines draw).
+    #[arg(long, default_value = "on", value_parser = parse_switch, action = clap::ArgAction::Set)]
+    silhouettes: bool,
 }
 
 fn bench_command(args: &BenchArgs) -> Result<()> {
@@ -234,13 +238,16 @@ fn bench_command(args: &BenchArgs) -> Result<()> {
         let mesh = load_mesh(spec)?;
         for &size in &sizes {
             progress.set_message(format!("{name} at {}x{}", size.0, size.1));
+            let style = Style {
+                silhouettes: args.silhouettes,
+                ..Style::default()
+            };
+            let timing = wirepass::bench::Timing {
+                frames: args.frames,
+                warmup: args.warmup,
+            };
             runs.extend(wirepass::bench::bench(
-                &ctx,
-                name,
-                &mesh,
-                size,
-                args.frames,
-                args.warmup,
+                &ctx, name, &mesh, size, &style, timing,
             )?);
             progress.inc(1);
         }

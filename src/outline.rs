@@ -307,6 +307,81 @@ mod tests {
         assert!(!edges.contains(&(0, 2)));
     }
 
+    /// The outline pass skips a triangle seen further from edge-on than its edges fold
+    /// (`Mesh::outline_hints`, outline.wgsl); no skipped triangle may have a silhouette edge.
+    #[test]
+    fn outline_hints_never_skip_a_silhouette() {
+        let meshes = [
+            crate::mesh::Procedural::Sphere(2000).build().unwrap(),
+            crate::mesh::Procedural::Torus(3000).build().unwrap(),
+            crate::mesh::Procedural::Layers(3).build().unwrap(),
+        ];
+        let mut skipped = 0;
+        let mut total = 0;
+        for mesh in &meshes {
+            let hints = mesh.outline_hints();
+            let p = |v: u32| mesh.positions()[v as usize].as_dvec3();
+            for k in 0..40 {
+                let a = f64::from(k) * 0.7;
+                let eye =
+                    DVec3::new(a.cos(), (0.37 * a).sin(), a.sin()) * (1.2 + 0.1 * f64::from(k));
+                let outline: std::collections::HashSet<u32> = outline_edges(mesh, eye)
+                    .into_iter()
+                    .map(|(t, _)| t)
+                    .collect();
+                for (t, tri) in mesh.triangles().iter().enumerate() {
+                    let [a, b, c] = tri.map(p);
+                    let normal = (b - a).cross(c - a);
+                    let farthest = [a, b, c]
+                        .map(|v| (v - eye).length())
+                        .into_iter()
+                        .fold(0.0, f64::max);
+                    let bound = crate::mesh::adjacency::fold_bound(hints[t] >> 1);
+                    let skip = (a - eye).dot(normal).abs() > bound * farthest * normal.length();
+                    let neighboured = mesh.edge_neighbours()[t].iter().any(|&n| n != NO_NEIGHBOUR);
+                    total += 1;
+                    if skip && hints[t] & 1 == 0 && neighboured {
+                        skipped += 1;
+                        // A silhouette is listed under its lower id; check both sides.
+                        let has = outline.contains(&(t as u32))
+                            || mesh.edge_neighbours()[t]
+                                .iter()
+                                .any(|&n| outline_edges_of(mesh, eye, n).contains(&(t as u32)));
+                        assert!(!has, "triangle {t} skipped but has a silhouette, eye {eye}");
+                    }
+                }
+            }
+        }
+        assert!(skipped * 2 > total, "only {skipped} of {total} skipped");
+    }
+
+    /// The neighbours of `n` across its silhouette edges.
+    fn outline_edges_of(mesh: &Mesh, eye: DVec3, n: u32) -> Vec<u32> {
+        if n == NO_NEIGHBOUR {
+            return Vec::new();
+        }
+        let p = |v: u32| mesh.positions()[v as usize].as_dvec3();
+        let tri = mesh.triangles()[n as usize];
+        (0..3)
+            .filter_map(|i| {
+                let m = mesh.edge_neighbours()[n as usize][i];
+                if m == NO_NEIGHBOUR {
+                    return None;
+                }
+                let other = mesh.triangles()[m as usize].map(p);
+                let d = (other[0] + other[1] + other[2]) / 3.0;
+                edge_math::is_silhouette(
+                    p(tri[i]),
+                    p(tri[(i + 1) % 3]),
+                    p(tri[(i + 2) % 3]),
+                    d,
+                    eye,
+                )
+                .then_some(m)
+            })
+            .collect()
+    }
+
     #[test]
     fn a_fold_is_a_silhouette_only_when_seen_folded() {
         // Two triangles hinged on the y axis, opening towards +z like a book.

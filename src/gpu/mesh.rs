@@ -40,8 +40,7 @@ impl GpuMesh {
             .collect();
         let normals: Vec<f32> = mesh.normals().iter().flat_map(|n| n.to_array()).collect();
         let indices: &[u32] = bytemuck::cast_slice(mesh.triangles());
-        let mut masks = mesh.edge_mask(edges);
-        masks.resize(masks.len().div_ceil(4) * 4, 0);
+        let masks = packed_masks(mesh, edges);
         let neighbours: &[u32] = bytemuck::cast_slice(mesh.edge_neighbours());
         let storage = wgpu::BufferUsages::STORAGE;
         let create = |label, contents: &[u8], usage| {
@@ -129,11 +128,22 @@ impl GpuMesh {
                 self.triangles
             )));
         }
-        let mut masks = mesh.edge_mask(edges);
-        masks.resize(masks.len().div_ceil(4) * 4, 0);
-        queue.write_buffer(&self.edge_masks, 0, &masks);
+        queue.write_buffer(&self.edge_masks, 0, &packed_masks(mesh, edges));
         Ok(())
     }
+}
+
+/// A byte per triangle, padded to whole words: the edge mask in bits 0–2 and the outline
+/// hints (`Mesh::outline_hints`) in bits 3–7.
+fn packed_masks(mesh: &Mesh, edges: EdgeSelection) -> Vec<u8> {
+    let mut masks: Vec<u8> = mesh
+        .edge_mask(edges)
+        .iter()
+        .zip(mesh.outline_hints())
+        .map(|(m, h)| m | (h << 3))
+        .collect();
+    masks.resize(masks.len().div_ceil(4) * 4, 0);
+    masks
 }
 
 /// Where the per-triangle buffers (indices, neighbours: 12 bytes a triangle) split into two

@@ -8,6 +8,77 @@ use std::collections::HashMap;
 /// triangles (non-manifold).
 pub const NO_NEIGHBOUR: u32 = u32::MAX;
 
+/// The fold bound code meaning "may be a silhouette from any view".
+pub const ANY_FOLD: u8 = 15;
+
+/// The bound on sin(fold) that code `q` of [`outline_hints`] stands for: 0 for flat, then
+/// powers of two from 2⁻¹³ to 1, and above 1 (never skip) for [`ANY_FOLD`]; with a 1 %
+/// and 10⁻⁶ margin for f32 rounding. Twin of the decoding in outline.wgsl.
+pub fn fold_bound(q: u8) -> f64 {
+    match q {
+        0 => 1e-6,
+        ANY_FOLD.. => 2.0,
+        _ => (f64::from(q) - 14.0).exp2() * 1.01 + 1e-6,
+    }
+}
+
+/// Per triangle, `(q << 1) | boundary` (see `Mesh::outline_hints`). The fold of an edge is
+/// how far its two triangles are from lying flat, π minus the angle between them around the
+/// edge, whatever their winding. If a triangle's plane is seen at an angle α (from the eye)
+/// greater than its edges' largest fold φ, every neighbour stays on the far side of the plane
+/// through the eye and the shared edge, so no edge is a silhouette (`is_silhouette`). q is
+/// the smallest code with 2^(q − 14) ≥ sin φ (0 when flat), or [`ANY_FOLD`] for folds of 90°
+/// or more and for degenerate triangles. Powers of two keep the bound within 2× of the fold
+/// on smooth meshes, where folds are tiny.
+pub fn outline_hints(
+    positions: &[glam::Vec3],
+    triangles: &[[u32; 3]],
+    neighbours: &[[u32; 3]],
+) -> Vec<u8> {
+    let corner = |t: u32, k: usize| positions[triangles[t as usize][k % 3] as usize].as_dvec3();
+    (0..triangles.len() as u32)
+        .into_par_iter()
+        .map(|t| {
+            let mut boundary = false;
+            let mut sin_fold: f64 = 0.0;
+            for (i, &n) in neighbours[t as usize].iter().enumerate() {
+                if n == NO_NEIGHBOUR {
+                    boundary = true;
+                    continue;
+                }
+                let (a, b) = (corner(t, i), corner(t, i + 1));
+                let centroid = (corner(n, 0) + corner(n, 1) + corner(n, 2)) / 3.0;
+                let along = (b - a).normalize_or_zero();
+                let across = |p: glam::DVec3| {
+                    let v = p - a;
+                    (v - along * v.dot(along)).normalize_or_zero()
+                };
+                let (own, other) = (across(corner(t, i + 2)), across(centroid));
+                // Flat: the two point opposite ways (cos = -1, fold 0).
+                let cos_fold = -own.dot(other);
+                let degenerate = own == glam::DVec3::ZERO || other == glam::DVec3::ZERO;
+                // Degenerate triangles, and folds of 90° or more, are never skipped.
+                sin_fold = if degenerate || cos_fold <= 0.0 {
+                    1.0
+                } else {
+                    sin_fold.max((1.0 - cos_fold * cos_fold).max(0.0).sqrt())
+                };
+                if sin_fold >= 1.0 {
+                    break;
+                }
+            }
+            let q = if sin_fold == 0.0 {
+                0
+            } else if sin_fold >= 1.0 {
+                ANY_FOLD
+            } else {
+                (sin_fold.log2().ceil() + 14.0).clamp(1.0, 14.0) as u8
+            };
+            (q << 1) | u8::from(boundary)
+        })
+        .collect()
+}
+
 /// For each triangle, the triangle across each of its edges (edge `i` runs from corner `i`
 /// to corner `i + 1`), or [`NO_NEIGHBOUR`].
 pub fn edge_neighbours(positions: &[glam::Vec3], triangles: &[[u32; 3]]) -> Vec<[u32; 3]> {

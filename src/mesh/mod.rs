@@ -64,6 +64,8 @@ pub struct Mesh {
     polygon_edges: Vec<u8>,
     /// Edge adjacency, computed on first use.
     neighbours: std::sync::OnceLock<Vec<[u32; 3]>>,
+    /// Per triangle, what lets the outline pass skip it: see [`Mesh::outline_hints`].
+    outline_hints: std::sync::OnceLock<Vec<u8>>,
 }
 
 impl Mesh {
@@ -143,6 +145,7 @@ impl Mesh {
             triangles,
             polygon_edges,
             neighbours: Default::default(),
+            outline_hints: Default::default(),
         })
     }
 
@@ -211,6 +214,18 @@ impl Mesh {
     pub fn edge_neighbours(&self) -> &[[u32; 3]] {
         self.neighbours
             .get_or_init(|| adjacency::edge_neighbours(&self.positions, &self.triangles))
+    }
+
+    /// Per triangle, 5 bits that let the GPU outline pass skip triangles that cannot have an
+    /// outline edge: bit 0 set when an edge has no neighbour (a boundary, always an outline),
+    /// bits 1–4 a code q bounding how far the surface folds at its edges: a neighboured edge
+    /// can be a silhouette only while the eye sees the triangle within
+    /// asin([`adjacency::fold_bound`]\(q\)) of edge-on.
+    /// See [`adjacency::outline_hints`]. Computed once, on first use.
+    pub fn outline_hints(&self) -> &[u8] {
+        self.outline_hints.get_or_init(|| {
+            adjacency::outline_hints(&self.positions, &self.triangles, self.edge_neighbours())
+        })
     }
 
     /// Axis-aligned bounds `(min, max)` of the positions that triangles use.

@@ -231,6 +231,7 @@ pub fn default_scene() -> Mesh {
         triangles: scene.triangles,
         polygon_edges: scene.edges,
         neighbours: Default::default(),
+        outline_hints: Default::default(),
     }
 }
 
