@@ -51,7 +51,11 @@ fn outlines_reach_over_the_background_in_deferred_only() {
     for &i in &outer {
         assert_eq!(deferred.ids[i], u32::MAX);
         let err = (deferred.edge_distance[i] - truth.edge_distance[i]).abs();
-        assert!(err < 0.01, "pixel {i}: deferred {}", deferred.edge_distance[i]);
+        assert!(
+            err < 0.01,
+            "pixel {i}: deferred {}",
+            deferred.edge_distance[i]
+        );
         assert!(forward.edge_distance[i].is_infinite() || forward.ids[i] != u32::MAX);
     }
     // The whole outline's width: pixels with full line colour, counted on each side.
@@ -136,7 +140,10 @@ fn lines_fade_with_depth_in_every_method() {
     for method in [Method::Deferred, Method::Forward, Method::TwoPass] {
         let with = draw(&fading, method);
         let without = draw(&plain, method);
-        assert_eq!(with.ids, without.ids, "{method:?}: the fade changes no coverage");
+        assert_eq!(
+            with.ids, without.ids,
+            "{method:?}: the fade changes no coverage"
+        );
         // How much lighter the red channel gets, over pixels in front of the fade and behind.
         let lightening = |keep: &dyn Fn(f64) -> bool| -> f64 {
             (0..with.ids.len())
@@ -146,7 +153,10 @@ fn lines_fade_with_depth_in_every_method() {
         };
         let near = lightening(&|w| w < 0.99 * start);
         let far = lightening(&|w| w > 1.01 * end);
-        assert!(near.abs() < 200.0, "{method:?}: in front of the fade {near}");
+        assert!(
+            near.abs() < 200.0,
+            "{method:?}: in front of the fade {near}"
+        );
         assert!(far > 10_000.0, "{method:?}: behind the fade {far}");
     }
 }
