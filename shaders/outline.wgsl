@@ -5,9 +5,9 @@
 // A triangle only colours its own pixels, so the edge pass alone draws an outline edge (a
 // boundary, or a silhouette: see `is_silhouette`) at half width. Outline triangles are nearly
 // edge-on and often own no pixel centre at all, so they cannot be found from the ids around a
-// pixel; instead one invocation per triangle finds its outline edges and writes, into every
-// pixel within the line's reach, the distance to the edge's nearest point, when that point is
-// visible. Definition (src/outline.rs implements it in f64 for the ground truth): pixel p is
+// pixel; instead one invocation per triangle finds its outline edges, the visible runs of
+// each (points every 1/4 px tested, changes bisected), and writes into every pixel within the
+// line's reach the distance to the nearest visible run. Definition (src/outline.rs implements it in f64 for the ground truth): pixel p is
 // at distance d from an outline when d is the distance from p's centre to the visible part of
 // the edge's projection (in front of the near plane, inside the image, not hidden by another
 // surface). No depth test at p is needed: a nearer surface between p and a farther edge has

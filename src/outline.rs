@@ -8,9 +8,9 @@
 //! nearest visible point.
 //!
 //! Visibility along an edge is found by casting a ray through points every 1/8 pixel of its
-//! projection and bisecting each change to 2⁻³⁰ of the edge. The GPU pass tests only the
-//! nearest point of each edge; the two agree wherever a nearer surface's own outline lies
-//! between a pixel and a hidden stretch of edge, which is where it can matter.
+//! projection and bisecting each change to 2⁻³⁰ of the edge. The GPU pass does the same at
+//! 1/4 pixel, testing each point against the triangles rasterized around it instead of a ray
+//! cast; tests/ground_truth.rs holds the two within 0.1 px.
 
 // `!(a <= b)` is deliberate: NaN must take the rejecting branch.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]

@@ -37,8 +37,9 @@ pub struct Frame {
     /// Depth in the `perspective_rh` convention: 0 at the near plane, 1 at the far plane
     /// and on background.
     pub depth: Vec<f32>,
-    /// Pixels to the nearest drawn edge of the visible triangle; `inf` on background and
-    /// where no edge of the triangle is drawn. [`Method::Forward`] reports its interpolated
+    /// Pixels to the nearest line: a drawn edge of the visible triangle or, with
+    /// [`Style::silhouettes`](crate::Style::silhouettes), an outline within the line's reach
+    /// (background pixels included); `inf` where there is none. [`Method::Forward`] reports its interpolated
     /// altitudes as they come (NaN where they are NaN); [`Method::TwoPass`] measures no
     /// distance and reports 0 where it drew a line fragment, `inf` elsewhere.
     pub edge_distance: Vec<f32>,
