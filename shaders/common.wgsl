@@ -141,6 +141,32 @@ fn is_silhouette(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>, d: vec3<f32>, eye: ve
     return !(side_c * side_d < 0.0);
 }
 
+// Bounds on a cluster of consecutive triangles (src/mesh/clusters.rs): a sphere holding their
+// corners, and the axis and spread (cone half-angle plus largest fold, radians; over π/2:
+// never skipped) of their normals.
+struct Cluster {
+    center: vec3<f32>,
+    radius: f32,
+    axis: vec3<f32>,
+    spread: f32,
+}
+
+// Twin of clusters::may_fold: false when, seen from `eye`, no triangle of the cluster can have
+// an outline edge: every direction from the eye into the sphere (within β of its centre's)
+// makes an angle with every normal (within the spread of the axis) that stays off 90°.
+fn cluster_may_fold(c: Cluster, eye: vec3<f32>) -> bool {
+    let d = c.center - eye;
+    let distance = length(d);
+    if !(distance > c.radius) {
+        return true;
+    }
+    let beta = asin(c.radius / distance);
+    let gamma = atan2(length(cross(d, c.axis)), dot(d, c.axis));
+    let reach = beta + c.spread;
+    let quarter = 1.5707963;
+    return !(gamma + reach < quarter || gamma - reach > quarter);
+}
+
 // Diffuse key light plus ambient; the normal is turned towards the viewer so back faces
 // seen through open meshes are lit like front faces.
 fn shade(base: vec3<f32>, normal: vec3<f32>, to_eye: vec3<f32>, light_dir: vec3<f32>, ambient: f32) -> vec3<f32> {

@@ -5,9 +5,11 @@
 // A triangle only colours its own pixels, so the edge pass alone draws an outline edge (a
 // boundary, or a silhouette: see `is_silhouette`) at half width. Outline triangles are nearly
 // edge-on and often own no pixel centre at all, so they cannot be found from the ids around a
-// pixel; instead one invocation per triangle finds its outline edges, the visible runs of
-// each (points every 1/4 px tested, changes bisected), and writes into every pixel within the
-// line's reach the distance to the nearest visible run. Definition (src/outline.rs implements it in f64 for the ground truth): pixel p is
+// pixel; instead one invocation per triangle finds its outline edges, the visible runs of each
+// (points every 1/4 px tested, changes bisected), and writes into every pixel within the line's
+// reach the distance to the nearest visible run. Only triangles of the clusters that
+// `outline_cull` lists are visited, so the pass reads few triangles beyond those near an
+// outline. Definition (src/outline.rs implements it in f64 for the ground truth): pixel p is
 // at distance d from an outline when d is the distance from p's centre to the visible part of
 // the edge's projection (in front of the near plane, inside the image, not hidden by another
 // surface). No depth test at p is needed: a nearer surface between p and a farther edge has
@@ -16,22 +18,69 @@
 // drawn twice.
 
 @group(1) @binding(6) var<storage, read_write> outline_acc: array<atomic<u32>>;
+// One Cluster per OUTLINE_GROUP triangles of `cluster_triangles` (src/mesh/clusters.rs).
+@group(1) @binding(7) var<storage, read> clusters: array<Cluster>;
+@group(1) @binding(8) var<storage, read_write> outline_list: OutlineList;
+@group(1) @binding(9) var<storage, read_write> outline_args: OutlineArgs;
+// Triangle ids in cluster order: cluster c holds entries OUTLINE_GROUP × c and on.
+@group(1) @binding(10) var<storage, read> cluster_triangles: array<u32>;
 
-// Invocations per workgroup of `outline_main`.
+// The clusters that `outline_cull` finds may hold an outline edge; starts with count zero.
+struct OutlineList {
+    count: atomic<u32>,
+    clusters: array<u32>,
+}
+
+// The indirect dispatch size of `outline_main`, as `outline_cull` leaves it; starts zeroed.
+struct OutlineArgs {
+    x: atomic<u32>,
+    y: u32,
+    z: u32,
+}
+
+// Triangles per cluster, and invocations per workgroup of both entry points.
 const OUTLINE_GROUP: u32 = 64u;
+// Workgroups of `outline_main` at most; each then takes every MAX_OUTLINE_GROUPS-th listed
+// cluster. Below every device's max_compute_workgroups_per_dimension (at least 65535).
+const MAX_OUTLINE_GROUPS: u32 = 16384u;
 
 // A point on an edge is hidden when a surface there is nearer than this share of its depth.
 // Triangles sharing the edge's end vertices meet it at equal depth; this keeps their f32
 // rounding from hiding it.
 const HIDDEN_MARGIN: f32 = 1.0e-4;
 
+// Lists the clusters that may hold an outline edge from this eye (`cluster_may_fold`), so that
+// the triangles of the others, usually nearly all, are never read.
 @compute @workgroup_size(64)
-fn outline_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
-    // Dispatched as a 2D grid: meshes have more triangles than one dimension allows.
-    let t = gid.x + gid.y * groups.x * OUTLINE_GROUP;
-    if t >= frame.triangles {
+fn outline_cull(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    // Dispatched as a 2D grid: huge meshes have more clusters than one dimension allows.
+    let c = gid.x + gid.y * groups.x * OUTLINE_GROUP;
+    if c == 0u {
+        outline_args.y = 1u;
+        outline_args.z = 1u;
+    }
+    if c >= (frame.triangles + OUTLINE_GROUP - 1u) / OUTLINE_GROUP || !cluster_may_fold(clusters[c], frame.eye.xyz) {
         return;
     }
+    let k = atomicAdd(&outline_list.count, 1u);
+    outline_list.clusters[k] = c;
+    atomicMax(&outline_args.x, min(k + 1u, MAX_OUTLINE_GROUPS));
+}
+
+// One invocation per triangle of each listed cluster.
+@compute @workgroup_size(64)
+fn outline_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32, @builtin(num_workgroups) groups: vec3<u32>) {
+    let count = atomicLoad(&outline_list.count);
+    for (var k = group.x; k < count; k += groups.x) {
+        let i = outline_list.clusters[k] * OUTLINE_GROUP + lane;
+        if i < frame.triangles {
+            outline_triangle(cluster_triangles[i]);
+        }
+    }
+}
+
+// Finds the outline edges of triangle t and draws them.
+fn outline_triangle(t: u32) {
     let v = corners(t);
     var p = array<vec3<f32>, 3>(position(v.x), position(v.y), position(v.z));
     // Most triangles are seen well away from edge-on, further than their edges fold: none of

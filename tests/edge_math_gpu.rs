@@ -464,6 +464,96 @@ fn wgsl_outline_math_matches_rust() {
     );
 }
 
+const CLUSTER_SHADER: &str = r#"
+@group(0) @binding(0) var<storage, read> cases: array<vec4<f32>>;
+@group(0) @binding(1) var<storage, read_write> results: array<vec4<f32>>;
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if 3u * i >= arrayLength(&cases) {
+        return;
+    }
+    let c = Cluster(cases[3u * i].xyz, cases[3u * i].w, cases[3u * i + 1u].xyz, cases[3u * i + 1u].w);
+    results[i] = vec4<f32>(select(0.0, 1.0, cluster_may_fold(c, cases[3u * i + 2u].xyz)));
+}
+"#;
+
+/// `cluster_may_fold` in WGSL against `clusters::may_fold`, on random clusters and eyes
+/// (the angles clear of the 90° threshold by more than f32 rounding) and hand-picked ones:
+/// the eye inside the sphere, a cluster that may fold from anywhere, a patch seen face-on
+/// and edge-on.
+#[test]
+fn wgsl_cluster_test_matches_rust() {
+    use wirepass::mesh::clusters::{may_fold, ClusterBounds, ALWAYS};
+    let mut state = 0x51_7cc1_b727_220a_u64;
+    let mut next = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+    };
+    let patch = |spread| ClusterBounds {
+        center: DVec3::ZERO,
+        radius: 0.1,
+        axis: DVec3::Z,
+        spread,
+    };
+    let mut rows: Vec<(ClusterBounds, DVec3)> = vec![
+        (patch(0.1), DVec3::new(0.0, 0.05, 0.0)),
+        (patch(ALWAYS), DVec3::Z * 5.0),
+        (patch(0.1), DVec3::Z * 5.0),
+        (patch(0.1), DVec3::X * 5.0),
+    ];
+    let quarter = std::f64::consts::FRAC_PI_2;
+    while rows.len() < 500 {
+        let r: [f64; 11] = std::array::from_fn(|_| next());
+        let bounds = ClusterBounds {
+            center: DVec3::new(r[0], r[1], r[2]),
+            radius: 0.2 * (r[3] + 1.0),
+            axis: DVec3::new(r[4], r[5], r[6]).normalize(),
+            spread: 0.5 * (r[7] + 1.0),
+        };
+        let eye = DVec3::new(r[8], r[9], r[10]) * 4.0;
+        let d = bounds.center - eye;
+        let beta = (bounds.radius / d.length()).asin();
+        let gamma = d.angle_between(bounds.axis);
+        let reach = beta + bounds.spread;
+        if (gamma + reach - quarter).abs() > 1e-4 && (gamma - reach - quarter).abs() > 1e-4 {
+            rows.push((bounds, eye));
+        }
+    }
+    let input: Vec<Vec4> = rows
+        .iter()
+        .flat_map(|(b, eye)| {
+            [
+                b.center.as_vec3().extend(b.radius as f32),
+                b.axis.as_vec3().extend(b.spread as f32),
+                eye.as_vec3().extend(0.0),
+            ]
+        })
+        .collect();
+    let got = run_shader(CLUSTER_SHADER, &input, rows.len());
+    let mut folds = 0;
+    for (k, ((b, eye), g)) in rows.iter().zip(&got).enumerate() {
+        let want = may_fold(b, *eye);
+        folds += usize::from(want);
+        assert_eq!(g.x == 1.0, want, "case {k}: {b:?} from {eye}");
+    }
+    assert_eq!(
+        rows[..4]
+            .iter()
+            .map(|(b, e)| may_fold(b, *e))
+            .collect::<Vec<_>>(),
+        [true, true, false, true]
+    );
+    assert!(
+        folds > 50 && folds + 50 < rows.len(),
+        "{folds} of {}",
+        rows.len()
+    );
+}
+
 const EPS32: f64 = f32::EPSILON as f64;
 
 #[test]

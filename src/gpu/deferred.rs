@@ -18,8 +18,8 @@ pub const DIAGNOSTIC_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Fl
 pub const RESOLVED_ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 /// Edge-pass workgroup side (8 × 8 pixels).
 const TILE: u32 = 8;
-/// Outline-pass workgroup size (triangles), as in outline.wgsl.
-const OUTLINE_GROUP: u32 = 64;
+/// Outline-pass workgroup size and triangles per cluster, as in outline.wgsl.
+const OUTLINE_GROUP: u32 = crate::mesh::clusters::CLUSTER_TRIANGLES as u32;
 
 /// Construction options.
 #[derive(Clone, Copy, Debug)]
@@ -82,8 +82,8 @@ pub struct DeferredPass {
     overlay: (wgpu::ComputePipeline, wgpu::BindGroupLayout),
     diagnostic: (wgpu::ComputePipeline, wgpu::BindGroupLayout),
     floor: (wgpu::ComputePipeline, wgpu::BindGroupLayout),
-    /// The outline pass and the layout of its read-write buffer.
-    outline: (wgpu::ComputePipeline, wgpu::BindGroupLayout),
+    /// The outline pass.
+    outline: OutlinePipelines,
     /// Layout of the edge pass's read-only view of the outline buffer.
     outline_read: wgpu::BindGroupLayout,
     /// Whether the last prepared style draws outlines (runs the outline pass).
@@ -290,22 +290,39 @@ impl DeferredPass {
             ],
         );
         let floor = compute("floor_main", &[entry(5, cs, storage_texture(format))]);
-        let outline_write = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("wirepass outline write"),
-            entries: &[entry(
-                6,
-                cs,
-                wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Storage { read_only: false },
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-            )],
-        });
-        let outline = (
-            pipeline("outline_main", &[Some(&mesh_layout), Some(&outline_write)]),
-            outline_write,
+        let read_write = wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only: false },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        };
+        let layout = |label, entries: &[wgpu::BindGroupLayoutEntry]| {
+            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some(label),
+                entries,
+            })
+        };
+        let cull_layout = layout(
+            "wirepass outline cull",
+            &[
+                entry(7, cs, storage()),
+                entry(8, cs, read_write),
+                entry(9, cs, read_write),
+            ],
         );
+        let draw_layout = layout(
+            "wirepass outline draw",
+            &[
+                entry(6, cs, read_write),
+                entry(8, cs, read_write),
+                entry(10, cs, storage()),
+            ],
+        );
+        let outline = OutlinePipelines {
+            cull: pipeline("outline_cull", &[Some(&mesh_layout), Some(&cull_layout)]),
+            draw: pipeline("outline_main", &[Some(&mesh_layout), Some(&draw_layout)]),
+            cull_layout,
+            draw_layout,
+        };
 
         let frame = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("wirepass frame"),
@@ -743,8 +760,10 @@ impl DeferredPass {
         Ok(())
     }
 
-    /// The outline pass (outline.wgsl): one invocation per triangle, on a 2D grid of
-    /// workgroups since large meshes need more than one dimension allows.
+    /// The outline pass (outline.wgsl): `outline_cull` lists the clusters of triangles that
+    /// may hold an outline edge, one invocation per cluster on a 2D grid of workgroups (huge
+    /// meshes need more than one dimension allows); `outline_main` then visits their
+    /// triangles, dispatched indirectly with the size the cull leaves.
     fn outline_pass(
         &self,
         device: &wgpu::Device,
@@ -754,25 +773,67 @@ impl DeferredPass {
         timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
         let targets = self.targets()?;
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("wirepass outline write"),
-            layout: &self.outline.1,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 6,
-                resource: targets.outline.as_entire_binding(),
-            }],
-        });
-        let groups = mesh.triangles.div_ceil(OUTLINE_GROUP);
+        let group = |label, layout, entries: &[(u32, &wgpu::Buffer)]| {
+            let entries: Vec<_> = entries
+                .iter()
+                .map(|&(binding, buffer)| wgpu::BindGroupEntry {
+                    binding,
+                    resource: buffer.as_entire_binding(),
+                })
+                .collect();
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some(label),
+                layout,
+                entries: &entries,
+            })
+        };
+        let cull_group = group(
+            "wirepass outline cull",
+            &self.outline.cull_layout,
+            &[
+                (7, &mesh.clusters),
+                (8, &mesh.outline_list),
+                (9, &mesh.outline_args),
+            ],
+        );
+        let draw_group = group(
+            "wirepass outline draw",
+            &self.outline.draw_layout,
+            &[
+                (6, &targets.outline),
+                (8, &mesh.outline_list),
+                (10, &mesh.cluster_triangles),
+            ],
+        );
+        encoder.clear_buffer(&mesh.outline_args, 0, None);
+        encoder.clear_buffer(&mesh.outline_list, 0, Some(4));
+        let groups = mesh
+            .triangles
+            .div_ceil(OUTLINE_GROUP)
+            .div_ceil(OUTLINE_GROUP);
         let max = device.limits().max_compute_workgroups_per_dimension.max(1);
         let (x, y) = (groups.min(max), groups.div_ceil(max));
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("wirepass outline pass"),
             timestamp_writes: timer.and_then(|t| t.compute_span("outline")),
         });
-        pass.set_pipeline(&self.outline.0);
         pass.set_bind_group(0, mesh_group, &[]);
-        pass.set_bind_group(1, &group, &[]);
+        pass.set_bind_group(1, &cull_group, &[]);
+        pass.set_pipeline(&self.outline.cull);
         pass.dispatch_workgroups(x, y, 1);
+        pass.set_bind_group(1, &draw_group, &[]);
+        pass.set_pipeline(&self.outline.draw);
+        pass.dispatch_workgroups_indirect(&mesh.outline_args, 0);
         Ok(())
     }
+}
+
+/// The two entry points of the outline pass and the layouts of their own bindings: the
+/// mesh's cluster bounds, list and dispatch size for the cull; the pixel accumulator, the
+/// list and the clusters' triangles for the draw.
+struct OutlinePipelines {
+    cull: wgpu::ComputePipeline,
+    draw: wgpu::ComputePipeline,
+    cull_layout: wgpu::BindGroupLayout,
+    draw_layout: wgpu::BindGroupLayout,
 }

@@ -17,6 +17,17 @@ pub struct GpuMesh {
     pub(crate) indices: wgpu::Buffer,
     pub(crate) edge_masks: wgpu::Buffer,
     pub(crate) neighbours: wgpu::Buffer,
+    /// `Cluster` bounds (common.wgsl) per
+    /// [`CLUSTER_TRIANGLES`](crate::mesh::clusters::CLUSTER_TRIANGLES) triangles, for the outline
+    /// pass's cull.
+    pub(crate) clusters: wgpu::Buffer,
+    /// Triangle ids in cluster order (`Clusters::order`).
+    pub(crate) cluster_triangles: wgpu::Buffer,
+    /// The outline pass's scratch: a count and a list of clusters, and the indirect
+    /// dispatch size for visiting them (apart, as a buffer cannot be written and read as
+    /// dispatch size in one dispatch).
+    pub(crate) outline_list: wgpu::Buffer,
+    pub(crate) outline_args: wgpu::Buffer,
     pub(crate) triangles: u32,
     /// Triangles in the first binding of `indices` and `neighbours`; the rest go in a second
     /// (see [`GpuMesh::halves`]). Equal to `triangles` when one binding holds them all.
@@ -42,6 +53,7 @@ impl GpuMesh {
         let indices: &[u32] = bytemuck::cast_slice(mesh.triangles());
         let masks = packed_masks(mesh, edges);
         let neighbours: &[u32] = bytemuck::cast_slice(mesh.edge_neighbours());
+        let clusters = gpu_clusters(mesh, origin);
         let storage = wgpu::BufferUsages::STORAGE;
         let create = |label, contents: &[u8], usage| {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -50,8 +62,27 @@ impl GpuMesh {
                 usage,
             })
         };
+        let scratch = |label, size, usage| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage: storage | wgpu::BufferUsages::COPY_DST | usage,
+                mapped_at_creation: false,
+            })
+        };
+        let cluster_count = mesh.outline_clusters().bounds.len() as u64;
+        let outline_list = scratch(
+            "wirepass outline list",
+            4 + 4 * cluster_count,
+            wgpu::BufferUsages::empty(),
+        );
+        let outline_args = scratch("wirepass outline args", 12, wgpu::BufferUsages::INDIRECT);
         let bytes = (positions.len() + normals.len() + indices.len() + neighbours.len()) as u64 * 4
-            + masks.len() as u64;
+            + masks.len() as u64
+            + (clusters.len() * 4) as u64
+            + triangles * 4
+            + outline_list.size()
+            + outline_args.size();
         Ok(Self {
             positions: create(
                 "wirepass positions",
@@ -74,6 +105,18 @@ impl GpuMesh {
                 bytemuck::cast_slice(neighbours),
                 storage,
             ),
+            clusters: create(
+                "wirepass outline clusters",
+                bytemuck::cast_slice(&clusters),
+                storage,
+            ),
+            cluster_triangles: create(
+                "wirepass cluster triangles",
+                bytemuck::cast_slice(&mesh.outline_clusters().order),
+                storage,
+            ),
+            outline_list,
+            outline_args,
             triangles: mesh.triangle_count() as u32,
             split,
             origin,
@@ -131,6 +174,23 @@ impl GpuMesh {
         queue.write_buffer(&self.edge_masks, 0, &packed_masks(mesh, edges));
         Ok(())
     }
+}
+
+/// The mesh's cluster bounds as `Cluster`s (common.wgsl): centre relative to `origin`, radius,
+/// axis and spread, eight f32s each. The radius grows by the f32 rounding of itself and the
+/// centre.
+fn gpu_clusters(mesh: &Mesh, origin: DVec3) -> Vec<f32> {
+    mesh.outline_clusters()
+        .bounds
+        .iter()
+        .flat_map(|c| {
+            let center = c.center - origin;
+            let radius = c.radius * (1.0 + 1e-6) + center.length() * 1e-6;
+            let [x, y, z] = center.as_vec3().to_array();
+            let [ax, ay, az] = c.axis.as_vec3().to_array();
+            [x, y, z, radius as f32, ax, ay, az, c.spread as f32]
+        })
+        .collect()
 }
 
 /// A byte per triangle, padded to whole words: the edge mask in bits 0–2 and the outline

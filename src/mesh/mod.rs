@@ -2,6 +2,7 @@
 //! per-triangle mask that says which triangle edges were edges of the source polygons.
 
 pub mod adjacency;
+pub mod clusters;
 mod obj;
 mod procedural;
 
@@ -66,6 +67,9 @@ pub struct Mesh {
     neighbours: std::sync::OnceLock<Vec<[u32; 3]>>,
     /// Per triangle, what lets the outline pass skip it: see [`Mesh::outline_hints`].
     outline_hints: std::sync::OnceLock<Vec<u8>>,
+    /// Per cluster of triangles, what lets the outline pass skip it: see
+    /// [`Mesh::outline_clusters`].
+    outline_clusters: std::sync::OnceLock<clusters::Clusters>,
 }
 
 impl Mesh {
@@ -146,6 +150,7 @@ impl Mesh {
             polygon_edges,
             neighbours: Default::default(),
             outline_hints: Default::default(),
+            outline_clusters: Default::default(),
         })
     }
 
@@ -225,6 +230,16 @@ impl Mesh {
     pub fn outline_hints(&self) -> &[u8] {
         self.outline_hints.get_or_init(|| {
             adjacency::outline_hints(&self.positions, &self.triangles, self.edge_neighbours())
+        })
+    }
+
+    /// The triangles in clusters of [`clusters::CLUSTER_TRIANGLES`] nearby ones, with bounds
+    /// that let the GPU outline pass skip a cluster when, from the current eye, none of its
+    /// triangles can have an outline edge. See [`clusters::clusters`]. Computed once, on
+    /// first use.
+    pub fn outline_clusters(&self) -> &clusters::Clusters {
+        self.outline_clusters.get_or_init(|| {
+            clusters::clusters(&self.positions, &self.triangles, self.outline_hints())
         })
     }
 

@@ -232,6 +232,7 @@ pub fn default_scene() -> Mesh {
         polygon_edges: scene.edges,
         neighbours: Default::default(),
         outline_hints: Default::default(),
+        outline_clusters: Default::default(),
     }
 }
 

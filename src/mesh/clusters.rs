@@ -1,0 +1,165 @@
+//! Clusters of nearby triangles with bounds that let the GPU outline pass skip a whole cluster
+//! at once, so that its cost follows the triangles near the outline rather than the triangle
+//! count.
+//!
+//! Triangles are ordered along a Morton curve through their centroids and cut into runs of
+//! [`CLUSTER_TRIANGLES`], so a cluster is a compact patch whatever order the file lists its
+//! triangles in, and its normals spread little on a smooth surface.
+//!
+//! A neighboured edge can be a silhouette only while the eye sees its triangle's plane within
+//! the edge's fold of edge-on ([`super::adjacency::outline_hints`]). A cluster's bounds are a
+//! sphere holding its triangles and a cone holding their normals, widened by the largest fold
+//! among them: when every direction from the eye into the sphere makes an angle with every
+//! normal in the cone that stays more than the fold away from 90°, no triangle of the cluster
+//! has an outline edge.
+
+use super::adjacency::{fold_bound, ANY_FOLD};
+use glam::DVec3;
+use rayon::prelude::*;
+
+/// Triangles per cluster (the last may have fewer); the outline pass's workgroup size.
+pub const CLUSTER_TRIANGLES: usize = 64;
+
+/// The spread of a cluster that may hold an outline edge from any view: over π/2 fails
+/// both skip conditions of [`may_fold`] whatever the eye.
+pub const ALWAYS: f64 = 4.0;
+
+/// Added to each spread for the GPU's f32 rounding of centres, axes and the eye, in radians.
+const SPREAD_MARGIN: f64 = 1e-4;
+
+/// A cluster's bounds, in mesh coordinates.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ClusterBounds {
+    /// Centre of a sphere holding every corner of the cluster's triangles.
+    pub center: DVec3,
+    /// Radius of that sphere.
+    pub radius: f64,
+    /// Unit axis of the normal cone (zero when the spread is [`ALWAYS`]).
+    pub axis: DVec3,
+    /// The cone's half-angle plus the largest fold of the cluster's edges, in radians;
+    /// [`ALWAYS`] when a triangle has a boundary edge, folds 90° or more, or is degenerate.
+    pub spread: f64,
+}
+
+/// A mesh's triangles in clusters.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Clusters {
+    /// Triangle ids in Morton order; cluster `c` holds entries
+    /// `CLUSTER_TRIANGLES × c ..` up to the next cluster's.
+    pub order: Vec<u32>,
+    /// Bounds of each cluster.
+    pub bounds: Vec<ClusterBounds>,
+}
+
+/// Clusters the triangles; `hints` are [`super::Mesh::outline_hints`].
+pub fn clusters(positions: &[glam::Vec3], triangles: &[[u32; 3]], hints: &[u8]) -> Clusters {
+    let corner = |t: u32, k: usize| positions[triangles[t as usize][k] as usize].as_dvec3();
+    let centroid = |t: u32| (corner(t, 0) + corner(t, 1) + corner(t, 2)) / 3.0;
+    let (lo, hi) = (0..triangles.len() as u32)
+        .into_par_iter()
+        .map(|t| (centroid(t), centroid(t)))
+        .reduce(
+            || (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+            |a, b| (a.0.min(b.0), a.1.max(b.1)),
+        );
+    let scale = ((1u64 << MORTON_BITS) - 1) as f64 / (hi - lo).max_element().max(f64::MIN_POSITIVE);
+    let mut keyed: Vec<(u64, u32)> = (0..triangles.len() as u32)
+        .into_par_iter()
+        .map(|t| {
+            let q = ((centroid(t) - lo) * scale).as_u64vec3();
+            (morton(q.x) | morton(q.y) << 1 | morton(q.z) << 2, t)
+        })
+        .collect();
+    keyed.par_sort_unstable();
+    let order: Vec<u32> = keyed.into_iter().map(|(_, t)| t).collect();
+    let bounds = order
+        .par_chunks(CLUSTER_TRIANGLES)
+        .map(|ids| {
+            bound(
+                ids,
+                |t| [0, 1, 2].map(|k| corner(t, k)),
+                |t| hints[t as usize],
+            )
+        })
+        .collect();
+    Clusters { order, bounds }
+}
+
+/// Bits of each coordinate in a Morton key.
+const MORTON_BITS: u32 = 21;
+
+/// Spreads the low 21 bits of `v` to every third bit.
+fn morton(v: u64) -> u64 {
+    let mut x = v & 0x1f_ffff;
+    x = (x | x << 32) & 0x001f_0000_0000_ffff;
+    x = (x | x << 16) & 0x001f_0000_ff00_00ff;
+    x = (x | x << 8) & 0x100f_00f0_0f00_f00f;
+    x = (x | x << 4) & 0x10c3_0c30_c30c_30c3;
+    (x | x << 2) & 0x1249_2492_4924_9249
+}
+
+/// The bounds of the triangles `ids`, with their corners and outline hints.
+fn bound(
+    ids: &[u32],
+    corners: impl Fn(u32) -> [DVec3; 3],
+    hint: impl Fn(u32) -> u8,
+) -> ClusterBounds {
+    let points = || ids.iter().flat_map(|&t| corners(t));
+    let (lo, hi) = points().fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(p), hi.max(p)),
+    );
+    let center = (lo + hi) * 0.5;
+    let radius = points().map(|p| p.distance(center)).fold(0.0, f64::max);
+    let always = ClusterBounds {
+        center,
+        radius,
+        axis: DVec3::ZERO,
+        spread: ALWAYS,
+    };
+    let mut normals = Vec::with_capacity(ids.len());
+    let mut fold: f64 = 0.0;
+    for &t in ids {
+        let (q, boundary) = (hint(t) >> 1, hint(t) & 1 != 0);
+        let [a, b, c] = corners(t);
+        let n = (b - a).cross(c - a).normalize_or_zero();
+        if boundary || q >= ANY_FOLD || n == DVec3::ZERO {
+            return always;
+        }
+        normals.push(n);
+        fold = fold.max(fold_bound(q).min(1.0).asin());
+    }
+    let axis = normals.iter().sum::<DVec3>().normalize_or_zero();
+    if axis == DVec3::ZERO {
+        return always;
+    }
+    let cone = normals
+        .iter()
+        .map(|n| n.cross(axis).length().atan2(n.dot(axis)))
+        .fold(0.0, f64::max);
+    ClusterBounds {
+        center,
+        radius,
+        axis,
+        spread: (cone + fold + SPREAD_MARGIN).min(ALWAYS),
+    }
+}
+
+/// Twin of `cluster_may_fold` in common.wgsl: false when, seen from `eye`, no triangle of the
+/// cluster can have an outline edge. The directions from the eye into the sphere lie within
+/// β = asin(r / D) of its centre's; the angle γ between that and the axis then bounds every
+/// direction-to-normal angle within γ ± (β + spread), and the cluster may fold when that
+/// interval reaches 90°. An eye inside the sphere sees every direction.
+#[allow(clippy::neg_cmp_op_on_partial_ord)] // as in WGSL: a NaN distance may fold
+pub fn may_fold(bounds: &ClusterBounds, eye: DVec3) -> bool {
+    let d = bounds.center - eye;
+    let distance = d.length();
+    if !(distance > bounds.radius) {
+        return true;
+    }
+    let beta = (bounds.radius / distance).asin();
+    let gamma = d.cross(bounds.axis).length().atan2(d.dot(bounds.axis));
+    let reach = beta + bounds.spread;
+    let quarter = std::f64::consts::FRAC_PI_2;
+    !(gamma + reach < quarter || gamma - reach > quarter)
+}
