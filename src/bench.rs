@@ -405,8 +405,8 @@ pub fn csv(runs: &[Run]) -> String {
 }
 
 mod plot {
-    //! Log-log plots of total GPU time per method, with plotters and an embedded font so
-    //! they draw the same on a machine without fonts.
+    //! Log-log plots of GPU time per method (and per pass of the deferred one), with
+    //! plotters and an embedded font so they draw the same on a machine without fonts.
 
     use super::Run;
     use crate::error::{Error, Result};
@@ -432,9 +432,36 @@ mod plot {
         RGBColor(214, 39, 40),
         RGBColor(44, 160, 44),
     ];
+    /// The deferred method's own passes, drawn thin beside the totals.
+    const PASSES: [(&str, RGBColor); 2] = [
+        ("edge", RGBColor(23, 190, 207)),
+        ("outline", RGBColor(148, 103, 189)),
+    ];
 
-    /// Total median GPU time against `x` (log-log): one colour per method, one line per
-    /// method and `group` (the variable held fixed along the line).
+    /// One plotted line.
+    struct Line {
+        label: String,
+        color: RGBColor,
+        /// Stroke width in pixels.
+        width: u32,
+        points: Vec<(f64, f64)>,
+    }
+
+    /// `20k`, `2M`, `1.5M`: tick labels that read at a glance.
+    fn short(v: f64) -> String {
+        let (scaled, unit) = match v.abs() {
+            a if a >= 1e9 => (v / 1e9, "G"),
+            a if a >= 1e6 => (v / 1e6, "M"),
+            a if a >= 1e3 => (v / 1e3, "k"),
+            _ => (v, ""),
+        };
+        let text = format!("{scaled:.1}");
+        format!("{}{unit}", text.trim_end_matches(".0"))
+    }
+
+    /// Median GPU time against `x` (log-log): the total per method, one colour per method
+    /// and one line per method and `group` (the variable held fixed along the line), and
+    /// thinner lines for the deferred method's edge and outline passes.
     pub fn time_against(
         path: &Path,
         runs: &[Run],
@@ -447,17 +474,67 @@ mod plot {
             path: path.to_owned(),
             message: e,
         };
-        let points: Vec<(f64, f64)> = runs
-            .iter()
-            .map(|r| (x(r), r.total_median_ms))
-            .filter(|p| p.0 > 0.0 && p.1 > 0.0)
-            .collect();
-        if points.is_empty() {
-            return Ok(());
+        let mut methods: Vec<&str> = Vec::new();
+        let mut keys: Vec<(&str, String)> = Vec::new();
+        for r in runs {
+            if !methods.contains(&r.method.as_str()) {
+                methods.push(&r.method);
+            }
+            let key = (r.method.as_str(), group(r));
+            if !keys.contains(&key) {
+                keys.push(key);
+            }
         }
+        let groups = keys
+            .iter()
+            .map(|l| &l.1)
+            .collect::<std::collections::BTreeSet<_>>();
+        let mut lines: Vec<Line> = Vec::new();
+        for (method, fixed) in &keys {
+            let chosen = || {
+                runs.iter()
+                    .filter(|r| r.method == *method && group(r) == *fixed)
+            };
+            let suffix = if groups.len() > 1 {
+                format!(" ({fixed})")
+            } else {
+                String::new()
+            };
+            let m = methods.iter().position(|n| n == method).unwrap_or(0);
+            let total = chosen().map(|r| (x(r), r.total_median_ms)).collect();
+            lines.push(Line {
+                label: format!("{method}{suffix}"),
+                color: COLORS[m % COLORS.len()],
+                width: 2,
+                points: total,
+            });
+            if *method == "deferred" {
+                for (pass, color) in PASSES {
+                    let points: Vec<_> = chosen()
+                        .filter_map(|r| r.passes.get(pass).map(|s| (x(r), s.median_ms)))
+                        .collect();
+                    if !points.is_empty() {
+                        lines.push(Line {
+                            label: format!("deferred: {pass} pass{suffix}"),
+                            color,
+                            width: 1,
+                            points,
+                        });
+                    }
+                }
+            }
+        }
+        for line in &mut lines {
+            line.points.retain(|p| p.0 > 0.0 && p.1 > 0.0);
+            line.points.sort_by(|a, b| a.0.total_cmp(&b.0));
+        }
+        let points = lines.iter().flat_map(|l| l.points.iter());
         let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-        for &(px, py) in &points {
+        for &(px, py) in points {
             (x0, x1, y0, y1) = (x0.min(px), x1.max(px), y0.min(py), y1.max(py));
+        }
+        if x0 > x1 {
+            return Ok(());
         }
         let root = BitMapBackend::new(path, (900, 560)).into_drawing_area();
         root.fill(&WHITE).map_err(|e| fail(e.to_string()))?;
@@ -477,50 +554,30 @@ mod plot {
         chart
             .configure_mesh()
             .x_desc(x_name)
-            .y_desc("median GPU ms (sum of passes)")
+            .y_desc("median GPU ms")
+            .x_label_formatter(&|v| short(*v))
+            .y_label_formatter(&|v| short(*v))
             .draw()
             .map_err(|e| fail(e.to_string()))?;
-        let mut methods: Vec<&str> = Vec::new();
-        let mut lines: Vec<(&str, String)> = Vec::new();
-        for r in runs {
-            if !methods.contains(&r.method.as_str()) {
-                methods.push(&r.method);
-            }
-            let key = (r.method.as_str(), group(r));
-            if !lines.contains(&key) {
-                lines.push(key);
-            }
-        }
-        let dashes = lines
-            .iter()
-            .map(|l| &l.1)
-            .collect::<std::collections::BTreeSet<_>>();
-        for (method, fixed) in &lines {
-            let m = methods.iter().position(|n| n == method).unwrap_or(0);
-            let color = COLORS[m % COLORS.len()];
-            let mut series: Vec<(f64, f64)> = runs
-                .iter()
-                .filter(|r| r.method == *method && group(r) == *fixed && r.total_median_ms > 0.0)
-                .map(|r| (x(r), r.total_median_ms))
-                .collect();
-            series.sort_by(|a, b| a.0.total_cmp(&b.0));
-            let label = if dashes.len() > 1 {
-                format!("{method} ({fixed})")
-            } else {
-                (*method).to_owned()
-            };
+        for Line {
+            label,
+            color,
+            width,
+            points: series,
+        } in lines
+        {
             chart
-                .draw_series(LineSeries::new(series.clone(), color.stroke_width(2)))
+                .draw_series(LineSeries::new(series.clone(), color.stroke_width(width)))
                 .map_err(|e| fail(e.to_string()))?
                 .label(label)
                 .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2))
+                    PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(width))
                 });
             chart
                 .draw_series(
                     series
                         .into_iter()
-                        .map(|p| Circle::new(p, 4, color.filled())),
+                        .map(|p| Circle::new(p, 2 + width, color.filled())),
                 )
                 .map_err(|e| fail(e.to_string()))?;
         }
