@@ -141,7 +141,7 @@ fn is_silhouette(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>, d: vec3<f32>, eye: ve
     return !(side_c * side_d < 0.0);
 }
 
-// Bounds on a cluster of consecutive triangles (src/mesh/clusters.rs): a sphere holding their
+// Bounds on a cluster of nearby triangles (src/mesh/clusters.rs): a sphere holding their
 // corners, and the axis and spread (cone half-angle plus largest fold, radians; over π/2:
 // never skipped) of their normals.
 struct Cluster {

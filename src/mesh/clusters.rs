@@ -62,11 +62,14 @@ pub fn clusters(positions: &[glam::Vec3], triangles: &[[u32; 3]], hints: &[u8]) 
             || (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
             |a, b| (a.0.min(b.0), a.1.max(b.1)),
         );
-    let scale = ((1u64 << MORTON_BITS) - 1) as f64 / (hi - lo).max_element().max(f64::MIN_POSITIVE);
+    let cells = ((1u64 << MORTON_BITS) - 1) as f64;
+    let scale = cells / (hi - lo).max_element().max(f64::MIN_POSITIVE);
     let mut keyed: Vec<(u64, u32)> = (0..triangles.len() as u32)
         .into_par_iter()
         .map(|t| {
-            let q = ((centroid(t) - lo) * scale).as_u64vec3();
+            let q = ((centroid(t) - lo) * scale)
+                .clamp(DVec3::ZERO, DVec3::splat(cells))
+                .as_u64vec3();
             (morton(q.x) | morton(q.y) << 1 | morton(q.z) << 2, t)
         })
         .collect();
