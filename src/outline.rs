@@ -321,10 +321,7 @@ mod tests {
         for mesh in &meshes {
             let hints = mesh.outline_hints();
             let p = |v: u32| mesh.positions()[v as usize].as_dvec3();
-            for k in 0..40 {
-                let a = f64::from(k) * 0.7;
-                let eye =
-                    DVec3::new(a.cos(), (0.37 * a).sin(), a.sin()) * (1.2 + 0.1 * f64::from(k));
+            for eye in test_eyes() {
                 let outline: std::collections::HashSet<u32> = outline_edges(mesh, eye)
                     .into_iter()
                     .map(|(t, _)| t)
@@ -387,10 +384,7 @@ mod tests {
                 mesh.triangle_count().div_ceil(CLUSTER_TRIANGLES)
             );
             let (mut skipped, mut total) = (0, 0);
-            for k in 0..40 {
-                let a = f64::from(k) * 0.7;
-                let eye =
-                    DVec3::new(a.cos(), (0.37 * a).sin(), a.sin()) * (1.2 + 0.1 * f64::from(k));
+            for eye in test_eyes() {
                 let outline: std::collections::HashSet<u32> = outline_edges(mesh, eye)
                     .into_iter()
                     .flat_map(|(t, i)| [t, mesh.edge_neighbours()[t as usize][i as usize]])
@@ -415,6 +409,14 @@ mod tests {
                 "mesh {m}: only {skipped} of {total} skipped"
             );
         }
+    }
+
+    /// Eyes all round the unit meshes, from just outside to five radii away.
+    fn test_eyes() -> impl Iterator<Item = DVec3> {
+        (0..40).map(|k| {
+            let a = f64::from(k) * 0.7;
+            DVec3::new(a.cos(), (0.37 * a).sin(), a.sin()) * (1.2 + 0.1 * f64::from(k))
+        })
     }
 
     /// The neighbours of `n` across its silhouette edges.
