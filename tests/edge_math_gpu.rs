@@ -340,6 +340,18 @@ fn run_shader(body: &str, input: &[Vec4], outputs: usize) -> Vec<Vec4> {
     bytemuck::pod_collect_to_vec(&readback.get_mapped_range(..).unwrap())
 }
 
+/// A small deterministic generator of numbers in [-1, 1) (xorshift): random cases that do
+/// not change between runs.
+fn uniform(seed: u64) -> impl FnMut() -> f64 {
+    let mut state = seed;
+    move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+    }
+}
+
 const OUTLINE_SHADER: &str = r#"
 @group(0) @binding(0) var<storage, read> cases: array<vec4<f32>>;
 @group(0) @binding(1) var<storage, read_write> results: array<vec4<f32>>;
@@ -366,14 +378,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 /// hand-picked ones: a flat pair, a fold seen edge-on, an eye far away.
 #[test]
 fn wgsl_outline_math_matches_rust() {
-    // A small deterministic generator: the cases must not change between runs.
-    let mut state = 0x2545_f491_4f6c_dd1d_u64;
-    let mut next = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-    };
+    let mut next = uniform(0x2545_f491_4f6c_dd1d);
     let mut rows: Vec<[DVec3; 5]> = vec![
         // Flat: the two triangles on either side of the edge, eye above.
         [
@@ -486,13 +491,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 #[test]
 fn wgsl_cluster_test_matches_rust() {
     use wirepass::mesh::clusters::{may_fold, ClusterBounds, ALWAYS};
-    let mut state = 0x51_7cc1_b727_220a_u64;
-    let mut next = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-    };
+    let mut next = uniform(0x51_7cc1_b727_220a);
     let patch = |spread| ClusterBounds {
         center: DVec3::ZERO,
         radius: 0.1,
