@@ -10,12 +10,12 @@ use wirepass::render::Scene;
 use wirepass::{Camera, EdgeSelection, Style};
 
 fn bunny_path() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes/stanford-bunny.obj")
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/meshes/stanford-bunny.obj")
 }
 
 fn cpu(c: &mut Criterion) {
     let path = bunny_path();
-    let mesh = load_obj(&path).expect("the shared bunny loads");
+    let mesh = load_obj(&path).expect("the test bunny loads");
     let mut group = c.benchmark_group("bunny (69,451 triangles)");
     group.sample_size(10);
     group.bench_function("load_obj", |b| b.iter(|| load_obj(black_box(&path))));

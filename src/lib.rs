@@ -7,21 +7,36 @@
 
 #![warn(missing_docs)]
 
-pub mod bench;
 pub mod camera;
-pub mod cli;
-pub mod compare;
 pub mod edge_math;
 pub mod error;
 pub mod gpu;
 pub mod mesh;
-pub mod outline;
-pub mod raycast;
-pub mod regression;
-pub mod render;
+mod par;
 pub mod style;
+
+#[cfg(feature = "tools")]
+pub mod bench;
+#[cfg(feature = "cli")]
+pub mod cli;
+#[cfg(feature = "tools")]
+pub mod compare;
+#[cfg(feature = "tools")]
+pub mod outline;
+#[cfg(feature = "tools")]
+pub mod raycast;
+#[cfg(feature = "regression")]
+pub mod regression;
+#[cfg(feature = "tools")]
+pub mod render;
 
 pub use camera::Camera;
 pub use error::{Error, Result};
 pub use mesh::{EdgeSelection, Mesh};
 pub use style::{Color, Style};
+
+/// The wgpu this crate is built against: use it (`wirepass::wgpu`) so the host's types match.
+pub use wgpu;
+
+/// The glam this crate's API uses for vectors and matrices.
+pub use glam;

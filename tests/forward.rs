@@ -32,7 +32,7 @@ fn gpu() -> &'static GpuContext {
 
 fn mesh_path(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/meshes")
+        .join("tests/data/meshes")
         .join(name)
 }
 

@@ -15,7 +15,7 @@
 
 use super::adjacency::{fold_bound, ANY_FOLD};
 use glam::DVec3;
-use rayon::prelude::*;
+use crate::par::*;
 
 /// Triangles per cluster (the last may have fewer); the outline pass's workgroup size.
 pub const CLUSTER_TRIANGLES: usize = 64;
@@ -55,13 +55,10 @@ pub struct Clusters {
 pub fn clusters(positions: &[glam::Vec3], triangles: &[[u32; 3]], hints: &[u8]) -> Clusters {
     let corner = |t: u32, k: usize| positions[triangles[t as usize][k] as usize].as_dvec3();
     let centroid = |t: u32| (corner(t, 0) + corner(t, 1) + corner(t, 2)) / 3.0;
-    let (lo, hi) = (0..triangles.len() as u32)
-        .into_par_iter()
-        .map(|t| (centroid(t), centroid(t)))
-        .reduce(
-            || (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-            |a, b| (a.0.min(b.0), a.1.max(b.1)),
-        );
+    let (lo, hi) = (0..triangles.len() as u32).map(centroid).fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(lo, hi), c| (lo.min(c), hi.max(c)),
+    );
     let cells = ((1u64 << MORTON_BITS) - 1) as f64;
     let scale = cells / (hi - lo).max_element().max(f64::MIN_POSITIVE);
     let mut keyed: Vec<(u64, u32)> = (0..triangles.len() as u32)

@@ -3,9 +3,11 @@
 
 pub mod adjacency;
 pub mod clusters;
+#[cfg(feature = "formats")]
 mod obj;
 mod procedural;
 
+#[cfg(feature = "formats")]
 pub use obj::load_obj;
 pub use procedural::{default_scene, grid, layers, sphere, torus, Procedural, LAYER_TRIANGLES};
 

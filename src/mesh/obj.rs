@@ -411,8 +411,8 @@ mod tests {
     use crate::mesh::{EdgeSelection, ALL_EDGES};
     use std::path::PathBuf;
 
-    fn shared(name: &str) -> PathBuf {
-        Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes")).join(name)
+    fn test_mesh(name: &str) -> PathBuf {
+        Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/meshes")).join(name)
     }
 
     /// Writes `bytes` to a fresh temporary file, loads it, and removes the file.
@@ -438,7 +438,7 @@ mod tests {
     #[test]
     fn suzanne_quads_have_one_masked_diagonal() {
         // 468 quads × 2 + 32 triangles (the README's 936 counts the quads' triangles only).
-        let m = load_obj(&shared("suzanne.obj")).unwrap();
+        let m = load_obj(&test_mesh("suzanne.obj")).unwrap();
         assert_eq!(m.triangle_count(), 968);
         let mask = m.edge_mask(EdgeSelection::Polygon);
         let cleared: u32 = mask.iter().map(|m| 3 - m.count_ones()).sum();
@@ -454,7 +454,7 @@ mod tests {
     }
 
     #[test]
-    fn shared_meshes_load_with_their_triangle_counts() {
+    fn test_meshes_load_with_their_triangle_counts() {
         for (name, count) in [
             ("teapot.obj", 6320),
             ("spot.obj", 5856),
@@ -462,7 +462,7 @@ mod tests {
             ("fandisk.obj", 12946),
             ("stanford-bunny.obj", 69451),
         ] {
-            let m = load_obj(&shared(name)).unwrap();
+            let m = load_obj(&test_mesh(name)).unwrap();
             assert_eq!(m.triangle_count(), count, "{name}");
             if name == "spot.obj" {
                 // Texture coordinates are dropped, so UV seams do not split vertices.
@@ -770,7 +770,7 @@ mod tests {
 
     #[test]
     fn mutated_files_never_panic() {
-        let base = std::fs::read(shared("suzanne.obj")).unwrap();
+        let base = std::fs::read(test_mesh("suzanne.obj")).unwrap();
         let base = &base[..base.len().min(6000)];
         let alphabet = b"vfnlto/-0123456789.e \n#\0\xff";
         let mut seed = 0x2545_f491_4f6c_dd1d_u64;

@@ -20,16 +20,16 @@ pub fn gpu() -> &'static GpuContext {
     })
 }
 
-/// Path of a shared test mesh.
-pub fn shared_mesh(name: &str) -> PathBuf {
+/// Path of a test mesh in `tests/data/meshes` (see its README for their origins).
+pub fn test_mesh(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/meshes")
+        .join("tests/data/meshes")
         .join(name)
 }
 
-/// Loads a shared test mesh.
+/// Loads a test mesh from `tests/data/meshes`.
 pub fn load(name: &str) -> Mesh {
-    wirepass::mesh::load_obj(&shared_mesh(name)).unwrap_or_else(|e| panic!("{e}"))
+    wirepass::mesh::load_obj(&test_mesh(name)).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// A camera at `eye` looking at `target`, with explicit planes.

@@ -1,0 +1,54 @@
+//! Data parallelism for mesh preprocessing: rayon's iterators with the `parallel` feature,
+//! the same calls run on one thread without it, so a host can build the library without
+//! rayon and the code reads the same either way.
+
+#[cfg(feature = "parallel")]
+pub(crate) use rayon::prelude::*;
+
+#[cfg(not(feature = "parallel"))]
+pub(crate) use sequential::*;
+
+#[cfg(not(feature = "parallel"))]
+mod sequential {
+    /// `into_par_iter` as a plain iterator.
+    pub(crate) trait IntoParallelIterator: IntoIterator + Sized {
+        fn into_par_iter(self) -> Self::IntoIter {
+            self.into_iter()
+        }
+    }
+    impl<T: IntoIterator> IntoParallelIterator for T {}
+
+    /// Slice methods of rayon's `ParallelSlice` and `ParallelSliceMut`.
+    pub(crate) trait ParallelSlice<T> {
+        fn par_iter(&self) -> std::slice::Iter<'_, T>;
+        fn par_chunks(&self, size: usize) -> std::slice::Chunks<'_, T>;
+        fn par_sort_unstable(&mut self)
+        where
+            T: Ord;
+    }
+    impl<T> ParallelSlice<T> for [T] {
+        fn par_iter(&self) -> std::slice::Iter<'_, T> {
+            self.iter()
+        }
+        fn par_chunks(&self, size: usize) -> std::slice::Chunks<'_, T> {
+            self.chunks(size)
+        }
+        fn par_sort_unstable(&mut self)
+        where
+            T: Ord,
+        {
+            self.sort_unstable()
+        }
+    }
+
+    /// rayon's `flat_map_iter`, which is `flat_map` on one thread.
+    pub(crate) trait FlatMapIter: Iterator + Sized {
+        fn flat_map_iter<U: IntoIterator, F: FnMut(Self::Item) -> U>(
+            self,
+            f: F,
+        ) -> std::iter::FlatMap<Self, U, F> {
+            self.flat_map(f)
+        }
+    }
+    impl<I: Iterator> FlatMapIter for I {}
+}
