@@ -6,7 +6,7 @@ use std::hint::black_box;
 use std::path::PathBuf;
 use wirepass::mesh::{adjacency, load_obj};
 use wirepass::raycast::{render_raycast, RayCaster};
-use wirepass::render::Scene;
+use wirepass::render::{Shot, World};
 use wirepass::{Camera, EdgeSelection, Style};
 
 fn bunny_path() -> PathBuf {
@@ -22,17 +22,20 @@ fn cpu(c: &mut Criterion) {
     group.bench_function("edge adjacency", |b| {
         b.iter(|| adjacency::edge_neighbours(black_box(mesh.positions()), mesh.triangles()))
     });
-    group.bench_function("BVH build", |b| b.iter(|| RayCaster::new(black_box(&mesh))));
-    let (lo, hi) = mesh.bounds();
-    let scene = Scene {
-        mesh: &mesh,
-        camera: Camera::framing(lo, hi, 4.0 / 3.0),
-        style: Style::default(),
+    let world = World::single(mesh.clone(), EdgeSelection::All);
+    group.bench_function("BVH build", |b| {
+        b.iter(|| RayCaster::new(black_box(&world)))
+    });
+    let (lo, hi) = mesh.bounds_f64();
+    let style = Style::default();
+    let shot = Shot {
+        world: &world,
+        view: Camera::framing(lo, hi, 4.0 / 3.0).to_view(4.0 / 3.0),
+        style: &style,
         size: (320, 240),
-        edges: EdgeSelection::All,
     };
     group.bench_function("ray cast 320x240", |b| {
-        b.iter(|| render_raycast(black_box(&scene)))
+        b.iter(|| render_raycast(black_box(&shot)))
     });
     group.finish();
 }

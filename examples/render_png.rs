@@ -1,66 +1,89 @@
-//! Renders a mesh to a PNG with the library API only: your own device and encoder, the
-//! deferred pass encoded into them, and a readback.
+//! Renders two transformed instances of a mesh into a PNG with the library API only: a
+//! device opened with the WebGPU default limits, your own encoder, the deferred pass encoded
+//! into it, and a readback.
 //!
 //! `cargo run --release --example render_png -- [MESH.obj] [OUT.png]`
 
-use wirepass::gpu::{DeferredPass, GpuMesh, OutputTarget, PassOptions};
-use wirepass::{Camera, EdgeSelection, Style};
+use wirepass::glam::{DMat4, DVec3};
+use wirepass::gpu::{DeferredPass, MeshStore, OutputTarget, PassOptions};
+use wirepass::{Camera, EdgeSelection, Instance, InstanceStyle, Scene, Style};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
-    let mesh = match args.next() {
+    let mesh = match args.next().filter(|p| !p.is_empty()) {
         Some(path) => wirepass::mesh::load_obj(path.as_ref())?,
-        None => wirepass::mesh::default_scene(),
+        None => wirepass::mesh::torus(5000)?,
     };
     let out = args.next().unwrap_or_else(|| "example.png".into());
     let size = (640, 480);
 
-    // The host owns the device, the queue and the output texture. Here a headless device.
+    // The host owns the device, the queue and the output texture. Here a headless device
+    // with the limits every WebGPU implementation has.
     let instance =
         wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
     let adapter = pollster::block_on(instance.request_adapter(&Default::default()))?;
     let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
         required_features: adapter.features() & wgpu::Features::PRIMITIVE_INDEX,
+        required_limits: wgpu::Limits::default(),
         ..Default::default()
     }))?;
-    let output = device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("output"),
-        size: wgpu::Extent3d {
-            width: size.0,
-            height: size.1,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::Rgba8Unorm,
-        usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
-        view_formats: &[],
-    });
+    let output = wirepass::gpu::texture_2d(
+        &device,
+        "output",
+        size,
+        wgpu::TextureFormat::Rgba8Unorm,
+        wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
+    );
 
-    // Construct once, upload the mesh, prepare when camera, style or size change.
+    // Construct once and upload the mesh once.
     let mut pass = DeferredPass::new(
         &device,
         PassOptions {
             output_format: output.format(),
         },
     )?;
-    let gpu_mesh = GpuMesh::new(&device, &mesh, EdgeSelection::Polygon)?;
-    let (lo, hi) = mesh.bounds();
-    let camera = Camera::framing(lo, hi, size.0 as f32 / size.1 as f32);
+    let mut meshes = MeshStore::new(&device);
+    let id = meshes.insert(&device, &queue, &mesh, EdgeSelection::Polygon)?;
+
+    // Each frame: the instances and the view. The second instance is mirrored, stretched
+    // and drawn in its own colour; both occlude each other exactly.
+    let (lo, hi) = mesh.bounds_f64();
+    let extent = (hi - lo).max_element();
+    let beside = DMat4::from_translation(DVec3::new(0.7 * extent, 0.0, -0.3 * extent))
+        * DMat4::from_scale(DVec3::new(-1.0, 1.4, 1.0));
+    let instances = [
+        Instance::new(id, DMat4::IDENTITY),
+        Instance::new(id, beside).with_style(InstanceStyle {
+            wire_color: Some(wirepass::Color::from_hex("#b03020")?),
+            line_width: Some(2.5),
+            ..Default::default()
+        }),
+    ];
+    let aspect = f64::from(size.0) / f64::from(size.1);
+    let (lo, hi) = (
+        lo.min(lo + beside.w_axis.truncate()),
+        hi.max(hi + beside.w_axis.truncate()),
+    );
+    let camera = Camera::framing(
+        lo - DVec3::splat(0.2 * extent),
+        hi + DVec3::splat(0.2 * extent),
+        aspect,
+    );
+    let scene = Scene::borrowed(camera.to_view(aspect), &instances);
     let style = Style {
-        line_width: 2.0,
+        line_width: 1.5,
         ..Style::default()
     };
-    pass.prepare(&device, &queue, &gpu_mesh, &camera, &style, size)?;
+    let frame = pass.prepare(&device, &meshes, &scene, &style, size)?;
 
-    // Each frame: encode into the host's encoder.
+    // Encode into the host's encoder.
     let mut encoder = device.create_command_encoder(&Default::default());
     let view = output.create_view(&Default::default());
     pass.encode(
         &device,
         &mut encoder,
-        &gpu_mesh,
+        &meshes,
+        &frame,
         OutputTarget::Shaded(&view),
     )?;
     queue.submit([encoder.finish()]);

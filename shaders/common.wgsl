@@ -1,36 +1,79 @@
-// Definitions every wirepass shader shares. Each has a Rust twin of the same name
-// (src/edge_math.rs, src/style.rs); tests keep the two equal.
+// Definitions every wirepass shader shares. Each function has a Rust twin of the same name
+// (src/edge_math.rs, src/style.rs, src/gpu/mesh_store.rs); tests keep the two equal.
 
+// Per frame (src/gpu/frame.rs, FrameUniforms).
 struct Frame {
-    // Mesh-local (rebased) position -> clip space.
-    view_proj: mat4x4<f32>,
-    // Reverse-Z depth row (clip w row minus clip z row): dot(depth_row, p) / w is 1 at the
-    // near plane and 0 at the far plane, computed without cancellation for precision.
-    depth_row: vec4<f32>,
-    // Eye in mesh-local coordinates (xyz).
-    eye: vec4<f32>,
+    // Size of the full image the projection maps onto, in pixels: the edge math's screen.
+    image_size: vec2<f32>,
+    // Full-image pixel coordinates of the targets' pixel (0, 0).
+    target_origin: vec2<f32>,
+    // Size of the id and depth targets, in pixels.
+    target_size: vec2<f32>,
+    // Where the output starts in the targets, and its size (pixels).
+    output_offset: vec2<f32>,
+    output_size: vec2<f32>,
+    // Depth fade (start, end) in view depth; (0, 0) for none. See `depth_fade`.
+    fade: vec2<f32>,
+    // The visibility raster's clip transform onto the targets: x' = x * crop.x + w * crop.z,
+    // y' = y * crop.y + w * crop.w.
+    crop: vec4<f32>,
     // Unit direction towards the key light, world axes (xyz).
     light_dir: vec4<f32>,
     // Linear RGBA colours.
-    wire_color: vec4<f32>,
     fill_color: vec4<f32>,
     background: vec4<f32>,
-    // Image size in pixels.
-    size: vec2<f32>,
-    // Line width in pixels.
-    line_width: f32,
     // Share of ambient light in the shading, 0..1.
     ambient: f32,
-    // Depth fade (start, end) in view depth; (0, 0) for none. See `depth_fade`.
-    fade: vec2<f32>,
-    // Triangles in the first binding of the per-triangle buffers (indices, neighbours), which
-    // meshes past max_storage_buffer_binding_size split over two (src/gpu/mesh.rs).
-    index_split: u32,
-    // 1: draw outlines at full width (outline.wgsl); 0: every edge inside its own triangles.
-    silhouettes: u32,
-    // Triangles in the mesh.
-    triangles: u32,
+    // Instances in the frame.
+    instances: u32,
+    // First element of the second binding of the vertex and per-triangle buffers, for a
+    // store split over two bindings (src/gpu/mesh_store.rs); the capacity otherwise.
+    vertex_split: u32,
+    triangle_split: u32,
+    // Clusters of all instances together: the outline cull's range.
+    clusters: u32,
+    // Host depth: 1 when the id target was seeded from the host's depth.
+    host_depth: u32,
+    _pad: vec2<u32>,
 }
+
+// Per instance (src/gpu/frame.rs, InstanceRecord). "Local" coordinates are the mesh
+// store's: each mesh rebased to its centre and scaled to about ±1.
+struct Instance {
+    // Local position -> clip rows x, y, near, w: row 2 is >= 0 exactly in front of the near
+    // plane, whatever the view's depth convention.
+    clip: mat4x4<f32>,
+    // Reverse depth row: dot(depth_row, p) / w is 1 at the near plane and 0 at the far one.
+    depth_row: vec4<f32>,
+    // The eye in homogeneous local coordinates: (eye, 1), or (towards the viewer, 0) for an
+    // orthographic view.
+    eye: vec4<f32>,
+    // View depth (distance in front of the eye along the view axis) of a local point.
+    fade_row: vec4<f32>,
+    // Rows of the local -> world normal matrix.
+    normal_x: vec4<f32>,
+    normal_y: vec4<f32>,
+    normal_z: vec4<f32>,
+    wire_color: vec4<f32>,
+    line_width: f32,
+    // INSTANCE_EDGES, INSTANCE_OUTLINES.
+    flags: u32,
+    vertex_base: u32,
+    triangle_base: u32,
+    triangles: u32,
+    cluster_base: u32,
+    // The first of this instance's clusters among all instances' (the outline cull's index).
+    cluster_first: u32,
+    // This record's place in the instance buffer.
+    index: u32,
+}
+
+const INSTANCE_EDGES: u32 = 1u;
+const INSTANCE_OUTLINES: u32 = 2u;
+
+// Instance ids of the id target: background, and host geometry in front (host depth).
+const BACKGROUND_ID: u32 = 0xffffffffu;
+const HOST_ID: u32 = 0xfffffffeu;
 
 // Distance returned for an edge that is not drawn or not visible.
 const NO_EDGE: f32 = 3.0e38;
@@ -56,7 +99,7 @@ struct EdgeEval {
 }
 
 // Edge distances and barycentrics of the pixel centre for a triangle given in clip space.
-// `mask` bit i enables edge i. A clip z below 0 lies behind the near plane (depth 0..1).
+// `mask` bit i enables edge i. A clip z (the near row) below 0 lies behind the near plane.
 fn edge_eval(c0: vec4<f32>, c1: vec4<f32>, c2: vec4<f32>, mask: u32, pixel: vec2<f32>, size: vec2<f32>) -> EdgeEval {
     let p0 = pixel_relative(c0, pixel, size);
     let p1 = pixel_relative(c1, pixel, size);
@@ -66,7 +109,8 @@ fn edge_eval(c0: vec4<f32>, c1: vec4<f32>, c2: vec4<f32>, mask: u32, pixel: vec2
     let l1 = cross(p1, p2);
     let l2 = cross(p2, p0);
     var out: EdgeEval;
-    out.distance = edge_distances(l0, l1, l2, vec3<f32>(c0.z, c1.z, c2.z), mask);
+    let raw = vec3<f32>(line_distance(l0), line_distance(l1), line_distance(l2));
+    out.distance = drawn_distances(raw, vec3<f32>(c0.z, c1.z, c2.z), mask);
     // Corner i's weight is the line of the opposite edge evaluated at the pixel.
     let e = vec3<f32>(l1.z, l2.z, l0.z);
     let sum = e.x + e.y + e.z;
@@ -78,25 +122,19 @@ fn edge_eval(c0: vec4<f32>, c1: vec4<f32>, c2: vec4<f32>, mask: u32, pixel: vec2
     return out;
 }
 
-// Distances to the three edge lines of `edge_eval`, applying the mask and the near-plane rule
-// (`clip_z` holds the corners' clip z; below 0 is behind the near plane).
-fn edge_distances(l0: vec3<f32>, l1: vec3<f32>, l2: vec3<f32>, clip_z: vec3<f32>, mask: u32) -> vec3<f32> {
-    let raw = vec3<f32>(line_distance(l0, true), line_distance(l1, true), line_distance(l2, true));
-    return drawn_distances(raw, clip_z, mask);
-}
-
 // `raw` (the distances to all three edge lines) with NO_EDGE for edges that are masked out
-// or have both ends behind the near plane.
-fn drawn_distances(raw: vec3<f32>, clip_z: vec3<f32>, mask: u32) -> vec3<f32> {
-    let behind = clip_z < vec3<f32>(0.0);
+// or have both ends behind the near plane (`near` holds the corners' near rows).
+fn drawn_distances(raw: vec3<f32>, near: vec3<f32>, mask: u32) -> vec3<f32> {
+    let behind = near < vec3<f32>(0.0);
     let masked = (vec3<u32>(mask) & vec3<u32>(1u, 2u, 4u)) == vec3<u32>(0u);
     let hidden = behind & behind.yzx;
     return select(raw, vec3<f32>(NO_EDGE), masked | hidden);
 }
 
-fn line_distance(l: vec3<f32>, drawn: bool) -> f32 {
+// Distance from the origin (the pixel centre) to the screen line l, NO_EDGE when l is no line.
+fn line_distance(l: vec3<f32>) -> f32 {
     let len = length(l.xy);
-    if !drawn || !(len > 0.0) {
+    if !(len > 0.0) {
         return NO_EDGE;
     }
     return abs(l.z) / len;
@@ -119,25 +157,57 @@ fn line_reach(width: f32) -> f32 {
     return max(0.5 * width - 1.0, 0.0) + 2.0;
 }
 
-// A line's strength at view depth `w`: 1 up to fade.x, falling linearly to 0 at fade.y;
+// A line's strength at view depth `depth`: 1 up to fade.x, falling linearly to 0 at fade.y;
 // 1 everywhere when fade.y <= fade.x (no fade).
-fn depth_fade(w: f32, fade: vec2<f32>) -> f32 {
+fn depth_fade(depth: f32, fade: vec2<f32>) -> f32 {
     if !(fade.y > fade.x) {
         return 1.0;
     }
-    return clamp((fade.y - w) / (fade.y - fade.x), 0.0, 1.0);
+    return clamp((fade.y - depth) / (fade.y - fade.x), 0.0, 1.0);
+}
+
+// Which line colours a pixel most: lines are ranked by their intensity in 1/4095 steps, and
+// equal ones by nearness (src/style.rs, line_key, is the twin). The outline pass keeps the
+// greatest key per pixel with an atomic max; the distance is kept in 1/4096 px steps.
+const KEY_DISTANCE_STEPS: f32 = 4096.0;
+const KEY_DISTANCE_MAX: u32 = 0xfffffu;
+
+fn line_key(intensity: f32, d: f32) -> u32 {
+    let level = u32(round(clamp(intensity, 0.0, 1.0) * 4095.0));
+    let q = u32(clamp(d * KEY_DISTANCE_STEPS, 0.0, f32(KEY_DISTANCE_MAX)));
+    return (level << 20u) | (KEY_DISTANCE_MAX - q);
+}
+
+// The intensity a key was ranked with.
+fn key_intensity(key: u32) -> f32 {
+    return f32(key >> 20u) / 4095.0;
+}
+
+// The distance a key holds (NO_EDGE for the empty key 0).
+fn key_distance(key: u32) -> f32 {
+    if key == 0u {
+        return NO_EDGE;
+    }
+    return (f32(KEY_DISTANCE_MAX - (key & KEY_DISTANCE_MAX)) + 0.5) / KEY_DISTANCE_STEPS;
+}
+
+// The point of view `eye` (homogeneous: a point with w = 1, a direction towards the viewer
+// with w = 0) as seen from `a`: the direction from `a` towards it, up to a positive factor.
+fn towards_eye(a: vec3<f32>, eye: vec4<f32>) -> vec3<f32> {
+    return eye.xyz - a * eye.w;
 }
 
 // True when the edge a -> b, shared by a triangle with third corner c and a neighbour with a
 // point d off the edge, is a silhouette seen from `eye`: both triangles lie on the same side
 // of the plane through the eye and the edge, so on screen they fold onto one side of it and
-// the other side shows something else. Independent of winding. Each side is the triple
-// product of (a - eye) with a triangle's own edge vectors, which stay small and exact for a
-// far eye. An edge-on triangle (side 0) counts as folded.
-fn is_silhouette(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>, d: vec3<f32>, eye: vec3<f32>) -> bool {
-    let to_edge = a - eye;
-    let side_c = dot(to_edge, cross(b - a, c - a));
-    let side_d = dot(to_edge, cross(b - a, d - a));
+// the other side shows something else. Independent of winding, so mirrored instances get
+// the same silhouettes. Each side is the triple product of the direction to the eye with a
+// triangle's own edge vectors, which stay small and exact for a far eye. An edge-on
+// triangle (side 0) counts as folded.
+fn is_silhouette(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>, d: vec3<f32>, eye: vec4<f32>) -> bool {
+    let to_eye = towards_eye(a, eye);
+    let side_c = dot(to_eye, cross(b - a, c - a));
+    let side_d = dot(to_eye, cross(b - a, d - a));
     return !(side_c * side_d < 0.0);
 }
 
@@ -153,44 +223,67 @@ struct Cluster {
 
 // Twin of clusters::may_fold: false when, seen from `eye`, no triangle of the cluster can have
 // an outline edge: every direction from the eye into the sphere (within β of its centre's)
-// makes an angle with every normal (within the spread of the axis) that stays off 90°.
-fn cluster_may_fold(c: Cluster, eye: vec3<f32>) -> bool {
-    let d = c.center - eye;
-    let distance = length(d);
-    if !(distance > c.radius) {
-        return true;
+// makes an angle with every normal (within the spread of the axis) that stays off 90°. An
+// orthographic eye sees along one direction (β = 0).
+fn cluster_may_fold(c: Cluster, eye: vec4<f32>) -> bool {
+    var d = -eye.xyz;
+    var beta = 0.0;
+    if eye.w != 0.0 {
+        d = c.center - eye.xyz / eye.w;
+        let distance = length(d);
+        if !(distance > c.radius) {
+            return true;
+        }
+        beta = asin(c.radius / distance);
     }
-    let beta = asin(c.radius / distance);
     let gamma = atan2(length(cross(d, c.axis)), dot(d, c.axis));
     let reach = beta + c.spread;
     let quarter = 1.5707963;
     return !(gamma + reach < quarter || gamma - reach > quarter);
 }
 
-// Diffuse key light plus ambient; the normal is turned towards the viewer so back faces
-// seen through open meshes are lit like front faces.
-fn shade(base: vec3<f32>, normal: vec3<f32>, to_eye: vec3<f32>, light_dir: vec3<f32>, ambient: f32) -> vec3<f32> {
+// Twin of mesh_store::unpack_normal: a unit normal packed octahedrally into two 16-bit
+// snorms; 0x80008000 marks a vertex without one (zero).
+fn unpack_normal(packed: u32) -> vec3<f32> {
+    if packed == 0x80008000u {
+        return vec3<f32>(0.0);
+    }
+    let f = unpack2x16snorm(packed);
+    var n = vec3<f32>(f, 1.0 - abs(f.x) - abs(f.y));
+    let t = max(-n.z, 0.0);
+    n.x += select(t, -t, n.x >= 0.0);
+    n.y += select(t, -t, n.y >= 0.0);
+    return normalize(n);
+}
+
+// Diffuse key light plus ambient; `facing` (the local normal dotted with the direction to the
+// eye) turns the normal towards the viewer, so back faces seen through open meshes are lit
+// like front faces.
+fn shade(base: vec3<f32>, normal: vec3<f32>, facing: f32, light_dir: vec3<f32>, ambient: f32) -> vec3<f32> {
     var n = normal;
-    if dot(n, to_eye) < 0.0 {
+    if facing < 0.0 {
         n = -n;
     }
     let diffuse = max(dot(n, light_dir), 0.0);
     return base * (ambient + (1.0 - ambient) * diffuse);
 }
 
-// The shaded colour of the surface point `world` of a triangle: the interpolated normal,
-// falling back to the face normal where it vanishes, then to the view direction. Every method
-// shades through this; the ground truth (src/raycast.rs) follows the same steps in f64.
-fn surface_color(f: Frame, world: vec3<f32>, normal: vec3<f32>, face_normal: vec3<f32>) -> vec3<f32> {
-    let to_eye = f.eye.xyz - world;
+// The shaded colour of the local surface point `p` of an instance's triangle: the
+// interpolated normal, falling back to the face normal where it vanishes, then to the view
+// direction; normals are taken to world axes for the light. Every method shades through
+// this; the ground truth (src/raycast.rs) follows the same steps in f64.
+fn surface_color(f: Frame, inst: Instance, p: vec3<f32>, normal: vec3<f32>, face_normal: vec3<f32>) -> vec3<f32> {
+    let to_eye = towards_eye(p, inst.eye);
     var n = normal;
     if !(dot(n, n) > 1e-12) {
         n = face_normal;
     }
     if !(dot(n, n) > 0.0) {
-        n = to_eye;
+        // Seen edge-on or degenerate: light it as if it faced the viewer.
+        return shade(f.fill_color.rgb, normalize(f.light_dir.xyz), 1.0, f.light_dir.xyz, f.ambient);
     }
-    return shade(f.fill_color.rgb, normalize(n), to_eye, f.light_dir.xyz, f.ambient);
+    let world = vec3<f32>(dot(inst.normal_x.xyz, n), dot(inst.normal_y.xyz, n), dot(inst.normal_z.xyz, n));
+    return shade(f.fill_color.rgb, normalize(world), dot(n, to_eye), f.light_dir.xyz, f.ambient);
 }
 
 fn linear_to_srgb(c: vec3<f32>) -> vec3<f32> {
@@ -198,10 +291,10 @@ fn linear_to_srgb(c: vec3<f32>) -> vec3<f32> {
     return select(1.055 * pow(x, vec3<f32>(1.0 / 2.4)) - 0.055, 12.92 * x, x <= vec3<f32>(0.0031308));
 }
 
-// Clip position for rasterising with reverse-Z depth (1 at near, 0 at far), whose precision
-// is nearly uniform in distance; x, y and w are those of `view_proj`.
-fn reverse_z(view_proj: mat4x4<f32>, depth_row: vec4<f32>, p: vec3<f32>) -> vec4<f32> {
+// Clip position for rasterising onto the targets with reverse depth (1 at near, 0 at far):
+// x and y mapped by the frame's crop, depth from the instance's depth row.
+fn raster_position(f: Frame, clip: mat4x4<f32>, depth_row: vec4<f32>, p: vec3<f32>) -> vec4<f32> {
     let h = vec4<f32>(p, 1.0);
-    let c = view_proj * h;
-    return vec4<f32>(c.x, c.y, dot(depth_row, h), c.w);
+    let c = clip * h;
+    return vec4<f32>(c.x * f.crop.x + c.w * f.crop.z, c.y * f.crop.y + c.w * f.crop.w, dot(depth_row, h), c.w);
 }

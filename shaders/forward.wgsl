@@ -1,13 +1,13 @@
 // Forward single-pass wireframe (Bærentzen et al. 2006, NVIDIA "Solid Wireframe" 2007; seeds
-// 000-004), with vertex pulling in place of the seeds' geometry shader. Prepended with
-// common.wgsl; the Rust side appends `encode_output` for the output format.
+// 000-004), with vertex pulling in place of the seeds' geometry shader. Assembled after
+// common.wgsl and scene.wgsl; the Rust side appends `encode_output` for the output format.
 //
-// A non-indexed draw of 3 × triangles vertices: invocation k reads triangle k / 3's three
-// vertices, projects all three, and computes the screen-space altitude of its own corner
-// k % 3 exactly as the seeds' geometry shader does, with the corrected WIN_SCALE (half the
-// image size; seed 000's reader comment). The three distances are interpolated without
-// perspective (`@interpolate(linear)` = GLSL `noperspective`), and the fragment's distance to
-// the nearest edge is their minimum.
+// One non-indexed instanced draw of 3 × triangles vertices per mesh: invocation k reads
+// triangle k / 3's three vertices, projects all three, and computes the screen-space altitude
+// of its own corner k % 3 exactly as the seeds' geometry shader does, with the corrected
+// WIN_SCALE (half the image size; seed 000's reader comment). The three distances are
+// interpolated without perspective (`@interpolate(linear)` = GLSL `noperspective`), and the
+// fragment's distance to the nearest edge is their minimum.
 //
 // Like the seeds, this DIVIDES BY w. It is the baseline as published, and its failure for
 // triangles that cross the near plane (w <= 0 behind the eye: the projected corners jump to
@@ -19,72 +19,45 @@
 // three distances on some triangles their clipper cuts (the same values interpolated with
 // perspective are fine), so those triangles lose their lines; tests/forward.rs pins how often.
 
-struct Draw {
-    first_id: u32,
-}
-
-@group(0) @binding(0) var<uniform> frame: Frame;
-@group(0) @binding(1) var<uniform> draw: Draw;
-// xyz per vertex, packed, mesh-local.
-@group(0) @binding(2) var<storage, read> positions: array<f32>;
-@group(0) @binding(3) var<storage, read> normals: array<f32>;
-@group(0) @binding(4) var<storage, read> indices: array<u32>;
-// Edge masks, 8 bits per triangle, 4 triangles per word; bit i = edge i (corner i -> i+1).
-@group(0) @binding(5) var<storage, read> edge_masks: array<u32>;
-// The second half of `indices`, for meshes split over two bindings (src/gpu/mesh.rs).
-@group(0) @binding(6) var<storage, read> indices_hi: array<u32>;
-
-// Vertex indices of triangle t.
-fn corners(t: u32) -> vec3<u32> {
-    if t < frame.index_split {
-        return vec3<u32>(indices[3u * t], indices[3u * t + 1u], indices[3u * t + 2u]);
-    }
-    let k = 3u * (t - frame.index_split);
-    return vec3<u32>(indices_hi[k], indices_hi[k + 1u], indices_hi[k + 2u]);
-}
-
 // Seed 004's Q ("max edge width", 100 there): the distance a masked edge's component
 // carries. Beyond the reach of any line a sane width draws, and small enough that the
 // rasteriser interpolates it without precision trouble.
 const MASKED: f32 = 1.0e6;
 
-fn position(v: u32) -> vec3<f32> {
-    return vec3<f32>(positions[3u * v], positions[3u * v + 1u], positions[3u * v + 2u]);
-}
-
-fn normal(v: u32) -> vec3<f32> {
-    return vec3<f32>(normals[3u * v], normals[3u * v + 1u], normals[3u * v + 2u]);
-}
-
-fn triangle_mask(t: u32) -> u32 {
-    return (edge_masks[t >> 2u] >> ((t & 3u) * 8u)) & 7u;
-}
-
-
 struct Varyings {
     @builtin(position) clip: vec4<f32>,
     // Component j: distance in pixels to the edge opposite corner j, i.e. edge (j + 1) % 3.
     @location(0) @interpolate(linear) dist: vec3<f32>,
-    @location(1) world: vec3<f32>,
+    @location(1) local: vec3<f32>,
     @location(2) normal: vec3<f32>,
     @location(3) @interpolate(flat) face_normal: vec3<f32>,
-    @location(4) @interpolate(flat) id: u32,
+    @location(4) @interpolate(flat) slot: u32,
+    @location(5) @interpolate(flat) tri: u32,
+}
+
+// The drawn edges of triangle t of instance `inst`.
+fn drawn_mask(inst: u32, t: u32) -> u32 {
+    if (instances[inst].flags & INSTANCE_EDGES) == 0u {
+        return 0u;
+    }
+    return info[instances[inst].triangle_base + t] & 7u;
 }
 
 @vertex
-fn vs_main(@builtin(vertex_index) k: u32) -> Varyings {
+fn vs_main(@builtin(vertex_index) k: u32, @location(7) slot: u32) -> Varyings {
     let t = k / 3u;
     let corner = k - 3u * t;
-    let v = corners(t);
-    let w0 = position(v.x);
-    let w1 = position(v.y);
-    let w2 = position(v.z);
+    let v = corners(instances[slot].triangle_base + t) + instances[slot].vertex_base;
+    let a0 = vertex_at(v.x);
+    let a1 = vertex_at(v.y);
+    let a2 = vertex_at(v.z);
+    let clip = instances[slot].clip;
 
     // The seeds' geometry shader, with WIN_SCALE = half the image size.
-    let win_scale = 0.5 * frame.size;
-    let c0 = frame.view_proj * vec4<f32>(w0, 1.0);
-    let c1 = frame.view_proj * vec4<f32>(w1, 1.0);
-    let c2 = frame.view_proj * vec4<f32>(w2, 1.0);
+    let win_scale = 0.5 * frame.image_size;
+    let c0 = clip * vec4<f32>(a0.xyz, 1.0);
+    let c1 = clip * vec4<f32>(a1.xyz, 1.0);
+    let c2 = clip * vec4<f32>(a2.xyz, 1.0);
     let p0 = win_scale * c0.xy / c0.w;
     let p1 = win_scale * c1.xy / c1.w;
     let p2 = win_scale * c2.xy / c2.w;
@@ -96,7 +69,7 @@ fn vs_main(@builtin(vertex_index) k: u32) -> Varyings {
     // Component j belongs to edge (j + 1) % 3: component 0 to edge 1 (mask bit 2), component
     // 1 to edge 2 (bit 4), component 2 to edge 0 (bit 1). So edge i is carried by corner
     // (i + 2) % 3, the corner opposite it.
-    let mask = triangle_mask(t);
+    let mask = drawn_mask(slot, t);
     let drawn = vec3<bool>((mask & 2u) != 0u, (mask & 4u) != 0u, (mask & 1u) != 0u);
     // A drawn edge's component is the corner's altitude at its own corner and 0 at the two
     // corners on the edge. A masked edge's component is Q at all three corners (seed 004 puts
@@ -104,32 +77,26 @@ fn vs_main(@builtin(vertex_index) k: u32) -> Varyings {
     // the edge out of the minimum everywhere, as the deferred pass's NO_EDGE does).
     var dist = select(vec3<f32>(MASKED), vec3<f32>(0.0), drawn);
     var opposite = v0;
+    var own = a0;
     if corner == 1u {
         opposite = v1;
+        own = a1;
     } else if corner == 2u {
         opposite = v2;
+        own = a2;
     }
     if drawn[corner] {
         dist[corner] = area / length(opposite);
     }
-
-    var own = w0;
-    var own_normal = normal(v.x);
-    if corner == 1u {
-        own = w1;
-        own_normal = normal(v.y);
-    } else if corner == 2u {
-        own = w2;
-        own_normal = normal(v.z);
-    }
     var out: Varyings;
     // Exactly the visibility pass's expression, so both rasterise the same triangles.
-    out.clip = reverse_z(frame.view_proj, frame.depth_row, own);
+    out.clip = raster_position(frame, clip, instances[slot].depth_row, own.xyz);
     out.dist = dist;
-    out.world = own;
-    out.normal = own_normal;
-    out.face_normal = cross(w1 - w0, w2 - w0);
-    out.id = draw.first_id + t;
+    out.local = own.xyz;
+    out.normal = unpack_normal(bitcast<u32>(own.w));
+    out.face_normal = cross(a1.xyz - a0.xyz, a2.xyz - a0.xyz);
+    out.slot = slot;
+    out.tri = t;
     return out;
 }
 
@@ -139,10 +106,11 @@ fn nearest(in: Varyings) -> f32 {
 }
 
 fn shaded(in: Varyings, d: f32) -> vec4<f32> {
-    let surface = surface_color(frame, in.world, in.normal, in.face_normal);
-    let w = (frame.view_proj * vec4<f32>(in.world, 1.0)).w;
-    let i = line_intensity(d, frame.line_width) * depth_fade(w, frame.fade);
-    return vec4<f32>(mix(surface, frame.wire_color.rgb, i * frame.wire_color.a), 1.0);
+    let inst = instances[in.slot];
+    let surface = surface_color(frame, inst, in.local, in.normal, in.face_normal);
+    let depth = dot(inst.fade_row, vec4<f32>(in.local, 1.0));
+    let i = line_intensity(d, inst.line_width) * depth_fade(depth, frame.fade);
+    return vec4<f32>(mix(surface, inst.wire_color.rgb, i * inst.wire_color.a), 1.0);
 }
 
 @fragment
@@ -152,10 +120,10 @@ fn fs_main(in: Varyings) -> @location(0) vec4<f32> {
 
 struct MapsOut {
     @location(0) color: vec4<f32>,
-    @location(1) id: u32,
+    @location(1) id: vec2<u32>,
     // The bits of two f32 (an Rgba32Uint target: float targets are not renderable on every
     // backend): r = distance in pixels (NO_EDGE where no edge is drawn; NaN stays NaN),
-    // g = reverse-Z raster depth.
+    // g = reverse raster depth.
     @location(2) diag: vec4<u32>,
 }
 
@@ -164,7 +132,7 @@ fn fs_maps(in: Varyings) -> MapsOut {
     var d = nearest(in);
     var out: MapsOut;
     out.color = encode_output(shaded(in, d));
-    out.id = in.id;
+    out.id = vec2<u32>(in.slot, in.tri);
     if d >= 0.5 * MASKED {
         d = NO_EDGE;
     }

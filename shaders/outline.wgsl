@@ -1,95 +1,120 @@
-// The outline pass (Style::silhouettes), assembled after edge_pass.wgsl, whose mesh bindings
-// and exact per-point triangle test (`sample`) it shares. It runs between the visibility pass
-// and the edge pass, which reads what it leaves in `outline_acc`.
+// The outline pass, after common.wgsl and scene.wgsl. It runs between the visibility pass
+// and the edge pass, which reads what it leaves in `acc`.
 //
 // A triangle only colours its own pixels, so the edge pass alone draws an outline edge (a
 // boundary, or a silhouette: see `is_silhouette`) at half width. Outline triangles are nearly
 // edge-on and often own no pixel centre at all, so they cannot be found from the ids around a
 // pixel; instead one invocation per triangle finds its outline edges, the visible runs of each
 // (points every 1/4 px tested, changes bisected), and writes into every pixel within the line's
-// reach the distance to the nearest visible run. Only triangles of the clusters that
+// reach the key (`line_key`) of the nearest visible run. Only triangles of the clusters that
 // `outline_cull` lists are visited, so the pass reads few triangles beyond those near an
 // outline. Definition (src/outline.rs implements it in f64 for the ground truth): pixel p is
 // at distance d from an outline when d is the distance from p's centre to the visible part of
-// the edge's projection (in front of the near plane, inside the image, not hidden by another
-// surface). No depth test at p is needed: a nearer surface between p and a farther edge has
-// its own outline between them, which is nearer to p and wins the minimum. Each pixel keeps
-// the least distance (and its depth fade) by an atomic max on `pack_outline`, so nothing is
-// drawn twice.
+// the edge's projection (in front of the near plane, not beyond the far plane, inside the
+// targets, not hidden by another surface). No depth test at p is needed: a nearer surface
+// between p and a farther edge has its own outline between them, which is nearer to p and
+// wins. Each pixel keeps the line that colours it most (the greatest key) by an atomic max,
+// so nothing is drawn twice.
+//
+// Flags: COLORS (instances differ in line colour: each pixel also keeps the greatest
+// (intensity level, instance) pair, so the edge pass knows whose line it holds).
 
-@group(1) @binding(6) var<storage, read_write> outline_acc: array<atomic<u32>>;
-// One Cluster per OUTLINE_GROUP triangles of `cluster_triangles` (src/mesh/clusters.rs).
-@group(1) @binding(7) var<storage, read> clusters: array<Cluster>;
-@group(1) @binding(8) var<storage, read_write> outline_list: OutlineList;
-@group(1) @binding(9) var<storage, read_write> outline_args: OutlineArgs;
-// Triangle ids in cluster order: cluster c holds entries OUTLINE_GROUP × c and on.
-@group(1) @binding(10) var<storage, read> cluster_triangles: array<u32>;
+@group(0) @binding(9) var<storage, read> clusters: array<Cluster>;
+@group(0) @binding(11) var<storage, read_write> acc_rw: array<atomic<u32>>;
 
-// The clusters that `outline_cull` finds may hold an outline edge; starts with count zero.
+// The (instance, cluster) pairs that `outline_cull` finds may hold an outline edge, and the
+// indirect dispatch size for visiting them; starts as (0, 1, 1, 0).
 struct OutlineList {
-    count: atomic<u32>,
-    clusters: array<u32>,
-}
-
-// The indirect dispatch size of `outline_main`, as `outline_cull` leaves it; starts zeroed.
-struct OutlineArgs {
     x: atomic<u32>,
     y: u32,
     z: u32,
+    count: atomic<u32>,
+    items: array<vec2<u32>>,
 }
+@group(0) @binding(13) var<storage, read_write> cull_rw: OutlineList;
 
-// Triangles per cluster, and invocations per workgroup of both entry points.
-const OUTLINE_GROUP: u32 = 64u;
+struct OutlineListRead {
+    x: u32,
+    y: u32,
+    z: u32,
+    count: u32,
+    items: array<vec2<u32>>,
+}
+@group(0) @binding(14) var<storage, read> cull: OutlineListRead;
+
 // Workgroups of `outline_main` at most; each then takes every MAX_OUTLINE_GROUPS-th listed
 // cluster. Below every device's max_compute_workgroups_per_dimension (at least 65535).
 const MAX_OUTLINE_GROUPS: u32 = 16384u;
 
-// A point on an edge is hidden when a surface there is nearer than this share of its depth.
-// Triangles sharing the edge's end vertices meet it at equal depth; this keeps their f32
-// rounding from hiding it.
-const HIDDEN_MARGIN: f32 = 1.0e-4;
+// The instance whose clusters hold the cull's flat cluster index f: the last with
+// cluster_first <= f (instances are in the order of their cluster_first).
+fn instance_of_cluster(f: u32) -> u32 {
+    var lo = 0u;
+    var hi = frame.instances;
+    while hi - lo > 1u {
+        let mid = (lo + hi) / 2u;
+        if instances[mid].cluster_first <= f {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    return lo;
+}
 
-// Lists the clusters that may hold an outline edge from this eye (`cluster_may_fold`), so that
-// the triangles of the others, usually nearly all, are never read.
+// Lists the clusters that may hold an outline edge from their instance's eye
+// (`cluster_may_fold`), so that the triangles of the others, usually nearly all, are never
+// read.
 @compute @workgroup_size(64)
 fn outline_cull(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
-    // Dispatched as a 2D grid: huge meshes have more clusters than one dimension allows.
-    let c = gid.x + gid.y * groups.x * OUTLINE_GROUP;
-    if c == 0u {
-        outline_args.y = 1u;
-        outline_args.z = 1u;
-    }
-    if c >= (frame.triangles + OUTLINE_GROUP - 1u) / OUTLINE_GROUP || !cluster_may_fold(clusters[c], frame.eye.xyz) {
+    // Dispatched as a 2D grid: huge scenes have more clusters than one dimension allows.
+    let f = gid.x + gid.y * groups.x * CLUSTER_TRIANGLES;
+    if f >= frame.clusters {
         return;
     }
-    let k = atomicAdd(&outline_list.count, 1u);
-    outline_list.clusters[k] = c;
-    atomicMax(&outline_args.x, min(k + 1u, MAX_OUTLINE_GROUPS));
+    let inst = instance_of_cluster(f);
+    if (instances[inst].flags & INSTANCE_OUTLINES) == 0u {
+        return;
+    }
+    let c = f - instances[inst].cluster_first;
+    if !cluster_may_fold(clusters[instances[inst].cluster_base + c], instances[inst].eye) {
+        return;
+    }
+    let k = atomicAdd(&cull_rw.count, 1u);
+    cull_rw.items[k] = vec2<u32>(inst, c);
+    atomicMax(&cull_rw.x, min(k + 1u, MAX_OUTLINE_GROUPS));
 }
+
+// Triangles per cluster, and invocations per workgroup of both entry points.
+const CLUSTER_TRIANGLES: u32 = 64u;
 
 // One invocation per triangle of each listed cluster.
 @compute @workgroup_size(64)
 fn outline_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32, @builtin(num_workgroups) groups: vec3<u32>) {
-    let count = atomicLoad(&outline_list.count);
+    let count = cull.count;
     for (var k = group.x; k < count; k += groups.x) {
-        let i = outline_list.clusters[k] * OUTLINE_GROUP + lane;
-        if i < frame.triangles {
-            outline_triangle(cluster_triangles[i]);
+        let item = cull.items[k];
+        let t = item.y * CLUSTER_TRIANGLES + lane;
+        if t < instances[item.x].triangles {
+            outline_triangle(item.x, t);
         }
     }
 }
 
-// Finds the outline edges of triangle t and draws them.
-fn outline_triangle(t: u32) {
-    let v = corners(t);
-    var p = array<vec3<f32>, 3>(position(v.x), position(v.y), position(v.z));
+// Finds the outline edges of triangle t of instance `inst` and draws them.
+fn outline_triangle(inst: u32, t: u32) {
+    let base = instances[inst].triangle_base;
+    let vbase = instances[inst].vertex_base;
+    let v = corners(base + t) + vbase;
+    var p = array<vec3<f32>, 3>(vertex_at(v.x).xyz, vertex_at(v.y).xyz, vertex_at(v.z).xyz);
     // Most triangles are seen well away from edge-on, further than their edges fold: none of
     // their neighboured edges can be a silhouette (Mesh::outline_hints), and they skip the
     // neighbours' vertices. The angle is taken from the triangle's farthest vertex, its least.
-    let hints = (edge_masks[t >> 2u] >> ((t & 3u) * 8u + 3u)) & 31u;
-    let boundary = (hints & 1u) != 0u;
+    let bits = info[base + t];
+    let boundary = (bits & 8u) != 0u;
+    let allowed = (bits >> 8u) & 7u;
     // Decoded as adjacency::fold_bound: 0 flat, 2^(q - 14) with a margin, 15 never skip.
-    let q = hints >> 1u;
+    let q = (bits >> 4u) & 15u;
     var fold_bound = exp2(f32(q) - 14.0) * 1.01 + 1e-6;
     if q == 0u {
         fold_bound = 1e-6;
@@ -97,26 +122,36 @@ fn outline_triangle(t: u32) {
         fold_bound = 2.0;
     }
     let normal = cross(p[1] - p[0], p[2] - p[0]);
-    let eye = frame.eye.xyz;
-    let height = abs(dot(p[0] - eye, normal));
-    let farthest = sqrt(max(dot(p[0] - eye, p[0] - eye), max(dot(p[1] - eye, p[1] - eye), dot(p[2] - eye, p[2] - eye))));
-    let may_fold = !(height > fold_bound * farthest * length(normal));
+    let eye = instances[inst].eye;
+    var may_fold = true;
+    if eye.w != 0.0 {
+        let e = eye.xyz / eye.w;
+        let height = abs(dot(p[0] - e, normal));
+        let farthest = sqrt(max(dot(p[0] - e, p[0] - e), max(dot(p[1] - e, p[1] - e), dot(p[2] - e, p[2] - e))));
+        may_fold = !(height > fold_bound * farthest * length(normal));
+    } else {
+        // Seen along one direction: the angle to edge-on is the same from every vertex.
+        may_fold = !(abs(dot(eye.xyz, normal)) > fold_bound * length(eye.xyz) * length(normal));
+    }
     if !may_fold && !boundary {
         return;
     }
     for (var i = 0u; i < 3u; i++) {
-        let n = neighbour(t, i);
+        if (allowed & (1u << i)) == 0u {
+            continue;
+        }
+        let n = neighbour(base + t, i);
         let a = p[i];
         let b = p[(i + 1u) % 3u];
         var outline = n == BACKGROUND_ID;
         if !outline && may_fold && t < n {
             // Shared edges are drawn by the lower id only.
-            let w = corners(n);
-            let d = (position(w.x) + position(w.y) + position(w.z)) / 3.0;
+            let w = corners(base + n) + vbase;
+            let d = (vertex_at(w.x).xyz + vertex_at(w.y).xyz + vertex_at(w.z).xyz) / 3.0;
             outline = is_silhouette(a, b, p[(i + 2u) % 3u], d, eye);
         }
         if outline {
-            draw_outline(t, n, a, b);
+            draw_outline(inst, t, n, a, b);
         }
     }
 }
@@ -145,17 +180,23 @@ fn keep_between(range: vec2<f32>, p0: f32, d: f32, lo: f32, hi: f32) -> vec2<f32
     return vec2<f32>(max(range.x, min(u0, u1)), min(range.y, max(u0, u1)));
 }
 
-// Where a clip-space point lands: pixel coordinates, and 1/w, which is affine along a screen
-// segment.
+// Where a clip-space point lands: full-image pixel coordinates, and 1/w, near/w and view
+// depth/w, which are affine along a screen segment.
 struct Projected {
     xy: vec2<f32>,
     inv_w: f32,
+    near_w: f32,
+    fade_w: f32,
 }
 
-fn project(c: vec4<f32>) -> Projected {
+fn project(c: vec4<f32>, fade: f32) -> Projected {
     let inv_w = 1.0 / c.w;
     let ndc = c.xy * inv_w;
-    return Projected(vec2<f32>(0.5 * (ndc.x + 1.0), 0.5 * (1.0 - ndc.y)) * frame.size, inv_w);
+    return Projected(vec2<f32>(0.5 * (ndc.x + 1.0), 0.5 * (1.0 - ndc.y)) * frame.image_size, inv_w, c.z * inv_w, fade * inv_w);
+}
+
+fn lerp_projected(a: Projected, b: Projected, k: f32) -> Projected {
+    return Projected(mix(a.xy, b.xy, k), mix(a.inv_w, b.inv_w, k), mix(a.near_w, b.near_w, k), mix(a.fade_w, b.fade_w, k));
 }
 
 // Visibility samples per pixel of edge length; each change between two is then bisected.
@@ -166,57 +207,59 @@ const RUN_BISECTIONS: u32 = 12u;
 const PIECE_PX: f32 = 16.0;
 const MAX_RUNS: u32 = 8u;
 
-// The screen segment of an outline edge, clipped to the view and the image.
+// The screen segment of an outline edge, clipped to the view and the targets.
 struct Segment {
-    start: vec2<f32>,
-    along: vec2<f32>,
-    // 1/w at both ends; affine along the segment.
-    inv_w: vec2<f32>,
+    start: Projected,
+    end: Projected,
+    inst: u32,
     t: u32,
     n: u32,
 }
 
-fn seg_point(s: Segment, k: f32) -> vec2<f32> {
-    return s.start + k * s.along;
-}
-
-fn seg_w(s: Segment, k: f32) -> f32 {
-    return 1.0 / mix(s.inv_w.x, s.inv_w.y, k);
+fn seg_at(s: Segment, k: f32) -> Projected {
+    return lerp_projected(s.start, s.end, k);
 }
 
 fn seg_visible(s: Segment, k: f32) -> bool {
-    return visible_at(seg_point(s, k), seg_w(s, k), s.t, s.n);
+    let q = seg_at(s, k);
+    let w = 1.0 / q.inv_w;
+    return visible_at(q.xy, q.near_w * w, w, s.inst, s.t, s.n);
 }
 
-// Writes edge a -> b (of triangle t, with neighbour n) into every pixel within reach of its
-// visible part.
-fn draw_outline(t: u32, n: u32, a: vec3<f32>, b: vec3<f32>) {
-    let ca = frame.view_proj * vec4<f32>(a, 1.0);
-    let cb = frame.view_proj * vec4<f32>(b, 1.0);
-    let ra = dot(frame.depth_row, vec4<f32>(a, 1.0));
-    let rb = dot(frame.depth_row, vec4<f32>(b, 1.0));
-    // In front of the near plane (clip z >= 0) and not beyond the far one (reverse-Z >= 0).
+// Writes edge a -> b (of triangle t of `inst`, with neighbour n) into every pixel within reach
+// of its visible part.
+fn draw_outline(inst: u32, t: u32, n: u32, a: vec3<f32>, b: vec3<f32>) {
+    let clip = instances[inst].clip;
+    let ha = vec4<f32>(a, 1.0);
+    let hb = vec4<f32>(b, 1.0);
+    let ca = clip * ha;
+    let cb = clip * hb;
+    let depth_row = instances[inst].depth_row;
+    let fade_row = instances[inst].fade_row;
+    // In front of the near plane and not beyond the far one.
     var s = keep_positive(vec2<f32>(0.0, 1.0), ca.z, cb.z);
-    s = keep_positive(s, ra, rb);
+    s = keep_positive(s, dot(depth_row, ha), dot(depth_row, hb));
     if !(s.x <= s.y) {
         return;
     }
-    let p0 = project(mix(ca, cb, s.x));
-    let p1 = project(mix(ca, cb, s.y));
-    // Inside the image.
+    let p0 = project(mix(ca, cb, s.x), mix(dot(fade_row, ha), dot(fade_row, hb), s.x));
+    let p1 = project(mix(ca, cb, s.y), mix(dot(fade_row, ha), dot(fade_row, hb), s.y));
+    // Inside the targets.
     let d = p1.xy - p0.xy;
-    var u = keep_between(vec2<f32>(0.0, 1.0), p0.xy.x, d.x, 0.0, frame.size.x);
-    u = keep_between(u, p0.xy.y, d.y, 0.0, frame.size.y);
+    let lo = frame.target_origin;
+    let hi = frame.target_origin + frame.target_size;
+    var u = keep_between(vec2<f32>(0.0, 1.0), p0.xy.x, d.x, lo.x, hi.x);
+    u = keep_between(u, p0.xy.y, d.y, lo.y, hi.y);
     if !(u.x <= u.y) {
         return;
     }
     var seg: Segment;
-    seg.start = p0.xy + u.x * d;
-    seg.along = (u.y - u.x) * d;
-    seg.inv_w = vec2<f32>(mix(p0.inv_w, p1.inv_w, u.x), mix(p0.inv_w, p1.inv_w, u.y));
+    seg.start = lerp_projected(p0, p1, u.x);
+    seg.end = lerp_projected(p0, p1, u.y);
+    seg.inst = inst;
     seg.t = t;
     seg.n = n;
-    let length_px = length(seg.along);
+    let length_px = length(seg.end.xy - seg.start.xy);
     let pieces = max(u32(ceil(length_px / PIECE_PX)), 1u);
     for (var piece = 0u; piece < pieces; piece++) {
         draw_piece(seg, f32(piece) / f32(pieces), f32(piece + 1u) / f32(pieces), length_px);
@@ -224,7 +267,7 @@ fn draw_outline(t: u32, n: u32, a: vec3<f32>, b: vec3<f32>) {
 }
 
 // Finds the visible runs of the segment between parameters k0 and k1, then writes the
-// distance to the nearest of them into every pixel within reach.
+// key of the nearest of them into every pixel within reach.
 fn draw_piece(seg: Segment, k0: f32, k1: f32, length_px: f32) {
     var runs: array<vec2<f32>, MAX_RUNS>;
     var count = 0u;
@@ -270,25 +313,29 @@ fn draw_piece(seg: Segment, k0: f32, k1: f32, length_px: f32) {
         return;
     }
 
-    let reach = line_reach(frame.line_width);
-    let q0 = seg_point(seg, k0);
-    let q1 = seg_point(seg, k1);
+    let width = instances[seg.inst].line_width;
+    let reach = line_reach(width);
+    let along = seg.end.xy - seg.start.xy;
+    let q0 = seg.start.xy + k0 * along;
+    let q1 = seg.start.xy + k1 * along;
     let span = q1 - q0;
-    let len2 = dot(seg.along, seg.along);
+    let len2 = dot(along, along);
     // Walk the pixels along the piece's major axis; across it, the band within reach of the
     // line is at most reach × √2 wide on either side (slope <= 1), plus a pixel for rounding.
+    // Pixels are addressed in target coordinates.
     let major = select(1u, 0u, abs(span.x) >= abs(span.y));
     let minor = 1u - major;
-    let last = vec2<i32>(frame.size) - 1;
+    let last = vec2<i32>(frame.target_size) - 1;
+    let origin = frame.target_origin;
     let band = reach * 1.4142135 + 1.0;
-    let first_m = max(i32(floor(min(q0[major], q1[major]) - reach)), 0);
-    let last_m = min(i32(ceil(max(q0[major], q1[major]) + reach)), last[major]);
+    let first_m = max(i32(floor(min(q0[major], q1[major]) - reach - origin[major])), 0);
+    let last_m = min(i32(ceil(max(q0[major], q1[major]) + reach - origin[major])), last[major]);
     for (var m = first_m; m <= last_m; m++) {
         var f = 0.0;
         if span[major] != 0.0 {
-            f = clamp((f32(m) + 0.5 - q0[major]) / span[major], 0.0, 1.0);
+            f = clamp((f32(m) + 0.5 + origin[major] - q0[major]) / span[major], 0.0, 1.0);
         }
-        let across = q0[minor] + f * span[minor];
+        let across = q0[minor] + f * span[minor] - origin[minor];
         let first_o = max(i32(floor(across - band)), 0);
         let last_o = min(i32(ceil(across + band)), last[minor]);
         for (var o = first_o; o <= last_o; o++) {
@@ -296,17 +343,17 @@ fn draw_piece(seg: Segment, k0: f32, k1: f32, length_px: f32) {
             if major == 1u {
                 xy = vec2<i32>(o, m);
             }
-            let pixel = vec2<f32>(xy) + 0.5;
+            let pixel = vec2<f32>(xy) + origin + 0.5;
             // Nearest point of the nearest visible run.
             var k = 0.0;
             if len2 > 0.0 {
-                k = dot(pixel - seg.start, seg.along) / len2;
+                k = dot(pixel - seg.start.xy, along) / len2;
             }
             var best = NO_EDGE;
             var best_k = 0.0;
             for (var r = 0u; r < count; r++) {
                 let kr = clamp(k, runs[r].x, runs[r].y);
-                let dr = distance(pixel, seg_point(seg, kr));
+                let dr = distance(pixel, seg.start.xy + kr * along);
                 if dr < best {
                     best = dr;
                     best_k = kr;
@@ -315,31 +362,34 @@ fn draw_piece(seg: Segment, k0: f32, k1: f32, length_px: f32) {
             if !(best < reach) {
                 continue;
             }
-            let fade = depth_fade(seg_w(seg, best_k), frame.fade);
-            let index = u32(xy.y) * u32(frame.size.x) + u32(xy.x);
-            atomicMax(&outline_acc[index], pack_outline(best, fade));
+            let q = seg_at(seg, best_k);
+            let fade = depth_fade(q.fade_w / q.inv_w, frame.fade);
+            let key = line_key(line_intensity(best, width) * fade, best);
+            let index = u32(xy.y) * u32(frame.target_size.x) + u32(xy.x);
+#if COLORS
+            atomicMax(&acc_rw[2u * index], key);
+            atomicMax(&acc_rw[2u * index + 1u], (key & 0xfff00000u) | seg.inst);
+#else
+            atomicMax(&acc_rw[index], key);
+#endif
         }
     }
 }
 
-// True unless a triangle other than t and n covers the screen point x nearer than view depth
-// w. The candidates are the triangles the rasterizer gave the four pixel centres around x,
-// and those a walk across edges from them reaches when they do not cover x themselves (x may
-// lie in a small triangle that owns none of those centres).
-fn visible_at(x: vec2<f32>, w: f32, t: u32, n: u32) -> bool {
-    let base = vec2<i32>(floor(x - 0.5));
-    let last = vec2<i32>(frame.size) - 1;
+// True unless a triangle other than t and n of `inst` covers the screen point x nearer than
+// the point at near row `near` and w `w` on the edge. The candidates are the triangles the
+// rasterizer gave the four pixel centres around x, and those a walk across edges from them
+// reaches when they do not cover x themselves (x may lie in a small triangle that owns none
+// of those centres).
+fn visible_at(x: vec2<f32>, near: f32, w: f32, inst: u32, t: u32, n: u32) -> bool {
+    let base = vec2<i32>(floor(x - frame.target_origin - 0.5));
     for (var k = 0; k < 4; k++) {
-        let q = clamp(base + vec2<i32>(k & 1, k >> 1u), vec2<i32>(0), last);
-        let id = textureLoad(ids, vec2<u32>(q), 0).x;
-        if id == BACKGROUND_ID || id == t || id == n {
+        let id = id_at(base + vec2<i32>(k & 1, k >> 1u));
+        if id.x >= HOST_ID || (id.x == inst && (id.y == t || id.y == n)) {
             continue;
         }
-        var s = sample(id, x);
-        if !s.covers {
-            s = walk(s, x);
-        }
-        if s.covers && s.id != t && s.id != n && s.w < w * (1.0 - HIDDEN_MARGIN) {
+        let s = locate(id.x, id.y, x, WALK_STEPS);
+        if s.covers && !(s.inst == inst && (s.tri == t || s.tri == n)) && nearer(s.near, near, w) {
             return false;
         }
     }

@@ -5,11 +5,10 @@
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::gpu::{
-    texture_2d, DeferredPass, EdgeLines, ForwardPass, GpuContext, GpuMesh, GpuTimer, OutputTarget,
-    PassOptions, TwoPass,
+    texture_2d, DeferredPass, EdgeLines, ForwardPass, GpuContext, GpuTimer, MeshStore,
+    OutputTarget, PassOptions, PreparedFrame, RasterFrame, TwoPass,
 };
-use crate::mesh::{EdgeSelection, Mesh};
-use crate::render::Scene;
+use crate::render::{Shot, Uploaded, World};
 use crate::style::Style;
 use std::collections::BTreeMap;
 use std::time::Instant;
@@ -44,13 +43,14 @@ impl Stats {
 pub struct Run {
     /// Scene name as given.
     pub scene: String,
-    /// Triangle count.
-    pub triangles: usize,
+    /// Triangle count over all objects.
+    pub triangles: u64,
     /// Image size.
     pub size: [u32; 2],
     /// Method name.
     pub method: String,
-    /// GPU time of each pass.
+    /// GPU time of each pass, and of each group of passes (`edge` is `edge.main` plus
+    /// `edge.refine`, `outline` is `outline.cull` plus `outline.draw`).
     pub passes: BTreeMap<String, Stats>,
     /// Median over frames of the sum of the passes.
     pub total_median_ms: f64,
@@ -60,12 +60,12 @@ pub struct Run {
     pub gpu_bytes: u64,
 }
 
-/// A method being measured: its pass and output.
+/// A method being measured: its pass, prepared frame and output.
 enum Subject {
-    Floor(DeferredPass, wgpu::Texture),
-    Deferred(DeferredPass, wgpu::Texture),
-    Forward(ForwardPass, wgpu::Texture),
-    TwoPass(TwoPass, EdgeLines, wgpu::Texture),
+    Floor(DeferredPass, PreparedFrame, wgpu::Texture),
+    Deferred(DeferredPass, PreparedFrame, wgpu::Texture),
+    Forward(ForwardPass, RasterFrame, wgpu::Texture),
+    TwoPass(TwoPass, RasterFrame, wgpu::Texture),
 }
 
 impl Subject {
@@ -82,37 +82,39 @@ impl Subject {
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
-        mesh: &GpuMesh,
+        (store, lines): (&MeshStore, &EdgeLines),
         timer: &mut GpuTimer,
     ) -> Result<()> {
         match self {
-            Subject::Floor(pass, out) => {
+            Subject::Floor(pass, frame, out) => {
                 let view = out.create_view(&Default::default());
-                pass.encode_timed(device, encoder, mesh, OutputTarget::Floor(&view), timer)
+                let target = OutputTarget::Floor(&view);
+                pass.encode_timed(device, encoder, store, frame, target, timer)
             }
-            Subject::Deferred(pass, out) => {
+            Subject::Deferred(pass, frame, out) => {
                 let view = out.create_view(&Default::default());
-                pass.encode_timed(device, encoder, mesh, OutputTarget::Shaded(&view), timer)
+                let target = OutputTarget::Shaded(&view);
+                pass.encode_timed(device, encoder, store, frame, target, timer)
             }
-            Subject::Forward(pass, out) => {
+            Subject::Forward(pass, frame, out) => {
                 let view = out.create_view(&Default::default());
-                pass.encode_timed(device, encoder, mesh, &view, timer)
+                pass.encode_timed(device, encoder, store, frame, &view, timer)
             }
-            Subject::TwoPass(pass, lines, out) => {
+            Subject::TwoPass(pass, frame, out) => {
                 let view = out.create_view(&Default::default());
-                pass.encode_timed(device, encoder, mesh, lines, &view, timer)
+                pass.encode_timed(device, encoder, (store, lines), frame, &view, timer)
             }
         }
     }
 
-    fn bytes(&self) -> u64 {
+    fn bytes(&self, lines: &EdgeLines) -> u64 {
         let texture = |t: &wgpu::Texture| u64::from(t.width()) * u64::from(t.height()) * 4;
-        // Colour, id and depth targets of the forward methods: 4 bytes per pixel each.
-        let forward = |t: &wgpu::Texture| 3 * texture(t);
+        // Colour, id (8 bytes), depth and diagnostic targets of the forward methods.
+        let forward = |t: &wgpu::Texture| 4 * texture(t);
         match self {
-            Subject::Floor(p, t) | Subject::Deferred(p, t) => p.target_bytes() + texture(t),
-            Subject::Forward(_, t) => forward(t),
-            Subject::TwoPass(_, lines, t) => forward(t) + lines.gpu_bytes(),
+            Subject::Floor(p, _, t) | Subject::Deferred(p, _, t) => p.target_bytes() + texture(t),
+            Subject::Forward(_, _, t) => forward(t),
+            Subject::TwoPass(_, _, t) => forward(t) + lines.gpu_bytes(),
         }
     }
 }
@@ -126,33 +128,33 @@ pub struct Timing {
     pub warmup: u32,
 }
 
-/// Times every method on `mesh` at `size`, with the framing camera and `style`: see
+/// Times every method on `world` at `size`, with the framing camera and `style`: see
 /// [`bench_scene`].
 pub fn bench(
     ctx: &GpuContext,
     name: &str,
-    mesh: &Mesh,
+    world: &World,
     size: (u32, u32),
     style: &Style,
     timing: Timing,
 ) -> Result<Vec<Run>> {
-    let (lo, hi) = mesh.bounds();
-    let scene = Scene {
-        mesh,
-        camera: Camera::framing(lo, hi, size.0 as f32 / size.1 as f32),
-        style: style.clone(),
+    let (lo, hi) = world.bounds();
+    let aspect = f64::from(size.0) / f64::from(size.1);
+    let shot = Shot {
+        world,
+        view: Camera::framing(lo, hi, aspect).to_view(aspect),
+        style,
         size,
-        edges: EdgeSelection::Polygon,
     };
-    bench_scene(ctx, name, &scene, timing)
+    bench_scene(ctx, name, &shot, timing)
 }
 
-/// Times the floor and every GPU method on `scene`: `timing.warmup` untimed frames, then
+/// Times the floor and every GPU method on `shot`: `timing.warmup` untimed frames, then
 /// `timing.frames` timed frames, each frame running every method once, in turn.
 pub fn bench_scene(
     ctx: &GpuContext,
     name: &str,
-    scene: &Scene<'_>,
+    shot: &Shot<'_>,
     Timing { frames, warmup }: Timing,
 ) -> Result<Vec<Run>> {
     if frames == 0 {
@@ -160,8 +162,10 @@ pub fn bench_scene(
     }
     let device = &ctx.device;
     let queue = &ctx.queue;
-    let (mesh, size, camera, style) = (scene.mesh, scene.size, scene.camera, &scene.style);
-    let gpu_mesh = GpuMesh::new(device, mesh, scene.edges)?;
+    let size = shot.size;
+    let up = Uploaded::new(ctx, shot.world)?;
+    let lines = up.edge_lines(ctx, shot.world)?;
+    let scene = up.scene(shot.world, shot.view);
     let storage = || {
         let usage = wgpu::TextureUsages::STORAGE_BINDING;
         texture_2d(
@@ -188,31 +192,30 @@ pub fn bench_scene(
     let mut subjects = Vec::new();
     for floor in [true, false] {
         let mut pass = DeferredPass::new(device, PassOptions::default())?;
-        pass.prepare(device, queue, &gpu_mesh, &camera, style, size)?;
+        let frame = pass.prepare(device, &up.store, &scene, shot.style, size)?;
         subjects.push(if floor {
-            Subject::Floor(pass, storage())
+            Subject::Floor(pass, frame, storage())
         } else {
-            Subject::Deferred(pass, storage())
+            Subject::Deferred(pass, frame, storage())
         });
     }
     let mut forward = ForwardPass::new(device, forward_options)?;
-    forward.prepare(device, queue, &gpu_mesh, &camera, style, size)?;
-    subjects.push(Subject::Forward(forward, attachment()));
+    let frame = forward.prepare(device, &up.store, &scene, shot.style, size)?;
+    subjects.push(Subject::Forward(forward, frame, attachment()));
     let mut two_pass = TwoPass::new(device, forward_options)?;
-    two_pass.prepare(device, queue, &gpu_mesh, &camera, style, size)?;
-    let lines = EdgeLines::new(device, mesh, scene.edges)?;
-    subjects.push(Subject::TwoPass(two_pass, lines, attachment()));
+    let frame = two_pass.prepare(device, &up.store, &scene, shot.style, size)?;
+    subjects.push(Subject::TwoPass(two_pass, frame, attachment()));
     ctx.finish()?;
 
-    let mut timer = GpuTimer::new(device, queue, 4)?;
-    let mut gpu: Vec<BTreeMap<&'static str, Vec<f64>>> = vec![BTreeMap::new(); subjects.len()];
+    let mut timer = GpuTimer::new(device, queue, 6)?;
+    let mut gpu: Vec<BTreeMap<String, Vec<f64>>> = vec![BTreeMap::new(); subjects.len()];
     let mut totals = vec![Vec::new(); subjects.len()];
     let mut cpu = vec![Vec::new(); subjects.len()];
     for frame in 0..warmup + frames {
         for (i, subject) in subjects.iter().enumerate() {
             let start = Instant::now();
             let mut encoder = device.create_command_encoder(&Default::default());
-            subject.encode(device, &mut encoder, &gpu_mesh, &mut timer)?;
+            subject.encode(device, &mut encoder, (&up.store, &lines), &mut timer)?;
             timer.resolve(&mut encoder);
             queue.submit([encoder.finish()]);
             let recorded = start.elapsed().as_secs_f64() * 1e3;
@@ -221,27 +224,35 @@ pub fn bench_scene(
             if frame >= warmup {
                 cpu[i].push(recorded);
                 totals[i].push(spans.iter().map(|s| s.1).sum());
+                let mut groups: BTreeMap<String, f64> = BTreeMap::new();
                 for (name, ms) in spans {
-                    gpu[i].entry(name).or_default().push(ms);
+                    if let Some((group, _)) = name.split_once('.') {
+                        *groups.entry(group.to_owned()).or_default() += ms;
+                    }
+                    gpu[i].entry(name.to_owned()).or_default().push(ms);
+                }
+                for (group, ms) in groups {
+                    gpu[i].entry(group).or_default().push(ms);
                 }
             }
         }
     }
+    let store_bytes = up.store.gpu_bytes();
     Ok(subjects
         .iter()
         .enumerate()
         .map(|(i, subject)| Run {
             scene: name.to_owned(),
-            triangles: mesh.triangle_count(),
+            triangles: shot.world.triangle_count(),
             size: [size.0, size.1],
             method: subject.name().to_owned(),
             passes: gpu[i]
                 .iter()
-                .map(|(name, v)| ((*name).to_owned(), Stats::of(v)))
+                .map(|(name, v)| (name.clone(), Stats::of(v)))
                 .collect(),
             total_median_ms: Stats::of(&totals[i]).median_ms,
             cpu: Stats::of(&cpu[i]),
-            gpu_bytes: gpu_mesh.gpu_bytes() + subject.bytes(),
+            gpu_bytes: store_bytes + subject.bytes(&lines),
         })
         .collect())
 }

@@ -1,10 +1,234 @@
-//! The pinhole camera every method shares: right-handed look-at, `perspective_rh` projection
-//! with depth 0..1, image row 0 at the top, pixel `(x, y)` centred at `(x + 0.5, y + 0.5)`.
+//! How the scene is seen: the host's own [`View`] (view and projection matrices of any
+//! standard kind) and [`Camera`], the look-at perspective convenience.
+//!
+//! Conventions every method shares: clip space as wgpu has it (x right, y up, visible
+//! points have `w > 0` and depth `z/w` in 0..1), image row 0 at the top, pixel `(x, y)`
+//! centred at `(x + 0.5, y + 0.5)`. Which end of the depth range is near is the view's
+//! [`DepthRange`]; perspective and orthographic projections, finite or infinite far
+//! planes and off-centre (jittered) frusta are all taken as given.
+
+// `!(a > b)` is deliberate throughout: NaN must take the rejecting branch.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 use crate::error::{Error, Result};
-use glam::{DMat4, DVec3, Vec3};
+use glam::dcamera::rh::{proj::directx as proj, view::look_at_mat4};
+use glam::{DMat4, DVec3, DVec4, Mat4, Vec3};
 
-/// A perspective camera. Angles in degrees; `near`/`far` are view-space distances.
+/// Which end of the 0..1 depth range a projection puts at the near plane.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum DepthRange {
+    /// Depth 0 at the near plane, 1 at the far plane (`perspective_rh`, `orthographic_rh`).
+    #[default]
+    Standard,
+    /// Depth 1 at the near plane, 0 at the far plane (reverse-Z).
+    Reversed,
+}
+
+/// The host's view of the scene: world → view and view → clip matrices, exactly as it
+/// renders with them, and its depth convention.
+///
+/// wirepass derives everything else from these: the eye (a point for perspective
+/// projections, a direction for orthographic ones), the near and far planes, and the light
+/// direction (given in view space by [`Style`](crate::Style)). Nothing divides by `w`, so
+/// vertices at or behind the eye stay exact.
+///
+/// ```
+/// use wirepass::glam::dcamera::rh::{proj::directx as proj, view::look_at_mat4};
+/// use wirepass::glam::DVec3;
+/// use wirepass::{DepthRange, View};
+///
+/// let view = look_at_mat4(DVec3::new(0.0, 1.0, 4.0), DVec3::ZERO, DVec3::Y);
+/// // A CAD-style orthographic view 3 units tall, reverse-Z.
+/// let projection = proj::orthographic(-2.0, 2.0, -1.5, 1.5, 10.0, 0.1);
+/// let v = View::new(view, projection, DepthRange::Reversed);
+/// assert!(v.validate().is_ok());
+/// assert!(v.is_orthographic());
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct View {
+    /// World → view space.
+    pub view: DMat4,
+    /// View → clip space.
+    pub projection: DMat4,
+    /// Which end of the depth range is near.
+    pub depth: DepthRange,
+}
+
+/// A view's clip transform in the form the passes use, for one model matrix: the rows
+/// giving clip x, y and w, a row that is ≥ 0 exactly in front of the near plane, and a
+/// reverse depth row that is ≥ 0 exactly before the far plane, with (reverse depth)/w equal
+/// to 1 at the near plane and 0 at the far plane, whatever the view's [`DepthRange`].
+/// Each row is formed in f64 from the matrices, so neither loses precision to a
+/// subtraction in f32.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ClipRows {
+    /// Rows x, y, near, w: clip position with the near-distance row in place of z.
+    pub clip: DMat4,
+    /// The reverse depth row.
+    pub depth: DVec4,
+}
+
+impl View {
+    /// A view from the host's matrices.
+    pub fn new(view: DMat4, projection: DMat4, depth: DepthRange) -> View {
+        View {
+            view,
+            projection,
+            depth,
+        }
+    }
+
+    /// A view from f32 matrices, as many renderers keep them.
+    pub fn from_f32(view: Mat4, projection: Mat4, depth: DepthRange) -> View {
+        View::new(view.as_dmat4(), projection.as_dmat4(), depth)
+    }
+
+    /// An orthographic view looking from `eye` at `target`, showing `height` world units
+    /// from the bottom to the top of the image at `aspect` (width / height), with depth
+    /// from `near` to `far` along the view direction (`near` may be negative).
+    pub fn orthographic(
+        (eye, target, up): (DVec3, DVec3, DVec3),
+        height: f64,
+        aspect: f64,
+        (near, far): (f64, f64),
+    ) -> View {
+        let (h, w) = (0.5 * height, 0.5 * height * aspect);
+        View::new(
+            look_at_mat4(eye, target, up.normalize_or_zero()),
+            proj::orthographic(-w, w, -h, h, near, far),
+            DepthRange::Standard,
+        )
+    }
+
+    /// World → clip.
+    pub fn view_projection(&self) -> DMat4 {
+        self.projection * self.view
+    }
+
+    /// True when the projection is affine (orthographic): clip w does not depend on the point.
+    pub fn is_orthographic(&self) -> bool {
+        self.projection.row(3).truncate() == DVec3::ZERO
+    }
+
+    /// The eye in homogeneous world coordinates: `(eye, 1)` for a perspective projection,
+    /// `(direction towards the viewer, 0)`, unit length, for an orthographic one. It is the
+    /// point every pixel's ray passes through (the one clip x, y and w all vanish at).
+    pub fn eye(&self) -> DVec4 {
+        let inv_view = self.view.inverse();
+        if self.is_orthographic() {
+            // Parallel rays: towards the viewer is where the near-distance row falls.
+            let rows = self.clip_rows(DMat4::IDENTITY);
+            let near_dir = rows.clip.row(2).truncate();
+            let d = -near_dir.normalize_or_zero();
+            return d.extend(0.0);
+        }
+        let e = null_vector(self.projection);
+        let e = if e.w != 0.0 { e / e.w } else { e };
+        let world = inv_view * e;
+        if world.w != 0.0 {
+            world / world.w
+        } else {
+            world
+        }
+    }
+
+    /// The clip rows of this view for a model matrix (object → world).
+    pub fn clip_rows(&self, model: DMat4) -> ClipRows {
+        let m = self.projection * self.view * model;
+        let (z, w) = (m.row(2), m.row(3));
+        let (near, depth) = match self.depth {
+            DepthRange::Standard => (z, w - z),
+            DepthRange::Reversed => (w - z, z),
+        };
+        ClipRows {
+            clip: DMat4::from_cols(m.row(0), m.row(1), near, w).transpose(),
+            depth,
+        }
+    }
+
+    /// View depth of a world point: its distance in front of the eye along the view axis
+    /// (−z in view space, as `look_at_rh` has it). The depth fade works on it.
+    pub fn view_depth_row(&self) -> DVec4 {
+        -self.view.row(2)
+    }
+
+    /// Checks that the view defines a projection wirepass can draw: finite, invertible
+    /// matrices, and a depth convention the projection agrees with.
+    pub fn validate(&self) -> Result<()> {
+        let bad = |m: String| Err(Error::InvalidCamera(m));
+        if !self.view.is_finite() || !self.projection.is_finite() {
+            return bad("the view or projection matrix has a non-finite entry".into());
+        }
+        let det = |m: DMat4| m.determinant();
+        if !(det(self.view).abs() > 0.0) {
+            return bad("the view matrix is singular".into());
+        }
+        // The projection's x, y and w rows must be independent (it may have no z row to
+        // speak of, as an infinite-far one nearly does).
+        let p = self.projection;
+        let (x, y, w) = (p.row(0), p.row(1), p.row(3));
+        if null_vector(p).length() == 0.0 || x.truncate().cross(y.truncate()) == DVec3::ZERO {
+            return bad("the projection matrix's x, y and w rows are not independent".into());
+        }
+        if w == DVec4::ZERO {
+            return bad("the projection matrix's w row is zero".into());
+        }
+        if self.is_orthographic() {
+            if !(w.w > 0.0) {
+                return bad("the orthographic projection gives w <= 0 everywhere".into());
+            }
+            let rows = self.clip_rows(DMat4::IDENTITY);
+            if rows.clip.row(2).truncate() == DVec3::ZERO {
+                return bad("the orthographic projection has no depth axis".into());
+            }
+            return Ok(());
+        }
+        // Perspective: along the eye's forward axis, depth must grow (standard) or fall
+        // (reversed) with distance, as the convention says.
+        let eye = null_vector(p);
+        let eye = (eye / eye.w).truncate();
+        let forward = w.truncate().normalize();
+        let ndc_z = |s: f64| {
+            let c = p * (eye + forward * s).extend(1.0);
+            c.z / c.w
+        };
+        let (a, b) = (ndc_z(1.0), ndc_z(2.0));
+        if !(a.is_finite() && b.is_finite()) || a == b {
+            return bad("the projection gives no depth along the view axis".into());
+        }
+        match (self.depth, b > a) {
+            (DepthRange::Standard, false) => bad(
+                "the projection puts nearer points at greater depth, as a reverse-Z one does: \
+                 declare DepthRange::Reversed"
+                    .into(),
+            ),
+            (DepthRange::Reversed, true) => bad(
+                "the projection puts nearer points at smaller depth: declare DepthRange::Standard"
+                    .into(),
+            ),
+            _ => Ok(()),
+        }
+    }
+}
+
+/// The homogeneous point where a projection's clip x, y and w all vanish: the centre of
+/// projection (w = 0 for an affine projection). Cofactors of the 3×4 matrix of those rows.
+fn null_vector(p: DMat4) -> DVec4 {
+    let (a, b, c) = (p.row(0), p.row(1), p.row(3));
+    let minor = |i: usize, j: usize, k: usize| {
+        DVec3::new(a[i], a[j], a[k])
+            .dot(DVec3::new(b[i], b[j], b[k]).cross(DVec3::new(c[i], c[j], c[k])))
+    };
+    DVec4::new(
+        minor(1, 2, 3),
+        -minor(0, 2, 3),
+        minor(0, 1, 3),
+        -minor(0, 1, 2),
+    )
+}
+
+/// A perspective look-at camera: the convenience the tools and the CLI use. Angles in
+/// degrees; `near`/`far` are view-space distances, and `far` may be infinite.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
     /// Eye position in world space.
@@ -17,7 +241,7 @@ pub struct Camera {
     pub fov_y_deg: f32,
     /// Distance of the near clipping plane, > 0.
     pub near: f32,
-    /// Distance of the far clipping plane, > `near`.
+    /// Distance of the far clipping plane, > `near`; `f32::INFINITY` for none.
     pub far: f32,
 }
 
@@ -49,24 +273,28 @@ impl Camera {
             return bad(format!("fov {} is not in (0, 180) degrees", self.fov_y_deg));
         }
         if !(self.near > 0.0 && self.near.is_finite()) {
-            return bad(format!("near {} must be > 0", self.near));
+            return bad(format!("near {} must be > 0 and finite", self.near));
         }
-        if !(self.far > self.near && self.far.is_finite()) {
-            return bad(format!("far {} must be > near {}", self.far, self.near));
+        if !(self.far > self.near) {
+            return bad(format!(
+                "far {} must be > near {} (or infinite)",
+                self.far, self.near
+            ));
         }
         Ok(())
     }
 
     /// Frames an axis-aligned box: looks at its centre from the front-right-above, at the
     /// smallest distance where all eight corners are in view (plus a 5 % margin), with near
-    /// and far hugging the box's bounding sphere.
-    pub fn framing(lo: Vec3, hi: Vec3, aspect: f32) -> Camera {
-        let (lo, hi) = (lo.as_dvec3(), hi.as_dvec3());
+    /// and far hugging the box's bounding sphere. Works in f64 throughout, so boxes of any
+    /// extent (1e-30 or 1e30) frame as well as a unit one.
+    pub fn framing(lo: DVec3, hi: DVec3, aspect: f64) -> Camera {
         let centre = (lo + hi) * 0.5;
-        let radius = ((hi - lo).length() * 0.5).max(1e-6);
+        let radius = ((hi - lo).length() * 0.5).max(centre.abs().max_element() * 1e-6);
+        let radius = if radius > 0.0 { radius } else { 1.0 };
         let fov_y = 40.0_f64;
         let tan_y = (fov_y.to_radians() * 0.5).tan();
-        let tan_x = tan_y * f64::from(aspect);
+        let tan_x = tan_y * aspect;
         let forward = -DVec3::new(0.55, 0.35, 1.0).normalize();
         let right = forward.cross(DVec3::Y).normalize();
         let up = right.cross(forward);
@@ -98,26 +326,33 @@ impl Camera {
 
     /// View matrix (world → view), in f64.
     pub fn view(&self) -> DMat4 {
-        glam::dcamera::rh::view::look_at_mat4(
+        look_at_mat4(
             self.eye.as_dvec3(),
             self.target.as_dvec3(),
             self.up.as_dvec3().normalize(),
         )
     }
 
-    /// Projection matrix (view → clip, depth 0..1, y up: glam's `perspective_rh`), in f64.
+    /// Projection matrix (view → clip, depth 0..1: glam's `perspective_rh`, or
+    /// `perspective_infinite_rh` for an infinite far plane), in f64.
     pub fn projection(&self, aspect: f64) -> DMat4 {
-        glam::dcamera::rh::proj::directx::perspective(
-            f64::from(self.fov_y_deg).to_radians(),
-            aspect,
-            f64::from(self.near),
-            f64::from(self.far),
-        )
+        let fov = f64::from(self.fov_y_deg).to_radians();
+        let near = f64::from(self.near);
+        if self.far.is_infinite() {
+            proj::perspective_infinite(fov, aspect, near)
+        } else {
+            proj::perspective(fov, aspect, near, f64::from(self.far))
+        }
     }
 
     /// Combined world → clip matrix for an image of `width × height` pixels.
     pub fn view_projection(&self, width: u32, height: u32) -> DMat4 {
         self.projection(f64::from(width) / f64::from(height)) * self.view()
+    }
+
+    /// The camera as a [`View`] for an image of aspect `width / height`.
+    pub fn to_view(&self, aspect: f64) -> View {
+        View::new(self.view(), self.projection(aspect), DepthRange::Standard)
     }
 }
 
@@ -139,6 +374,12 @@ mod tests {
     #[test]
     fn rejects_impossible_cameras() {
         assert!(cam().validate().is_ok());
+        assert!(Camera {
+            far: f32::INFINITY,
+            ..cam()
+        }
+        .validate()
+        .is_ok());
         let cases = [
             Camera {
                 target: cam().eye,
@@ -162,6 +403,10 @@ mod tests {
             },
             Camera { near: 0.0, ..cam() },
             Camera { far: 0.05, ..cam() },
+            Camera {
+                far: f32::NAN,
+                ..cam()
+            },
             Camera {
                 eye: Vec3::NAN,
                 ..cam()
@@ -200,22 +445,135 @@ mod tests {
 
     #[test]
     fn framing_sees_the_whole_box() {
-        let (lo, hi) = (Vec3::new(-1.0, -2.0, -0.5), Vec3::new(3.0, 1.0, 0.5));
-        for aspect in [0.5_f32, 1.0, 2.0] {
+        let (lo, hi) = (DVec3::new(-1.0, -2.0, -0.5), DVec3::new(3.0, 1.0, 0.5));
+        for aspect in [0.5, 1.0, 2.0] {
             let c = Camera::framing(lo, hi, aspect);
             c.validate().unwrap();
-            let m = c.projection(f64::from(aspect)) * c.view();
+            let m = c.projection(aspect) * c.view();
             for i in 0..8 {
                 let p = DVec3::new(
-                    if i & 1 == 0 { lo.x } else { hi.x } as f64,
-                    if i & 2 == 0 { lo.y } else { hi.y } as f64,
-                    if i & 4 == 0 { lo.z } else { hi.z } as f64,
+                    if i & 1 == 0 { lo.x } else { hi.x },
+                    if i & 2 == 0 { lo.y } else { hi.y },
+                    if i & 4 == 0 { lo.z } else { hi.z },
                 );
                 let clip = m * p.extend(1.0);
                 let ndc = clip.truncate() / clip.w;
                 assert!(ndc.x.abs() <= 1.0 && ndc.y.abs() <= 1.0, "{ndc}");
                 assert!((0.0..=1.0).contains(&ndc.z), "{ndc}");
             }
+        }
+    }
+
+    fn look() -> DMat4 {
+        look_at_mat4(DVec3::new(1.0, 2.0, 5.0), DVec3::ZERO, DVec3::Y)
+    }
+
+    #[test]
+    fn the_eye_of_every_kind_of_projection() {
+        let eye = DVec3::new(1.0, 2.0, 5.0);
+        let persp = [
+            View::new(
+                look(),
+                proj::perspective(0.8, 1.5, 0.1, 100.0),
+                DepthRange::Standard,
+            ),
+            View::new(
+                look(),
+                proj::perspective_infinite(0.8, 1.5, 0.1),
+                DepthRange::Standard,
+            ),
+            View::new(
+                look(),
+                proj::perspective_infinite_reverse(0.8, 1.5, 0.1),
+                DepthRange::Reversed,
+            ),
+            View::new(
+                look(),
+                proj::perspective(0.8, 1.5, 100.0, 0.1),
+                DepthRange::Reversed,
+            ),
+        ];
+        for v in persp {
+            v.validate().unwrap();
+            assert!(!v.is_orthographic());
+            let e = v.eye();
+            assert!((e.truncate() - eye).length() < 1e-9 && e.w == 1.0, "{e}");
+        }
+        let ortho = View::orthographic((eye, DVec3::ZERO, DVec3::Y), 4.0, 1.5, (0.1, 20.0));
+        ortho.validate().unwrap();
+        let e = ortho.eye();
+        assert_eq!(e.w, 0.0);
+        assert!((e.truncate() - eye.normalize()).length() < 1e-12, "{e}");
+        // Reversed ortho: the same direction.
+        let rev = View::new(
+            ortho.view,
+            proj::orthographic(-3.0, 3.0, -2.0, 2.0, 20.0, 0.1),
+            DepthRange::Reversed,
+        );
+        rev.validate().unwrap();
+        assert!((rev.eye().truncate() - eye.normalize()).length() < 1e-12);
+    }
+
+    #[test]
+    fn clip_rows_agree_across_depth_conventions() {
+        let standard = View::new(
+            look(),
+            proj::perspective(0.8, 1.5, 0.1, 100.0),
+            DepthRange::Standard,
+        );
+        let reversed = View::new(
+            look(),
+            proj::perspective(0.8, 1.5, 100.0, 0.1),
+            DepthRange::Reversed,
+        );
+        let (a, b) = (
+            standard.clip_rows(DMat4::IDENTITY),
+            reversed.clip_rows(DMat4::IDENTITY),
+        );
+        for p in [DVec3::new(0.3, -0.2, 0.1), DVec3::new(9.0, 1.0, -40.0)] {
+            let h = p.extend(1.0);
+            let (ca, cb) = (a.clip * h, b.clip * h);
+            assert!((ca - cb).length() < 1e-9 * ca.length(), "{ca} {cb}");
+            assert!((a.depth.dot(h) - b.depth.dot(h)).abs() < 1e-9);
+        }
+        // The near row is 0 on the near plane, the depth row/w is 1 there.
+        let on_near = standard.view.inverse() * DVec4::new(0.0, 0.0, -0.1, 1.0);
+        let c = a.clip * on_near;
+        assert!(c.z.abs() < 1e-12 && (a.depth.dot(on_near) / c.w - 1.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn rejects_impossible_views() {
+        let good = View::new(
+            look(),
+            proj::perspective(0.8, 1.5, 0.1, 100.0),
+            DepthRange::Standard,
+        );
+        assert!(good.validate().is_ok());
+        let cases = [
+            View {
+                depth: DepthRange::Reversed,
+                ..good
+            },
+            View {
+                projection: DMat4::ZERO,
+                ..good
+            },
+            View {
+                view: DMat4::ZERO,
+                ..good
+            },
+            View {
+                projection: DMat4::from_cols_array(&[f64::NAN; 16]),
+                ..good
+            },
+            View {
+                projection: proj::perspective(0.8, 1.5, 100.0, 0.1),
+                ..good
+            },
+        ];
+        for v in cases {
+            assert!(v.validate().is_err(), "{v:?}");
         }
     }
 }

@@ -1,20 +1,43 @@
 //! Command-line parsing helpers shared by the `wirepass` binary's subcommands.
 
-use crate::camera::Camera;
+// `!(a > b)` is deliberate throughout: NaN must take the rejecting branch.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+use crate::camera::{Camera, View};
 use crate::error::{Error, Result};
-use crate::mesh::{self, Mesh, Procedural};
-use glam::Vec3;
+use crate::mesh::{self, EdgeSelection, Mesh, Procedural};
+use crate::render::World;
+use crate::scene_file::FileCamera;
+use glam::{DVec3, Vec3};
 use std::path::Path;
 
-/// Loads `spec`: a procedural name (`sphere:N`, `grid:N`, `torus:N`), an OBJ file, or, when
-/// `None`, the built-in default scene.
+/// Loads one mesh from `spec`: a procedural name (`sphere:N`, `grid:N`, `torus:N`,
+/// `layers:K`), a mesh file, or, when `None`, the built-in default scene as one mesh.
 pub fn load_mesh(spec: Option<&str>) -> Result<Mesh> {
     match spec {
         None => Ok(mesh::default_scene()),
-        Some(s) if !Path::new(s).exists() && s.contains(':') && !s.contains(['/', '\\']) => {
-            s.parse::<Procedural>()?.build()
+        Some(s) => mesh_spec(s),
+    }
+}
+
+/// A procedural name or a mesh file.
+fn mesh_spec(s: &str) -> Result<Mesh> {
+    if !Path::new(s).exists() && s.contains(':') && !s.contains(['/', '\\']) {
+        return s.parse::<Procedural>()?.build();
+    }
+    mesh::load_obj(Path::new(s))
+}
+
+/// Loads what `spec` names as a world: a scene file (`.json`, with its camera if it has
+/// one), one mesh (procedural or a file) drawing `edges`, or, when `None`, the built-in
+/// scene (a torus and a sphere).
+pub fn load_world(spec: Option<&str>, edges: EdgeSelection) -> Result<(World, Option<FileCamera>)> {
+    match spec {
+        None => Ok((crate::render::default_world(edges), None)),
+        Some(s) if s.to_ascii_lowercase().ends_with(".json") => {
+            crate::scene_file::load(Path::new(s), edges, &mesh_spec)
         }
-        Some(s) => mesh::load_obj(Path::new(s)),
+        Some(s) => Ok((World::single(mesh_spec(s)?, edges), None)),
     }
 }
 
@@ -71,30 +94,51 @@ fn parse_vec3_arg(s: &str) -> std::result::Result<Vec3, String> {
 }
 
 impl CameraArgs {
-    /// The camera for `mesh` at `size`: explicit values where given, framing otherwise.
-    /// With an explicit eye, near and far default to values that enclose the mesh.
-    pub fn camera(&self, mesh: &Mesh, size: (u32, u32)) -> Result<Camera> {
-        let (lo, hi) = mesh.bounds();
-        // Finite coordinates can still span more than f32 holds; framing such a mesh would
+    /// True when no camera option is given.
+    pub fn is_empty(&self) -> bool {
+        self.eye.is_none()
+            && self.target.is_none()
+            && self.up.is_none()
+            && self.fov.is_none()
+            && self.near.is_none()
+            && self.far.is_none()
+    }
+
+    /// The view of `world` at `size`: the options given, else the scene file's camera, else
+    /// a camera framing the world.
+    pub fn view(&self, world: &World, file: Option<&FileCamera>, size: (u32, u32)) -> Result<View> {
+        let aspect = f64::from(size.0) / f64::from(size.1);
+        let view = match file {
+            Some(c) if self.is_empty() => c.view(aspect),
+            _ => self.camera(world.bounds(), size)?.to_view(aspect),
+        };
+        view.validate()?;
+        Ok(view)
+    }
+
+    /// The perspective camera for a world with bounds `(lo, hi)` at `size`: explicit values
+    /// where given, framing otherwise. With an explicit eye, near and far default to values
+    /// that enclose the world.
+    pub fn camera(&self, (lo, hi): (DVec3, DVec3), size: (u32, u32)) -> Result<Camera> {
+        // Finite coordinates can still span more than f32 holds; framing such a world would
         // overflow to an infinite eye, which the camera check reports in confusing terms.
-        if (hi.as_dvec3() - lo.as_dvec3()).length() > f64::from(f32::MAX) {
+        if !((hi - lo).length() <= f64::from(f32::MAX)) {
             return Err(Error::InvalidMesh(format!(
-                "the mesh spans {lo} to {hi}, more than f32 coordinates can hold"
+                "the scene spans {lo} to {hi}, more than f32 coordinates can hold"
             )));
         }
-        let framed = Camera::framing(lo, hi, size.0 as f32 / size.1 as f32);
+        let framed = Camera::framing(lo, hi, f64::from(size.0) / f64::from(size.1));
         let mut cam = framed;
         if let Some(eye) = self.eye {
             cam.eye = eye;
             cam.target = self.target.unwrap_or(framed.target);
-            // Near and far that enclose the mesh seen from this eye, in f64: the squares in
+            // Near and far that enclose the world seen from this eye, in f64: the squares in
             // an f32 length overflow for a far eye such as 1e30,1e30,1e30.
-            let (lo64, hi64) = (lo.as_dvec3(), hi.as_dvec3());
-            let radius = (hi64 - lo64).length() * 0.5;
-            let dist = ((lo64 + hi64) * 0.5 - eye.as_dvec3()).length();
-            let far = (dist + radius) * 1.5 + 1e-3;
+            let radius = (hi - lo).length() * 0.5;
+            let dist = ((lo + hi) * 0.5 - eye.as_dvec3()).length();
+            let far = (dist + radius) * 1.5 + 1e-3 * radius.max(f64::MIN_POSITIVE);
             cam.far = far as f32;
-            cam.near = ((dist - radius).max(far * 1e-5).max(1e-6) * 0.5) as f32;
+            cam.near = ((dist - radius).max(far * 1e-5) * 0.5) as f32;
         } else if let Some(target) = self.target {
             cam.eye += target - cam.target;
             cam.target = target;

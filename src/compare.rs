@@ -8,14 +8,13 @@ use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
 use crate::raycast::render_raycast;
 use crate::regression;
-use crate::render::{render, Frame, Method, Scene};
+use crate::render::{render, Frame, Method, Shot, BACKGROUND};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::time::Instant;
 
 /// Background id.
-const BACKGROUND: u32 = u32::MAX;
 /// Edge distances are compared only where the true distance is below this many pixels:
 /// that is where a line can be drawn, and where the distance matters.
 pub const DISTANCE_RANGE_PX: f64 = 4.0;
@@ -306,8 +305,8 @@ pub enum MethodReport {
 pub struct Report {
     /// Image size.
     pub size: [u32; 2],
-    /// Triangles in the mesh.
-    pub triangles: usize,
+    /// Triangles over all objects.
+    pub triangles: u64,
     /// Per method (JSON key: the method's name with `-` as `_`), in [`Method::ALL`] order.
     pub methods: serde_json::Map<String, serde_json::Value>,
     /// The same, typed, for the table.
@@ -327,14 +326,14 @@ const TIMED_FRAMES: u32 = 20;
 /// Frames drawn before timing starts.
 const WARM_UP_FRAMES: u32 = 3;
 
-/// GPU time of each method's passes for `scene` in milliseconds (median over frames, methods
+/// GPU time of each method's passes for `shot` in milliseconds (median over frames, methods
 /// interleaved frame by frame, see [`crate::bench`]), with a note on how it was taken.
-fn gpu_times(ctx: &GpuContext, scene: &Scene<'_>) -> (BTreeMap<String, f64>, String) {
+fn gpu_times(ctx: &GpuContext, shot: &Shot<'_>) -> (BTreeMap<String, f64>, String) {
     let timing = crate::bench::Timing {
         frames: TIMED_FRAMES,
         warmup: WARM_UP_FRAMES,
     };
-    match crate::bench::bench_scene(ctx, "compare", scene, timing) {
+    match crate::bench::bench_scene(ctx, "compare", shot, timing) {
         Ok(runs) => (
             runs.into_iter()
                 .map(|r| (r.method, r.total_median_ms))
@@ -351,19 +350,19 @@ fn gpu_times(ctx: &GpuContext, scene: &Scene<'_>) -> (BTreeMap<String, f64>, Str
     }
 }
 
-/// Renders `scene` with the ground truth and every GPU method, writes the images, heat maps,
+/// Renders `shot` with the ground truth and every GPU method, writes the images, heat maps,
 /// `sheet.png` and `report.json` into `out`, and returns the report.
-pub fn run(ctx: &GpuContext, scene: &Scene<'_>, out: &Path) -> Result<Report> {
+pub fn run(ctx: &GpuContext, shot: &Shot<'_>, out: &Path) -> Result<Report> {
     std::fs::create_dir_all(out).map_err(|source| Error::Io {
         path: out.to_owned(),
         source,
     })?;
     let start = Instant::now();
-    let reference = render_raycast(scene)?;
+    let reference = render_raycast(shot)?;
     let reference_seconds = start.elapsed().as_secs_f64();
     reference.save_png(&out.join(format!("{}.png", Method::Raycast.name())))?;
 
-    let (gpu_ms, note) = gpu_times(ctx, scene);
+    let (gpu_ms, note) = gpu_times(ctx, shot);
     let mut rows = Vec::new();
     let mut panels: Vec<(String, Option<[Image; 3]>)> = Vec::new();
     for &method in Method::ALL {
@@ -372,7 +371,7 @@ pub fn run(ctx: &GpuContext, scene: &Scene<'_>, out: &Path) -> Result<Report> {
         }
         let name = method.name();
         let start = Instant::now();
-        let report = match render(ctx, scene, method) {
+        let report = match render(ctx, shot, method) {
             Err(e) => {
                 panels.push((name.to_string(), None));
                 MethodReport::Skipped {
@@ -407,8 +406,8 @@ pub fn run(ctx: &GpuContext, scene: &Scene<'_>, out: &Path) -> Result<Report> {
         methods.insert(m.name().replace('-', "_"), value);
     }
     let report = Report {
-        size: [scene.size.0, scene.size.1],
-        triangles: scene.mesh.triangle_count(),
+        size: [shot.size.0, shot.size.1],
+        triangles: shot.world.triangle_count(),
         methods,
         rows,
         reference_seconds,

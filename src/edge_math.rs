@@ -60,17 +60,38 @@ pub fn edge_eval(clip: [DVec4; 3], mask: u8, pixel: DVec2, size: DVec2) -> EdgeE
     EdgeEval { distance, bary }
 }
 
+/// Twin of `towards_eye` in common.wgsl: the direction from `a` towards the homogeneous eye
+/// `eye` (a point with w = 1, or a direction towards the viewer with w = 0), up to a
+/// positive factor.
+pub fn towards_eye(a: DVec3, eye: DVec4) -> DVec3 {
+    eye.truncate() - a * eye.w
+}
+
 /// Twin of `is_silhouette` in common.wgsl: the edge `a → b`, shared by a triangle with third
 /// corner `c` and a neighbour with a point `d` off the edge, is a silhouette seen from `eye`
-/// when both triangles lie on the same side of the plane through the eye and the edge (so on
-/// screen they fold onto one side of it). Independent of winding; an edge-on triangle counts
-/// as folded.
+/// (homogeneous, as [`towards_eye`] takes it) when both triangles lie on the same side of the
+/// plane through the eye and the edge (so on screen they fold onto one side of it).
+/// Independent of winding, so mirrored instances have the same silhouettes; an edge-on
+/// triangle counts as folded.
 #[allow(clippy::neg_cmp_op_on_partial_ord)] // as in WGSL: NaN sides count as folded
-pub fn is_silhouette(a: DVec3, b: DVec3, c: DVec3, d: DVec3, eye: DVec3) -> bool {
-    let to_edge = a - eye;
-    let side_c = to_edge.dot((b - a).cross(c - a));
-    let side_d = to_edge.dot((b - a).cross(d - a));
+pub fn is_silhouette(a: DVec3, b: DVec3, c: DVec3, d: DVec3, eye: DVec4) -> bool {
+    let to_eye = towards_eye(a, eye);
+    let side_c = to_eye.dot((b - a).cross(c - a));
+    let side_d = to_eye.dot((b - a).cross(d - a));
     !(side_c * side_d < 0.0)
+}
+
+/// Twin of `HIDDEN_MARGIN` in scene.wgsl: how much nearer a surface must be than a point of
+/// a line, in near-row units relative to the point's, to hide it. Triangles that meet at an
+/// edge or a vertex agree there only to rounding.
+pub const HIDDEN_MARGIN: f64 = 1e-4;
+
+/// Twin of `nearer` in scene.wgsl: true when the point with near row `a_near` is nearer than
+/// the one with near row `b_near` and clip w `b_w` at the same screen point, by more than
+/// [`HIDDEN_MARGIN`]. Along one pixel's ray the near row grows with depth, for perspective
+/// and orthographic views alike.
+pub fn nearer(a_near: f64, b_near: f64, b_w: f64) -> bool {
+    a_near < b_near - HIDDEN_MARGIN * (b_near.abs() + b_w)
 }
 
 fn line_distance(l: DVec3, drawn: bool) -> f64 {

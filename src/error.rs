@@ -32,6 +32,23 @@ pub enum Error {
     /// A camera that cannot produce an image (eye on target, fov out of range, …).
     #[error("invalid camera: {0}")]
     InvalidCamera(String),
+    /// A scene that cannot be drawn (a singular or non-affine instance transform, a mesh
+    /// that is not in the store, too many instances, …).
+    #[error("invalid scene: {0}")]
+    InvalidScene(String),
+    /// A scene file could not be read; the message names the field.
+    #[error("{}: {message}", path.display())]
+    SceneFile {
+        /// The file that was read.
+        path: PathBuf,
+        /// What is wrong, and where.
+        message: String,
+    },
+    /// The library was used in a way it does not support: a texture of the wrong format,
+    /// size, usage or sample count, a frame from another pass, a mesh from another store,
+    /// encoding before preparing, …
+    #[error("misuse of the wirepass API: {0}")]
+    Misuse(String),
     /// Any other setting out of range (size, line width, colour string, …).
     #[error("invalid setting: {0}")]
     InvalidSetting(String),

@@ -13,6 +13,7 @@ pub mod error;
 pub mod gpu;
 pub mod mesh;
 mod par;
+pub mod scene;
 pub mod style;
 
 #[cfg(feature = "tools")]
@@ -29,10 +30,13 @@ pub mod raycast;
 pub mod regression;
 #[cfg(feature = "tools")]
 pub mod render;
+#[cfg(feature = "tools")]
+pub mod scene_file;
 
-pub use camera::Camera;
+pub use camera::{Camera, DepthRange, View};
 pub use error::{Error, Result};
 pub use mesh::{EdgeSelection, Mesh};
+pub use scene::{Instance, InstanceStyle, Scene};
 pub use style::{Color, Style};
 
 /// The wgpu this crate is built against: use it (`wirepass::wgpu`) so the host's types match.

@@ -3,11 +3,11 @@
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
-use wirepass::cli::{load_mesh, parse_size, CameraArgs};
+use wirepass::cli::{load_world, parse_size, CameraArgs};
 use wirepass::gpu::GpuContext;
-use wirepass::render::{render, Method, Scene};
+use wirepass::render::{render, Method, Shot, World};
 use wirepass::style::DepthFade;
-use wirepass::{Camera, Color, EdgeSelection, Mesh, Result, Style};
+use wirepass::{Color, EdgeSelection, Result, Style, View};
 
 #[derive(Parser)]
 #[command(
@@ -22,7 +22,8 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Render a mesh (an OBJ file, `sphere:N`, `grid:N`, `torus:N`, or the built-in scene).
+    /// Render a scene (a SCENE.json file, a mesh file, `sphere:N`, `grid:N`, `torus:N`,
+    /// `layers:K`, or the built-in scene).
     Render(RenderArgs),
     /// Render one scene with the CPU ray-cast ground truth and every GPU method, and report
     /// how closely each matches it (images, error maps, sheet.png, report.json).
@@ -41,7 +42,8 @@ fn parse_edges(s: &str) -> std::result::Result<EdgeSelection, String> {
 /// What to draw and how it looks: shared by `render` and `compare`.
 #[derive(clap::Args)]
 struct SceneArgs {
-    /// OBJ file or procedural mesh (`sphere:20000`, `grid:1k`, `torus:5000`); default: built-in scene.
+    /// Scene file (.json: objects with transforms and styles, and a camera), mesh file, or
+    /// procedural mesh (`sphere:20000`, `grid:1k`, `torus:5000`); default: the built-in scene.
     mesh: Option<String>,
     /// Image size WIDTHxHEIGHT.
     #[arg(long, default_value = "800x600")]
@@ -92,8 +94,8 @@ fn parse_fade(s: &str) -> std::result::Result<DepthFade, String> {
 }
 
 impl SceneArgs {
-    /// Checks the settings, then loads the mesh and places the camera.
-    fn load(&self) -> Result<(Mesh, Camera, Style, (u32, u32))> {
+    /// Checks the settings, then loads the scene and places the camera.
+    fn load(&self) -> Result<(World, View, Style, (u32, u32))> {
         let size = parse_size(&self.size)?;
         let style = Style {
             line_width: self.line_width,
@@ -105,9 +107,9 @@ impl SceneArgs {
             ..Style::default()
         };
         style.validate()?;
-        let mesh = load_mesh(self.mesh.as_deref())?;
-        let camera = self.camera.camera(&mesh, size)?;
-        Ok((mesh, camera, style, size))
+        let (world, file_camera) = load_world(self.mesh.as_deref(), self.edges)?;
+        let view = self.camera.view(&world, file_camera.as_ref(), size)?;
+        Ok((world, view, style, size))
     }
 }
 
@@ -123,7 +125,8 @@ struct RenderArgs {
     /// Output PNG.
     #[arg(short, long, default_value = "wireframe.png")]
     output: PathBuf,
-    /// Also write ids.npy, depth.npy, edge_distance.npy and camera.json into this directory.
+    /// Also write ids.npy (global triangle ids), depth.npy, edge_distance.npy and camera.json
+    /// (the view and projection matrices used) into this directory.
     #[arg(long)]
     dump: Option<PathBuf>,
 }
@@ -133,27 +136,27 @@ fn parse_method(s: &str) -> std::result::Result<Method, String> {
 }
 
 fn render_command(args: &RenderArgs) -> Result<()> {
-    let (mesh, camera, style, size) = args.scene.load()?;
+    let (world, view, style, size) = args.scene.load()?;
     let ctx = GpuContext::new()?;
-    let scene = Scene {
-        mesh: &mesh,
-        camera,
-        style,
+    let shot = Shot {
+        world: &world,
+        view,
+        style: &style,
         size,
-        edges: args.scene.edges,
     };
-    let frame = render(&ctx, &scene, args.method)?;
+    let frame = render(&ctx, &shot, args.method)?;
     frame.save_png(&args.output)?;
     if let Some(dir) = &args.dump {
-        frame.dump(dir, &camera)?;
+        frame.dump(dir, &view)?;
     }
     eprintln!(
-        "wrote {} ({}, {}x{}, {} triangles, {})",
+        "wrote {} ({}, {}x{}, {} objects, {} triangles, {})",
         args.output.display(),
         args.method.name(),
         size.0,
         size.1,
-        mesh.triangle_count(),
+        world.objects.len(),
+        world.triangle_count(),
         ctx.describe()
     );
     Ok(())
@@ -169,21 +172,20 @@ struct CompareArgs {
 }
 
 fn compare_command(args: &CompareArgs) -> Result<()> {
-    let (mesh, camera, style, size) = args.scene.load()?;
+    let (world, view, style, size) = args.scene.load()?;
     let ctx = GpuContext::new()?;
-    let scene = Scene {
-        mesh: &mesh,
-        camera,
-        style,
+    let shot = Shot {
+        world: &world,
+        view,
+        style: &style,
         size,
-        edges: args.scene.edges,
     };
-    let report = wirepass::compare::run(&ctx, &scene, &args.out)?;
+    let report = wirepass::compare::run(&ctx, &shot, &args.out)?;
     println!(
         "{}x{}, {} triangles, {}; ground truth (raycast) {:.2} s",
         size.0,
         size.1,
-        mesh.triangle_count(),
+        world.triangle_count(),
         ctx.describe(),
         report.reference_seconds
     );
@@ -194,9 +196,15 @@ fn compare_command(args: &CompareArgs) -> Result<()> {
 
 #[derive(clap::Args)]
 struct BenchArgs {
-    /// Scenes: OBJ files or procedural meshes (`sphere:20000 sphere:2M`); default: the
-    /// built-in scene.
+    /// Scenes: scene files, mesh files or procedural meshes (`sphere:20000 sphere:2M`);
+    /// default: the built-in scene.
     scenes: Vec<String>,
+    /// Which edges to draw (all, polygon, feature[:DEGREES]).
+    #[arg(long, default_value = "polygon", value_parser = parse_edges)]
+    edges: EdgeSelection,
+    /// Line width in pixels.
+    #[arg(long, default_value_t = 1.5)]
+    line_width: f32,
     /// Image sizes, comma separated: 1280x720,1920x1080.
     #[arg(long, default_value = "1280x720")]
     size: String,
@@ -235,19 +243,21 @@ fn bench_command(args: &BenchArgs) -> Result<()> {
     for spec in specs {
         let name = spec.unwrap_or("built-in");
         progress.set_message(format!("loading {name}"));
-        let mesh = load_mesh(spec)?;
+        let (world, _) = load_world(spec, args.edges)?;
         for &size in &sizes {
             progress.set_message(format!("{name} at {}x{}", size.0, size.1));
             let style = Style {
                 silhouettes: args.silhouettes,
+                line_width: args.line_width,
                 ..Style::default()
             };
+            style.validate()?;
             let timing = wirepass::bench::Timing {
                 frames: args.frames,
                 warmup: args.warmup,
             };
             runs.extend(wirepass::bench::bench(
-                &ctx, name, &mesh, size, &style, timing,
+                &ctx, name, &world, size, &style, timing,
             )?);
             progress.inc(1);
         }

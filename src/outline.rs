@@ -1,11 +1,13 @@
 //! Outlines for the ground truth, in f64: the definition `shaders/outline.wgsl` draws.
 //!
 //! An outline edge is a boundary edge (no neighbour, or more than one) or a silhouette
-//! ([`edge_math::is_silhouette`]). Pixel p lies at distance d from an outline when d is the
-//! distance from p's centre to the *visible part* of an outline edge's projection: the part
-//! in front of the near plane and not beyond the far one, inside the image, and not hidden by
-//! another surface. The line drawn there has the common profile and the depth fade of that
-//! nearest visible point.
+//! ([`edge_math::is_silhouette`]) of an object that draws its outline, among the edges its
+//! mesh allows as outlines. Pixel p lies at distance d from an outline when d is the distance
+//! from p's centre to the *visible part* of an outline edge's projection: the part in front
+//! of the near plane and not beyond the far one, inside the image, and not hidden by another
+//! surface ([`edge_math::nearer`]). Each pixel keeps the line that colours it most
+//! ([`style::line_key`](crate::style::line_key)): the common profile at the object's width,
+//! times the depth fade of that nearest visible point.
 //!
 //! Visibility along an edge is found by casting a ray through points every 1/8 pixel of its
 //! projection and bisecting each change to 2⁻³⁰ of the edge. The GPU pass does the same at
@@ -15,43 +17,43 @@
 // `!(a <= b)` is deliberate: NaN must take the rejecting branch.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-use crate::camera::Camera;
 use crate::edge_math;
 use crate::mesh::adjacency::NO_NEIGHBOUR;
-use crate::raycast::RayCaster;
-use crate::style::{depth_fade, line_reach, Style};
-use glam::{DMat4, DVec2, DVec3, DVec4};
+use crate::raycast::{Line, ObjectStyle, RayCaster, Rays};
+use crate::render::Shot;
+use crate::style::{depth_fade, line_intensity, line_key, line_reach};
+use glam::{DVec2, DVec4};
 use rayon::prelude::*;
 
-/// A point on an outline edge is hidden when a surface there is nearer than this share of its
-/// view depth (as `HIDDEN_MARGIN` in outline.wgsl).
-const HIDDEN_MARGIN: f64 = 1e-4;
 /// Visibility samples per pixel of projected edge length.
 const SAMPLES_PER_PIXEL: f64 = 8.0;
 /// Bisection steps that place each change of visibility along an edge.
 const BISECTIONS: u32 = 30;
 
-/// Per pixel, the distance to the nearest visible outline within the line's reach
-/// (`INFINITY` where none) and the depth fade of its nearest point.
+/// Per pixel, the outline line that colours it most, if any is within reach.
 pub struct OutlineMap {
     /// Pixels, row-major.
-    pub distance: Vec<f64>,
-    /// Line strength from the depth fade, 0..1.
-    pub fade: Vec<f64>,
+    pub line: Vec<Option<Line>>,
 }
 
-/// The outline edges of `mesh` seen from `eye`, as (triangle, edge) with edge `i` running
-/// from corner `i` to corner `i + 1`; an edge shared by two triangles appears once, under the
-/// lower id.
-pub fn outline_edges(mesh: &crate::Mesh, eye: DVec3) -> Vec<(u32, u32)> {
+/// The outline edges of `mesh` seen from `eye` (homogeneous, in the mesh's coordinates), as
+/// (triangle, edge) with edge `i` running from corner `i` to corner `i + 1`; an edge shared by
+/// two triangles appears once, under the lower id. Only the edges the mesh allows as outlines
+/// ([`Mesh::outline_mask`](crate::Mesh::outline_mask)) are listed.
+pub fn outline_edges(mesh: &crate::Mesh, eye: DVec4) -> Vec<(u32, u32)> {
     let p = mesh.positions();
     let tris = mesh.triangles();
     let neighbours = mesh.edge_neighbours();
+    let allowed = mesh.outline_mask();
     let corner = |t: u32, k: usize| p[tris[t as usize][k % 3] as usize].as_dvec3();
     (0..tris.len() as u32)
         .into_par_iter()
         .flat_map_iter(|t| {
+            let allowed = allowed[t as usize];
             (0..3).filter_map(move |i| {
+                if allowed & (1 << i) == 0 {
+                    return None;
+                }
                 let n = neighbours[t as usize][i];
                 let outline = n == NO_NEIGHBOUR
                     || (t < n && {
@@ -65,71 +67,93 @@ pub fn outline_edges(mesh: &crate::Mesh, eye: DVec3) -> Vec<(u32, u32)> {
         .collect()
 }
 
-/// A visible stretch of an outline edge on screen: pixel coordinates and 1/w at both ends.
+/// A visible stretch of an outline edge on screen: pixel coordinates at both ends, and there
+/// 1/w and view depth / w (affine along the stretch).
 #[derive(Clone, Copy, Debug)]
 struct Stretch {
     from: DVec2,
     to: DVec2,
     inv_w: [f64; 2],
+    depth_w: [f64; 2],
+    object: u32,
+    width: f64,
 }
 
-/// The outline map of `caster`'s mesh for `camera`, `style` and `size`.
-pub fn outline_map(
+/// The outline map of `caster`'s world for `shot`, seen along `rays`.
+pub(crate) fn outline_map(
     caster: &RayCaster<'_>,
-    camera: &Camera,
-    style: &Style,
-    size: (u32, u32),
+    rays: &Rays,
+    shot: &Shot<'_>,
+    styles: &[ObjectStyle],
 ) -> OutlineMap {
-    let (width, height) = size;
+    let (width, height) = shot.size;
     let n = width as usize * height as usize;
     let mut map = OutlineMap {
-        distance: vec![f64::INFINITY; n],
-        fade: vec![0.0; n],
+        line: vec![None; n],
     };
-    if !style.silhouettes {
-        return map;
-    }
-    let mesh = caster.mesh();
-    let vp = camera.view_projection(width, height);
-    let inv = vp.inverse();
-    let view = View {
+    let world = caster.world();
+    let view = Visibility {
         caster,
-        vp,
-        inv,
-        size: DVec2::new(f64::from(width), f64::from(height)),
+        rays,
+        fade_row: shot.view.view_depth_row(),
     };
-    let stretches: Vec<Stretch> = outline_edges(mesh, camera.eye.as_dvec3())
-        .into_par_iter()
-        .flat_map_iter(|(t, i)| view.visible_stretches(t, i))
+    let view = &view;
+    let eye = shot.view.eye();
+    let stretches: Vec<Stretch> = world
+        .objects
+        .iter()
+        .enumerate()
+        .filter(|(o, _)| styles[*o].outlines)
+        .flat_map(|(o, object)| {
+            let mesh = &world.meshes[object.mesh].mesh;
+            let mut local = object.transform.inverse() * eye;
+            local = if local.w != 0.0 {
+                local / local.w
+            } else {
+                local.truncate().normalize_or_zero().extend(0.0)
+            };
+            let first = caster.first_ids()[o];
+            let width = styles[o].width;
+            outline_edges(mesh, local)
+                .into_par_iter()
+                .flat_map_iter(move |(t, i)| {
+                    let n = mesh.edge_neighbours()[t as usize][i as usize];
+                    view.visible_stretches(first, (t, i, n), (o as u32, width))
+                })
+                .collect::<Vec<_>>()
+        })
         .collect();
 
-    let reach = line_reach(f64::from(style.line_width));
-    let fade = style.fade_range().map(f64::from);
-    map.distance
+    let fade = shot.style.fade_range().map(f64::from);
+    map.line
         .par_chunks_mut(width as usize)
-        .zip(map.fade.par_chunks_mut(width as usize))
         .enumerate()
-        .for_each(|(y, (dist_row, fade_row))| {
+        .for_each(|(y, row)| {
             let cy = y as f64 + 0.5;
             for s in &stretches {
+                let reach = line_reach(s.width);
                 if (s.from.y.min(s.to.y) - reach) > cy || (s.from.y.max(s.to.y) + reach) < cy {
                     continue;
                 }
                 let x0 = (s.from.x.min(s.to.x) - reach).floor().max(0.0) as usize;
                 let x1 = ((s.from.x.max(s.to.x) + reach).ceil() as usize).min(width as usize);
-                for (x, (d_out, f_out)) in dist_row
-                    .iter_mut()
-                    .zip(fade_row.iter_mut())
-                    .enumerate()
-                    .take(x1)
-                    .skip(x0)
-                {
+                for (x, out) in row.iter_mut().enumerate().take(x1).skip(x0) {
                     let p = DVec2::new(x as f64 + 0.5, cy);
                     let (d, at) = segment_distance(p, s.from, s.to);
-                    if d < reach && d < *d_out {
-                        *d_out = d;
-                        let w = 1.0 / (s.inv_w[0] + (s.inv_w[1] - s.inv_w[0]) * at);
-                        *f_out = depth_fade(w, fade);
+                    if !(d < reach) {
+                        continue;
+                    }
+                    let inv_w = s.inv_w[0] + (s.inv_w[1] - s.inv_w[0]) * at;
+                    let depth = (s.depth_w[0] + (s.depth_w[1] - s.depth_w[0]) * at) / inv_w;
+                    let intensity = line_intensity(d, s.width) * depth_fade(depth, fade);
+                    let key = line_key(intensity, d);
+                    if out.is_none_or(|l| key > l.key) {
+                        *out = Some(Line {
+                            key,
+                            distance: d,
+                            intensity,
+                            object: s.object,
+                        });
                     }
                 }
             }
@@ -149,42 +173,56 @@ pub fn segment_distance(p: DVec2, a: DVec2, b: DVec2) -> (f64, f64) {
     (p.distance(a + seg * at), at)
 }
 
-struct View<'a> {
+/// Visibility of points of outline edges, by ray casts.
+struct Visibility<'a> {
     caster: &'a RayCaster<'a>,
-    vp: DMat4,
-    inv: DMat4,
-    size: DVec2,
+    rays: &'a Rays,
+    fade_row: DVec4,
 }
 
-impl View<'_> {
-    /// The visible stretches of edge `i` of triangle `t`.
-    fn visible_stretches(&self, t: u32, i: u32) -> Vec<Stretch> {
-        let mesh = self.caster.mesh();
-        let tri = mesh.triangles()[t as usize];
-        let n = mesh.edge_neighbours()[t as usize][i as usize];
-        let a = mesh.positions()[tri[i as usize] as usize].as_dvec3();
-        let b = mesh.positions()[tri[(i as usize + 1) % 3] as usize].as_dvec3();
-        let (ca, cb) = (self.vp * a.extend(1.0), self.vp * b.extend(1.0));
-        // In front of the near plane (clip z >= 0), not beyond the far plane (w - z >= 0).
+impl Visibility<'_> {
+    /// The visible stretches of edge `i` of triangle `t` (neighbour `n`) of the object
+    /// whose first global id is `first`.
+    fn visible_stretches(
+        &self,
+        first: u32,
+        (t, i, n): (u32, u32, u32),
+        (object, width): (u32, f64),
+    ) -> Vec<Stretch> {
+        let corners = self.caster.corners(first + t);
+        let (a, b) = (corners[i as usize], corners[(i as usize + 1) % 3]);
+        let (ca, cb) = (self.rays.clip(a), self.rays.clip(b));
+        let depth = self.rays.rows().depth;
+        let (ha, hb) = (a.extend(1.0), b.extend(1.0));
+        // In front of the near plane, not beyond the far plane.
         let mut s = (0.0, 1.0);
         keep_positive(&mut s, ca.z, cb.z);
-        keep_positive(&mut s, ca.w - ca.z, cb.w - cb.z);
+        keep_positive(&mut s, depth.dot(ha), depth.dot(hb));
         if !(s.0 <= s.1) {
             return Vec::new();
         }
-        let (p0, iw0) = self.project(ca.lerp(cb, s.0));
-        let (p1, iw1) = self.project(ca.lerp(cb, s.1));
+        let fade = |h: DVec4| self.fade_row.dot(h);
+        let at = |k: f64| {
+            let c = ca.lerp(cb, k);
+            let f = fade(ha.lerp(hb, k));
+            self.project(c, f)
+        };
+        let (p0, p1) = (at(s.0), at(s.1));
         // Inside the image.
-        let d = p1 - p0;
+        let size = self.rays.size();
+        let d = p1.xy - p0.xy;
         let mut u = (0.0, 1.0);
-        keep_between(&mut u, p0.x, d.x, self.size.x);
-        keep_between(&mut u, p0.y, d.y, self.size.y);
+        keep_between(&mut u, p0.xy.x, d.x, size.x);
+        keep_between(&mut u, p0.xy.y, d.y, size.y);
         if !(u.0 <= u.1) {
             return Vec::new();
         }
-        let point = |k: f64| p0 + d * k;
-        let inv_w = |k: f64| iw0 + (iw1 - iw0) * k;
-        let visible = |k: f64| self.visible(point(k), 1.0 / inv_w(k), t, n);
+        let point = |k: f64| p0.lerp(&p1, k);
+        let visible = |k: f64| {
+            let q = point(k);
+            let w = 1.0 / q.inv_w;
+            self.visible(q.xy, (q.near_w * w, w), first, (t, n))
+        };
 
         let length = d.length() * (u.1 - u.0);
         let steps = (length * SAMPLES_PER_PIXEL).ceil().clamp(1.0, 65536.0) as usize;
@@ -218,35 +256,65 @@ impl View<'_> {
             out.push((from, u.1));
         }
         out.into_iter()
-            .map(|(k0, k1)| Stretch {
-                from: point(k0),
-                to: point(k1),
-                inv_w: [inv_w(k0), inv_w(k1)],
+            .map(|(k0, k1)| {
+                let (q0, q1) = (point(k0), point(k1));
+                Stretch {
+                    from: q0.xy,
+                    to: q1.xy,
+                    inv_w: [q0.inv_w, q1.inv_w],
+                    depth_w: [q0.depth_w, q1.depth_w],
+                    object,
+                    width,
+                }
             })
             .collect()
     }
 
-    /// Pixel coordinates and 1/w of a clip-space point with w > 0.
-    fn project(&self, c: DVec4) -> (DVec2, f64) {
+    /// Where a clip-space point with view depth `depth` lands: pixel coordinates, and 1/w,
+    /// near/w and depth/w, which are affine along a screen segment.
+    fn project(&self, c: DVec4, depth: f64) -> Projected {
         let inv_w = 1.0 / c.w;
         let ndc = DVec2::new(c.x, c.y) * inv_w;
-        let xy = DVec2::new(0.5 * (ndc.x + 1.0), 0.5 * (1.0 - ndc.y)) * self.size;
-        (xy, inv_w)
+        let xy = DVec2::new(0.5 * (ndc.x + 1.0), 0.5 * (1.0 - ndc.y)) * self.rays.size();
+        Projected {
+            xy,
+            inv_w,
+            near_w: c.z * inv_w,
+            depth_w: depth * inv_w,
+        }
     }
 
-    /// True unless a triangle other than `t` and `n` covers screen point `x` nearer than
-    /// view depth `w`.
-    fn visible(&self, x: DVec2, w: f64, t: u32, n: u32) -> bool {
-        let ndc = DVec2::new(x.x / self.size.x * 2.0 - 1.0, 1.0 - x.y / self.size.y * 2.0);
-        let near = self.inv.project_point3(ndc.extend(0.0));
-        let far = self.inv.project_point3(ndc.extend(1.0));
-        match self.caster.cast(near, far) {
+    /// True unless a triangle other than `t` and `n` of the object (first id `first`)
+    /// covers screen point `x` nearer than the edge's point there (near row and w).
+    fn visible(&self, x: DVec2, (near, w): (f64, f64), first: u32, (t, n): (u32, u32)) -> bool {
+        let (from, to) = self.rays.segment(x);
+        match self.caster.cast(from, to) {
             None => true,
             Some(hit) => {
-                hit.id == t
-                    || hit.id == n
-                    || (self.vp * hit.point.extend(1.0)).w >= w * (1.0 - HIDDEN_MARGIN)
+                let own = hit.id == first + t || (n != NO_NEIGHBOUR && hit.id == first + n);
+                own || !edge_math::nearer(self.rays.clip(hit.point).z, near, w)
             }
+        }
+    }
+}
+
+/// A projected point of an edge: see [`Visibility::project`].
+#[derive(Clone, Copy, Debug)]
+struct Projected {
+    xy: DVec2,
+    inv_w: f64,
+    near_w: f64,
+    depth_w: f64,
+}
+
+impl Projected {
+    fn lerp(&self, other: &Projected, k: f64) -> Projected {
+        let mix = |a: f64, b: f64| a + (b - a) * k;
+        Projected {
+            xy: self.xy.lerp(other.xy, k),
+            inv_w: mix(self.inv_w, other.inv_w),
+            near_w: mix(self.near_w, other.near_w),
+            depth_w: mix(self.depth_w, other.depth_w),
         }
     }
 }
@@ -278,8 +346,9 @@ fn keep_between(range: &mut (f64, f64), p0: f64, d: f64, hi: f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::Mesh;
-    use glam::Vec3;
+    use crate::render::World;
+    use crate::{Camera, EdgeSelection, Mesh, Style};
+    use glam::{DVec3, Vec3};
 
     fn camera(eye: Vec3) -> Camera {
         Camera {
@@ -301,7 +370,7 @@ mod tests {
             Vec3::new(-1.0, 1.0, 0.0),
         ];
         let mesh = Mesh::new(p, None, vec![[0, 1, 2], [0, 2, 3]], None).unwrap();
-        let edges = outline_edges(&mesh, DVec3::new(0.2, 0.1, 3.0));
+        let edges = outline_edges(&mesh, DVec4::new(0.2, 0.1, 3.0, 1.0));
         assert_eq!(edges.len(), 4, "{edges:?}");
         // The diagonal (0, 2) is not: the two triangles lie on either side of it.
         assert!(!edges.contains(&(0, 2)));
@@ -322,7 +391,7 @@ mod tests {
             let hints = mesh.outline_hints();
             let p = |v: u32| mesh.positions()[v as usize].as_dvec3();
             for eye in test_eyes() {
-                let outline: std::collections::HashSet<u32> = outline_edges(mesh, eye)
+                let outline: std::collections::HashSet<u32> = outline_edges(mesh, eye.extend(1.0))
                     .into_iter()
                     .map(|(t, _)| t)
                     .collect();
@@ -385,13 +454,13 @@ mod tests {
             );
             let (mut skipped, mut total) = (0, 0);
             for eye in test_eyes() {
-                let outline: std::collections::HashSet<u32> = outline_edges(mesh, eye)
+                let outline: std::collections::HashSet<u32> = outline_edges(mesh, eye.extend(1.0))
                     .into_iter()
                     .flat_map(|(t, i)| [t, mesh.edge_neighbours()[t as usize][i as usize]])
                     .collect();
                 for (c, bounds) in clusters.bounds.iter().enumerate() {
                     total += 1;
-                    if may_fold(bounds, eye) {
+                    if may_fold(bounds, eye.extend(1.0)) {
                         continue;
                     }
                     skipped += 1;
@@ -439,7 +508,7 @@ mod tests {
                     p(tri[(i + 1) % 3]),
                     p(tri[(i + 2) % 3]),
                     d,
-                    eye,
+                    eye.extend(1.0),
                 )
                 .then_some(m)
             })
@@ -456,13 +525,28 @@ mod tests {
             Vec3::new(1.0, 0.0, 1.0),
         ];
         let mesh = Mesh::new(p, None, vec![[0, 1, 2], [1, 0, 3]], None).unwrap();
-        let hinge = |eye: DVec3| outline_edges(&mesh, eye).contains(&(0, 0));
+        let hinge = |eye: DVec3| outline_edges(&mesh, eye.extend(1.0)).contains(&(0, 0));
         // From in front of the book or behind its spine the pages show on either side of the
         // hinge.
         assert!(!hinge(DVec3::new(0.0, 0.0, 3.0)));
         assert!(!hinge(DVec3::new(0.0, 0.0, -3.0)));
         // From off to one side, past a page's plane, both fold onto one side of it.
         assert!(hinge(DVec3::new(5.0, 0.0, 0.5)));
+    }
+
+    /// The outline map of one mesh seen by `camera` at `size`.
+    fn map_of(mesh: Mesh, camera: Camera, style: &Style, size: (u32, u32)) -> OutlineMap {
+        let world = World::single(mesh, EdgeSelection::All);
+        let caster = RayCaster::new(&world);
+        let shot = Shot {
+            world: &world,
+            view: camera.to_view(f64::from(size.0) / f64::from(size.1)),
+            style,
+            size,
+        };
+        let rays = Rays::new(&shot.view, size, &world).unwrap();
+        let styles = ObjectStyle::of(&world, style);
+        outline_map(&caster, &rays, &shot, &styles)
     }
 
     #[test]
@@ -474,27 +558,30 @@ mod tests {
             Vec3::new(-1.0, 1.0, 0.0),
         ];
         let mesh = Mesh::new(p, None, vec![[0, 1, 2], [0, 2, 3]], None).unwrap();
-        let caster = RayCaster::new(&mesh);
         let style = Style {
             line_width: 4.0,
             ..Style::default()
         };
-        let size = (64, 64);
-        let map = outline_map(&caster, &camera(Vec3::new(0.0, 0.0, 4.0)), &style, size);
+        let cam = camera(Vec3::new(0.0, 0.0, 4.0));
+        let map = map_of(mesh, cam, &style, (64, 64));
         // The right side of the quad projects to a vertical line; pixels on both sides of it
         // within reach have finite distances, symmetric about it.
-        let vp = camera(Vec3::new(0.0, 0.0, 4.0)).view_projection(64, 64);
+        let vp = cam.view_projection(64, 64);
         let c = vp * DVec4::new(1.0, 0.0, 0.0, 1.0);
         let x_edge = 0.5 * (c.x / c.w + 1.0) * 64.0;
         let row = 32 * 64;
         for x in 0..64 {
-            let d = map.distance[row + x];
+            let line = map.line[row + x];
             let expect = (x as f64 + 0.5 - x_edge).abs();
             if expect < line_reach(4.0) - 1e-9 {
-                assert!((d - expect).abs() < 1e-9, "x {x}: {d} vs {expect}");
-                assert_eq!(map.fade[row + x], 1.0);
+                let line = line.unwrap_or_else(|| panic!("x {x}: no line"));
+                assert!(
+                    (line.distance - expect).abs() < 1e-9,
+                    "x {x}: {line:?} vs {expect}"
+                );
+                assert_eq!(line.intensity, line_intensity(expect, 4.0));
             } else if x as f64 > x_edge {
-                assert!(d.is_infinite(), "x {x}: {d}");
+                assert!(line.is_none(), "x {x}: {line:?}");
             }
         }
     }
@@ -514,20 +601,22 @@ mod tests {
         ];
         let tris = vec![[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]];
         let mesh = Mesh::new(p, None, tris, None).unwrap();
-        let caster = RayCaster::new(&mesh);
+        let world = World::single(mesh, EdgeSelection::All);
+        let caster = RayCaster::new(&world);
         let cam = camera(Vec3::new(0.0, 0.0, 4.0));
-        let view = View {
+        let view = cam.to_view(1.0);
+        let rays = Rays::new(&view, (64, 64), &world).unwrap();
+        let vis = Visibility {
             caster: &caster,
-            vp: cam.view_projection(64, 64),
-            inv: cam.view_projection(64, 64).inverse(),
-            size: DVec2::new(64.0, 64.0),
+            rays: &rays,
+            fade_row: view.view_depth_row(),
         };
         // Triangle 0's edge 1 runs from (1, -1) to (1, 1): visible only above y = 0, i.e. on
         // screen from the middle row up, ending where the near quad's top edge crosses it.
-        let s = view.visible_stretches(0, 1);
+        let s = vis.visible_stretches(0, (0, 1, NO_NEIGHBOUR), (0, 1.5));
         assert_eq!(s.len(), 1, "{s:?}");
         let top_of_near = {
-            let c = view.vp * DVec4::new(1.0, 0.0, 1.0, 1.0);
+            let c = cam.view_projection(64, 64) * DVec4::new(1.0, 0.0, 1.0, 1.0);
             0.5 * (1.0 - c.y / c.w) * 64.0
         };
         let ys = [s[0].from.y, s[0].to.y];

@@ -1,11 +1,13 @@
-//! The CPU ground truth: one ray per pixel centre through an `obvhs` BVH, with the hit and the
-//! edge distance computed in f64 by the same definitions the GPU uses (`edge_math`, `style`).
+//! The CPU ground truth: one ray per pixel centre through an `obvhs` BVH over every object's
+//! triangles (transformed to world space in f64), with the hit and the edge distance
+//! computed in f64 by the same definitions the GPU uses (`edge_math`, `style`).
 //!
-//! The ray of pixel `(x, y)` is the segment from the near plane (NDC z = 0) to the far plane
-//! (NDC z = 1) through NDC `u = (x + 0.5)/W·2 − 1`, `v = 1 − (y + 0.5)/H·2`, unprojected with
-//! the f64 inverse of [`Camera::view_projection`](crate::Camera::view_projection): exactly the
-//! part of the line that rasterization keeps, so nothing in front of the near plane or beyond
-//! the far plane is hit.
+//! The ray of pixel `(x, y)` is the segment from the near plane to the far plane through
+//! NDC `u = (x + 0.5)/W·2 − 1`, `v = 1 − (y + 0.5)/H·2`, unprojected with the f64 inverse of
+//! the view's clip rows ([`View::clip_rows`](crate::View::clip_rows)): exactly the part of
+//! the line that rasterization keeps, so nothing in front of the near plane or beyond the
+//! far plane is hit. Perspective rays meet at the eye, orthographic ones are parallel; with
+//! an infinite far plane the segment runs past everything there is.
 //!
 //! The BVH only culls: it is built in f32 over triangle boxes padded by a margin far larger
 //! than any f32 rounding of the ray, so it never drops a triangle the ray meets. Every
@@ -13,75 +15,88 @@
 //! product of its endpoints relative to the ray origin and the ray direction, so the two
 //! triangles sharing an edge compute exactly opposite values and a ray cannot slip between
 //! them). A pixel centre exactly on a shared edge may pick either triangle; exact depth ties
-//! pick the lower id, as the GPU's strict depth test keeps the first triangle drawn.
+//! pick the lower global id.
 
 // `!(a > b)` is deliberate throughout: NaN must take the rejecting branch.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+use crate::camera::{ClipRows, View};
+use crate::edge_math;
 use crate::error::{Error, Result};
 use crate::gpu::light_world_dir;
-use crate::render::{Frame, Scene};
+use crate::render::{Frame, Shot, World, BACKGROUND};
 use crate::style::{self, Color};
-use crate::{edge_math, Mesh};
-use glam::{DMat4, DVec2, DVec3, DVec4, Vec3A};
+use glam::{DMat3, DMat4, DVec2, DVec3, DVec4, Vec3A};
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::Bvh2;
 use obvhs::ray::{Ray, RayHit};
 use rayon::prelude::*;
 
-/// Background id, as in every other map.
-const BACKGROUND: u32 = u32::MAX;
-
 /// A ray hit: the triangle and where along the pixel's near-to-far segment it lies.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Hit {
-    /// Triangle id (index into [`Mesh::triangles`]).
+    /// Global triangle id (objects in order, each object's triangles in its mesh's order).
     pub id: u32,
-    /// Parameter along the segment: 0 on the near plane, 1 on the far plane.
+    /// The object hit.
+    pub object: u32,
+    /// The triangle of the object's mesh.
+    pub tri: u32,
+    /// Parameter along the segment: 0 at its start, 1 at its end.
     pub t: f64,
     /// The hit point in world space.
     pub point: DVec3,
 }
 
-/// A BVH over a mesh's triangles for exact (f64) ray casting.
+/// A BVH over a world's triangles for exact (f64) ray casting.
 pub struct RayCaster<'a> {
-    mesh: &'a Mesh,
+    world: &'a World,
+    first_ids: Vec<u32>,
     bvh: Bvh2,
-    /// Centre of the mesh bounds; the BVH and the f64 tests work relative to it.
+    /// Centre of the world bounds; the BVH and the f64 tests work relative to it.
     centre: DVec3,
     /// Half extent of the padded bounds, per axis, relative to `centre`.
     half: DVec3,
-    /// Triangle corners relative to `centre`, in f64.
+    /// Triangle corners in world space relative to `centre`, by global id.
     corners: Vec<[DVec3; 3]>,
+    /// World units per BVH unit: the BVH works on the world scaled to about ±1, so tiny
+    /// and huge worlds keep f32's precision and range.
+    unit: f64,
 }
 
 impl<'a> RayCaster<'a> {
-    /// Builds the BVH over `mesh`.
-    pub fn new(mesh: &'a Mesh) -> Self {
-        let (lo, hi) = mesh.bounds();
-        let (lo, hi) = (lo.as_dvec3(), hi.as_dvec3());
+    /// Builds the BVH over every object of `world`.
+    pub fn new(world: &'a World) -> Self {
+        let first_ids = world.first_ids();
+        let (lo, hi) = world.bounds();
         let centre = (lo + hi) * 0.5;
         let extent = (hi - lo) * 0.5;
         // Every f32 rounding in the BVH's box tests (ray origin and direction, box bounds,
         // the slab products) is ~1e-7 of the scene's size, because rays are clipped to the
-        // mesh bounds first; a margin of 1e-4 of the size keeps the culling conservative.
+        // bounds first; a margin of 1e-4 of the size keeps the culling conservative.
         let radius = extent
             .length()
             .max(centre.abs().max_element() * 1e-6)
-            .max(1e-30);
+            .max(1e-300);
         let pad = 1e-4 * radius;
         let half = extent + DVec3::splat(2.0 * pad);
-        let positions = mesh.positions();
-        let corners: Vec<[DVec3; 3]> = mesh
-            .triangles()
+        let corners: Vec<[DVec3; 3]> = world
+            .objects
             .iter()
-            .map(|t| t.map(|v| positions[v as usize].as_dvec3() - centre))
+            .flat_map(|o| {
+                let mesh = &world.meshes[o.mesh].mesh;
+                let p = mesh.positions();
+                let m = o.transform;
+                mesh.triangles()
+                    .iter()
+                    .map(move |t| t.map(|v| m.transform_point3(p[v as usize].as_dvec3()) - centre))
+            })
             .collect();
+        let unit = radius;
         let boxes: Vec<Aabb> = corners
             .iter()
             .map(|c| {
-                let lo = c[0].min(c[1]).min(c[2]) - DVec3::splat(pad);
-                let hi = c[0].max(c[1]).max(c[2]) + DVec3::splat(pad);
+                let lo = (c[0].min(c[1]).min(c[2]) - DVec3::splat(pad)) / unit;
+                let hi = (c[0].max(c[1]).max(c[2]) + DVec3::splat(pad)) / unit;
                 Aabb::new(to_vec3a(lo), to_vec3a(hi))
             })
             .collect();
@@ -91,11 +106,13 @@ impl<'a> RayCaster<'a> {
             &mut std::time::Duration::default(),
         );
         Self {
-            mesh,
+            world,
+            first_ids,
             bvh,
             centre,
             half,
             corners,
+            unit,
         }
     }
 
@@ -105,7 +122,7 @@ impl<'a> RayCaster<'a> {
         let o = from - self.centre;
         let d = to - from;
         // Clip the segment to the padded bounds in f64, so the f32 ray the BVH sees starts
-        // near the mesh and its rounding is relative to the mesh's size.
+        // near the world and its rounding is relative to the world's size.
         let (mut t0, mut t1) = (0.0_f64, 1.0_f64);
         for axis in 0..3 {
             let (oa, da, ha) = (o[axis], d[axis], self.half[axis]);
@@ -122,6 +139,7 @@ impl<'a> RayCaster<'a> {
         if !(t1 > t0) {
             return None;
         }
+        let unit = self.unit;
         let span = d * (t1 - t0);
         let scale = span.abs().max_element();
         if !(scale > 0.0) || !scale.is_finite() {
@@ -129,14 +147,15 @@ impl<'a> RayCaster<'a> {
         }
         // Direction with largest component 1, so the BVH's tiny-component guard
         // (`safe_inverse`) only applies to rays within 1.2e-7 rad of a slab, whose error the
-        // padding covers; tau in 0..scale spans the clipped segment.
+        // padding covers; tau in 0..scale/unit spans the clipped segment (in the BVH's
+        // units).
         let ray = Ray::new(
-            to_vec3a(o + d * t0),
+            to_vec3a((o + d * t0) / unit),
             to_vec3a(span / scale),
             0.0,
-            (scale * (1.0 + 1e-6)) as f32,
+            (scale / unit * (1.0 + 1e-6)) as f32,
         );
-        let to_tau = scale / (t1 - t0);
+        let to_tau = scale / unit / (t1 - t0);
         let mut best: Option<(f64, u32)> = None;
         let mut hit = RayHit::none();
         self.bvh.ray_traverse(ray, &mut hit, |_, slot| {
@@ -156,16 +175,31 @@ impl<'a> RayCaster<'a> {
             let tau = ((t - t0) * to_tau).max(0.0) as f32;
             tau.next_up()
         });
-        best.map(|(t, id)| Hit {
-            id,
-            t,
-            point: self.centre + o + d * t,
+        best.map(|(t, id)| {
+            let (object, tri) = self.world.locate(&self.first_ids, id);
+            Hit {
+                id,
+                object: object as u32,
+                tri,
+                t,
+                point: self.centre + o + d * t,
+            }
         })
     }
 
-    /// The mesh this caster was built over.
-    pub fn mesh(&self) -> &Mesh {
-        self.mesh
+    /// The world this caster was built over.
+    pub fn world(&self) -> &World {
+        self.world
+    }
+
+    /// The world-space corners of global triangle `id`.
+    pub fn corners(&self, id: u32) -> [DVec3; 3] {
+        self.corners[id as usize].map(|c| c + self.centre)
+    }
+
+    /// The global id of each object's first triangle.
+    pub fn first_ids(&self) -> &[u32] {
+        &self.first_ids
     }
 }
 
@@ -175,7 +209,7 @@ fn to_vec3a(v: DVec3) -> Vec3A {
 
 /// Watertight, double-sided segment/triangle test in f64: the segment `o + t·d`, `0 ≤ t ≤ 1`.
 /// Returns `t` of the hit.
-fn intersect(c: &[DVec3; 3], o: DVec3, d: DVec3) -> Option<f64> {
+pub fn intersect(c: &[DVec3; 3], o: DVec3, d: DVec3) -> Option<f64> {
     let a = c[0] - o;
     let b = c[1] - o;
     let cc = c[2] - o;
@@ -200,6 +234,74 @@ fn intersect(c: &[DVec3; 3], o: DVec3, d: DVec3) -> Option<f64> {
     (0.0..=1.0).contains(&t).then_some(t)
 }
 
+/// The pixel rays of a view: each pixel centre's segment from the near plane to the far
+/// plane (or past the world, for an infinite far plane), in world space.
+pub struct Rays {
+    rows: ClipRows,
+    inv: DMat4,
+    size: DVec2,
+    /// Length that takes a segment from its start past the whole world.
+    reach: f64,
+    infinite: bool,
+}
+
+impl Rays {
+    /// The rays of `view` for an image of `size`, long enough to cross `world`.
+    pub fn new(view: &View, size: (u32, u32), world: &World) -> Result<Rays> {
+        let rows = view.clip_rows(DMat4::IDENTITY);
+        let inv = rows.clip.inverse();
+        if !inv.is_finite() {
+            return Err(Error::InvalidCamera(
+                "the view-projection matrix is not invertible".into(),
+            ));
+        }
+        let far = inv * DVec4::new(0.0, 0.0, 1.0, 1.0);
+        let infinite = !(far.w.abs() > 1e-12 * far.truncate().length());
+        let (lo, hi) = world.bounds();
+        let near = inv * DVec4::new(0.0, 0.0, 0.0, 1.0);
+        let start = near.truncate() / near.w;
+        let reach = 4.0 * ((lo - start).length().max((hi - start).length()) + (hi - lo).length());
+        Ok(Rays {
+            rows,
+            inv,
+            size: DVec2::new(f64::from(size.0), f64::from(size.1)),
+            reach,
+            infinite,
+        })
+    }
+
+    /// The segment of the ray through full-image point `pixel` (pixel units).
+    pub fn segment(&self, pixel: DVec2) -> (DVec3, DVec3) {
+        let u = pixel.x / self.size.x * 2.0 - 1.0;
+        let v = 1.0 - pixel.y / self.size.y * 2.0;
+        let point = |near_row: f64| {
+            let p = self.inv * DVec4::new(u, v, near_row, 1.0);
+            p.truncate() / p.w
+        };
+        let from = point(0.0);
+        if !self.infinite {
+            return (from, point(1.0));
+        }
+        let dir = (point(0.5) - from).normalize_or_zero();
+        (from, from + dir * self.reach)
+    }
+
+    /// Clip position (rows x, y, near, w) of a world point.
+    pub fn clip(&self, p: DVec3) -> DVec4 {
+        self.rows.clip * p.extend(1.0)
+    }
+
+    /// The view's clip rows.
+    pub fn rows(&self) -> &ClipRows {
+        &self.rows
+    }
+
+    /// The image size, in pixels.
+    pub fn size(&self) -> DVec2 {
+        self.size
+    }
+}
+
 /// Everything the ground truth knows about one pixel.
 #[derive(Clone, Copy, Debug)]
 struct Sample {
@@ -209,42 +311,81 @@ struct Sample {
     rgba: [u8; 4],
 }
 
-/// Renders `scene` by ray casting on the CPU in f64: the reference every GPU method is
+/// Each object's look, as the GPU's instance records carry it.
+pub(crate) struct ObjectStyle {
+    pub wire: [f64; 4],
+    pub width: f64,
+    pub edges: bool,
+    pub outlines: bool,
+    /// Model → world normal matrix.
+    pub normal: DMat3,
+}
+
+impl ObjectStyle {
+    pub fn of(world: &World, style: &style::Style) -> Vec<ObjectStyle> {
+        world
+            .objects
+            .iter()
+            .map(|o| ObjectStyle {
+                wire: o
+                    .style
+                    .wire_color
+                    .unwrap_or(style.wire_color)
+                    .0
+                    .map(f64::from),
+                width: f64::from(o.style.line_width.unwrap_or(style.line_width)),
+                edges: o.style.edges.unwrap_or(true),
+                outlines: o.style.outlines.unwrap_or(style.silhouettes),
+                normal: DMat3::from_mat4(o.transform).inverse().transpose(),
+            })
+            .collect()
+    }
+}
+
+/// Renders `shot` by ray casting on the CPU in f64: the reference every GPU method is
 /// measured against. Fills every map of the [`Frame`].
-pub fn render_raycast(scene: &Scene<'_>) -> Result<Frame> {
-    let (width, height) = scene.size;
+pub fn render_raycast(shot: &Shot<'_>) -> Result<Frame> {
+    let (width, height) = shot.size;
     if width == 0 || height == 0 {
         return Err(Error::InvalidSetting(format!(
             "image size {width}x{height} has a zero side"
         )));
     }
-    scene.camera.validate()?;
-    scene.style.validate()?;
-    let mesh = scene.mesh;
-    let vp = scene.camera.view_projection(width, height);
-    let inv = vp.inverse();
-    if !inv.is_finite() {
-        return Err(Error::InvalidCamera(
-            "the view-projection matrix is not invertible".into(),
-        ));
+    shot.view.validate()?;
+    shot.style.validate()?;
+    let world = shot.world;
+    world.validate()?;
+    for (i, o) in world.objects.iter().enumerate() {
+        crate::scene::check_transform(&o.transform, i)?;
+        o.style.validate(i)?;
     }
-    let caster = RayCaster::new(mesh);
-    let masks = mesh.edge_mask(scene.edges);
-    let shading = Shading::new(scene);
-    let outline = crate::outline::outline_map(&caster, &scene.camera, &scene.style, scene.size);
+    let caster = RayCaster::new(world);
+    let rays = Rays::new(&shot.view, shot.size, world)?;
+    let masks: Vec<Vec<u8>> = world
+        .meshes
+        .iter()
+        .map(|m| m.mesh.edge_mask(m.edges))
+        .collect();
+    let styles = ObjectStyle::of(world, shot.style);
+    let shading = Shading::new(shot);
+    let outline = crate::outline::outline_map(&caster, &rays, shot, &styles);
 
     let pixels = u64::from(width) * u64::from(height);
     let bar = progress_bar(u64::from(height), pixels);
-    let size = DVec2::new(f64::from(width), f64::from(height));
+    let gt = Truth {
+        caster: &caster,
+        rays: &rays,
+        masks: &masks,
+        styles: &styles,
+        shading: &shading,
+    };
     let rows: Vec<Vec<Sample>> = (0..height)
         .into_par_iter()
         .map(|y| {
             let row = (0..width)
                 .map(|x| {
                     let pixel = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
-                    let k = (y * width + x) as usize;
-                    let line = (outline.distance[k], outline.fade[k]);
-                    sample(&caster, &vp, &inv, &masks, &shading, pixel, size, line)
+                    gt.sample(pixel, outline.line[(y * width + x) as usize])
                 })
                 .collect();
             bar.inc(1);
@@ -255,7 +396,7 @@ pub fn render_raycast(scene: &Scene<'_>) -> Result<Frame> {
 
     let n = pixels as usize;
     let mut frame = Frame {
-        size: scene.size,
+        size: shot.size,
         rgba: Vec::with_capacity(4 * n),
         ids: Vec::with_capacity(n),
         depth: Vec::with_capacity(n),
@@ -287,108 +428,149 @@ fn progress_bar(rows: u64, pixels: u64) -> indicatif::ProgressBar {
 
 /// The frame's shading inputs in f64, as the GPU's `Frame` uniforms carry them.
 struct Shading {
-    eye: DVec3,
+    eye: DVec4,
+    fade_row: DVec4,
     light: DVec3,
     fill: [f64; 3],
-    wire: [f64; 4],
     background: Color,
     ambient: f64,
-    line_width: f64,
     fade: [f64; 2],
 }
 
 impl Shading {
-    fn new(scene: &Scene<'_>) -> Self {
-        let s = &scene.style;
+    fn new(shot: &Shot<'_>) -> Self {
+        let s = shot.style;
         let rgb = |c: Color| [0, 1, 2].map(|i| f64::from(c.0[i]));
         Self {
-            eye: scene.camera.eye.as_dvec3(),
-            light: light_world_dir(&scene.camera, s),
+            eye: shot.view.eye(),
+            fade_row: shot.view.view_depth_row(),
+            light: light_world_dir(&shot.view, s),
             fill: rgb(s.fill_color),
-            wire: s.wire_color.0.map(f64::from),
             background: s.background,
             ambient: f64::from(s.ambient),
-            line_width: f64::from(s.line_width),
             fade: s.fade_range().map(f64::from),
         }
     }
 }
 
-/// The ground truth at one pixel centre; `outline` is the pixel's (distance, fade) from the
-/// outline map.
-#[allow(clippy::too_many_arguments)]
-fn sample(
-    caster: &RayCaster<'_>,
-    vp: &DMat4,
-    inv: &DMat4,
-    masks: &[u8],
-    shading: &Shading,
-    pixel: DVec2,
-    size: DVec2,
-    outline: (f64, f64),
-) -> Sample {
-    let u = pixel.x / size.x * 2.0 - 1.0;
-    let v = 1.0 - pixel.y / size.y * 2.0;
-    let near = inv.project_point3(DVec3::new(u, v, 0.0));
-    let far = inv.project_point3(DVec3::new(u, v, 1.0));
-    let outline_line = style::line_intensity(outline.0, shading.line_width) * outline.1;
-    let Some(hit) = caster.cast(near, far) else {
-        let bg = shading.background.0.map(f64::from);
-        let i = outline_line * shading.wire[3];
-        let mix = |k: usize| (bg[k] + (shading.wire[k] - bg[k]) * i) as f32;
-        return Sample {
-            id: BACKGROUND,
-            depth: 1.0,
-            distance: outline.0 as f32,
-            rgba: Color([mix(0), mix(1), mix(2), bg[3].max(i) as f32]).to_srgb8(),
-        };
-    };
-    let mesh = caster.mesh();
-    let tri = mesh.triangles()[hit.id as usize];
-    let world = tri.map(|v| mesh.positions()[v as usize].as_dvec3());
-    let clip: [DVec4; 3] = world.map(|p| *vp * p.extend(1.0));
-    let e = edge_math::edge_eval(clip, masks[hit.id as usize], pixel, size);
-    let distance = e.min_distance();
-    let c = *vp * hit.point.extend(1.0);
-    let depth = (c.z / c.w).clamp(0.0, 1.0);
+/// A line at a pixel: its rank, distance, intensity and whose it is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Line {
+    /// `style::line_key` of the line.
+    pub key: u32,
+    /// Distance from the pixel centre, pixels.
+    pub distance: f64,
+    /// Profile × depth fade, before the wire alpha.
+    pub intensity: f64,
+    /// The object it belongs to.
+    pub object: u32,
+}
 
-    // Twin of `evaluate` in edge_pass.wgsl, in f64.
-    let [b0, b1, b2] = e.bary;
-    let point = world[0] * b0 + world[1] * b1 + world[2] * b2;
-    let to_eye = shading.eye - point;
+/// The ground truth's inputs for sampling pixels.
+struct Truth<'a> {
+    caster: &'a RayCaster<'a>,
+    rays: &'a Rays,
+    masks: &'a [Vec<u8>],
+    styles: &'a [ObjectStyle],
+    shading: &'a Shading,
+}
+
+impl Truth<'_> {
+    /// The ground truth at one pixel centre; `outline` is the pixel's line from the outline
+    /// map.
+    fn sample(&self, pixel: DVec2, outline: Option<Line>) -> Sample {
+        let sh = self.shading;
+        let world = self.caster.world();
+        let (from, to) = self.rays.segment(pixel);
+        let Some(hit) = self.caster.cast(from, to) else {
+            let bg = sh.background.0.map(f64::from);
+            let (i, wire) = outline.map_or((0.0, [0.0; 4]), |l| {
+                let w = self.styles[l.object as usize].wire;
+                (l.intensity * w[3], w)
+            });
+            let mix = |k: usize| (bg[k] + (wire[k] - bg[k]) * i) as f32;
+            return Sample {
+                id: BACKGROUND,
+                depth: 1.0,
+                distance: outline.map_or(f64::INFINITY, |l| l.distance) as f32,
+                rgba: Color([mix(0), mix(1), mix(2), bg[3].max(i) as f32]).to_srgb8(),
+            };
+        };
+        let object = &world.objects[hit.object as usize];
+        let st = &self.styles[hit.object as usize];
+        let wm = &world.meshes[object.mesh];
+        let tri = wm.mesh.triangles()[hit.tri as usize];
+        let corners = self.caster.corners(hit.id);
+        let clip: [DVec4; 3] = corners.map(|p| self.rays.clip(p));
+        let mask = if st.edges {
+            self.masks[object.mesh][hit.tri as usize]
+        } else {
+            0
+        };
+        let e = edge_math::edge_eval(clip, mask, pixel, self.rays.size());
+        let own = e.min_distance();
+        let c = self.rays.clip(hit.point);
+        let depth = (c.z / c.w).clamp(0.0, 1.0);
+
+        // Twin of `finish` in edge_pass.wgsl, in f64.
+        let [b0, b1, b2] = e.bary;
+        let point = corners[0] * b0 + corners[1] * b1 + corners[2] * b2;
+        let view_depth = sh.fade_row.dot(point.extend(1.0));
+        let own_line =
+            style::line_intensity(own, st.width) * style::depth_fade(view_depth, sh.fade);
+        let own_key = if own.is_finite() {
+            style::line_key(own_line, own)
+        } else {
+            0
+        };
+        let surface = surface_color(sh, st, &wm.mesh, tri, e.bary, point);
+        let (line, distance, wire) = match outline {
+            Some(l) if l.key > own_key => {
+                (l.intensity, l.distance, self.styles[l.object as usize].wire)
+            }
+            _ => (own_line, own, st.wire),
+        };
+        let i = line * wire[3];
+        let mix = |k: usize| (surface[k] + (wire[k] - surface[k]) * i) as f32;
+        Sample {
+            id: hit.id,
+            depth: depth as f32,
+            distance: distance as f32,
+            rgba: Color([mix(0), mix(1), mix(2), 1.0]).to_srgb8(),
+        }
+    }
+}
+
+/// Twin of `surface_color` in common.wgsl: the interpolated normal, the face normal where it
+/// vanishes, taken to world axes; lit as if facing the light where neither exists.
+fn surface_color(
+    sh: &Shading,
+    st: &ObjectStyle,
+    mesh: &crate::Mesh,
+    tri: [u32; 3],
+    bary: [f64; 3],
+    point: DVec3,
+) -> [f64; 3] {
     let normals = tri.map(|v| mesh.normals()[v as usize].as_dvec3());
+    let [b0, b1, b2] = bary;
     let mut n = normals[0] * b0 + normals[1] * b1 + normals[2] * b2;
     if !(n.dot(n) > 1e-12) {
-        n = (world[1] - world[0]).cross(world[2] - world[0]);
+        let p = tri.map(|v| mesh.positions()[v as usize].as_dvec3());
+        n = (p[1] - p[0]).cross(p[2] - p[0]);
     }
     if !(n.dot(n) > 0.0) {
-        n = to_eye;
+        return style::shade(sh.fill, sh.light, 1.0, sh.light, sh.ambient);
     }
-    let surface = style::shade(
-        shading.fill,
-        n.normalize_or_zero(),
-        to_eye,
-        shading.light,
-        shading.ambient,
-    );
-    // As the edge pass: the stronger of the own edge and the outline.
-    let own =
-        style::line_intensity(distance, shading.line_width) * style::depth_fade(c.w, shading.fade);
-    let i = own.max(outline_line) * shading.wire[3];
-    let mix = |k: usize| (surface[k] + (shading.wire[k] - surface[k]) * i) as f32;
-    Sample {
-        id: hit.id,
-        depth: depth as f32,
-        distance: distance.min(outline.0) as f32,
-        rgba: Color([mix(0), mix(1), mix(2), 1.0]).to_srgb8(),
-    }
+    let normal = (st.normal * n).normalize_or_zero();
+    let facing = normal.dot(edge_math::towards_eye(point, sh.eye));
+    style::shade(sh.fill, normal, facing, sh.light, sh.ambient)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::mesh::EdgeSelection;
-    use crate::{Camera, Style};
+    use crate::{Camera, Mesh, Style};
     use glam::Vec3;
 
     fn quad() -> Mesh {
@@ -413,7 +595,8 @@ mod tests {
         }
         let tris = (0..n).map(|i| [0, 1 + i, 1 + (i + 1) % n]).collect();
         let mesh = Mesh::new(p.clone(), None, tris, None).unwrap();
-        let caster = RayCaster::new(&mesh);
+        let world = World::single(mesh, EdgeSelection::All);
+        let caster = RayCaster::new(&world);
         for i in 0..n as usize {
             for k in 1..50 {
                 let q = p[1 + i].as_dvec3() * (f64::from(k) / 50.0);
@@ -430,8 +613,8 @@ mod tests {
 
     #[test]
     fn near_and_far_planes_bound_the_segment() {
-        let mesh = quad();
-        let caster = RayCaster::new(&mesh);
+        let world = World::single(quad(), EdgeSelection::All);
+        let caster = RayCaster::new(&world);
         let down =
             |z0: f64, z1: f64| caster.cast(DVec3::new(0.2, 0.3, z0), DVec3::new(0.2, 0.3, z1));
         let h = down(1.0, -1.0).unwrap();
@@ -448,8 +631,27 @@ mod tests {
     }
 
     #[test]
+    fn instances_are_cast_in_world_space() {
+        // Two copies of the quad: one moved back and mirrored; rays see the nearer first,
+        // and the farther one's ids follow the first's.
+        let mut world = World::single(quad(), EdgeSelection::All);
+        world.objects.push(crate::render::Object {
+            mesh: 0,
+            transform: DMat4::from_translation(DVec3::new(0.5, 0.0, -2.0))
+                * DMat4::from_scale(DVec3::new(-1.0, 1.0, 1.0)),
+            style: Default::default(),
+        });
+        let caster = RayCaster::new(&world);
+        let down = |x: f64| caster.cast(DVec3::new(x, 0.1, 5.0), DVec3::new(x, 0.1, -5.0));
+        assert!(down(0.0).unwrap().id < 2);
+        let far = down(1.3).unwrap();
+        assert!(far.id >= 2 && far.object == 1 && (far.point.z + 2.0).abs() < 1e-12);
+        assert!(down(1.6).is_none());
+    }
+
+    #[test]
     fn renders_a_quad_like_the_definition_says() {
-        let mesh = quad();
+        let world = World::single(quad(), EdgeSelection::All);
         let camera = Camera {
             eye: Vec3::new(0.0, 0.0, 3.0),
             target: Vec3::ZERO,
@@ -458,14 +660,14 @@ mod tests {
             near: 0.5,
             far: 10.0,
         };
-        let scene = Scene {
-            mesh: &mesh,
-            camera,
-            style: Style::default(),
+        let style = Style::default();
+        let shot = Shot {
+            world: &world,
+            view: camera.to_view(64.0 / 48.0),
+            style: &style,
             size: (64, 48),
-            edges: EdgeSelection::All,
         };
-        let frame = render_raycast(&scene).unwrap();
+        let frame = render_raycast(&shot).unwrap();
         assert_eq!(frame.rgba.len(), 64 * 48 * 4);
         // The corner pixel is background; the centre is covered at the right depth.
         assert_eq!(frame.ids[0], BACKGROUND);
@@ -480,5 +682,36 @@ mod tests {
         // Distances are finite on the quad and never NaN.
         assert!(frame.edge_distance[centre].is_finite());
         assert!(frame.edge_distance.iter().all(|d| !d.is_nan()));
+    }
+
+    #[test]
+    fn orthographic_and_infinite_rays_see_the_same_quad() {
+        let world = World::single(quad(), EdgeSelection::All);
+        let style = Style::default();
+        let eye = DVec3::new(0.0, 0.0, 3.0);
+        let views = [
+            View::orthographic((eye, DVec3::ZERO, DVec3::Y), 3.0, 1.0, (0.5, 10.0)),
+            Camera {
+                eye: eye.as_vec3(),
+                target: Vec3::ZERO,
+                up: Vec3::Y,
+                fov_y_deg: 60.0,
+                near: 0.5,
+                far: f32::INFINITY,
+            }
+            .to_view(1.0),
+        ];
+        for view in views {
+            let shot = Shot {
+                world: &world,
+                view,
+                style: &style,
+                size: (32, 32),
+            };
+            let frame = render_raycast(&shot).unwrap();
+            // The quad fills the middle of the image.
+            assert!(frame.ids[16 * 32 + 16] < 2, "{view:?}");
+            assert_eq!(frame.ids[0], BACKGROUND);
+        }
     }
 }

@@ -156,15 +156,16 @@ pub fn line_intensity(d: f64, width: f64) -> f64 {
     (0.5 * width).min(1.0) * (-2.0 * t * t).exp2()
 }
 
-/// Twin of `depth_fade` in common.wgsl: the strength of a line at view depth `w`, for the
-/// fade `fade` = (start, end); 1 where `end <= start` (no fade).
+/// Twin of `depth_fade` in common.wgsl: the strength of a line at view depth `depth` (the
+/// distance in front of the eye along the view axis), for the fade `fade` = (start, end); 1
+/// where `end <= start` (no fade).
 #[allow(clippy::neg_cmp_op_on_partial_ord)] // as in WGSL: NaN ends mean no fade
-pub fn depth_fade(w: f64, fade: [f64; 2]) -> f64 {
+pub fn depth_fade(depth: f64, fade: [f64; 2]) -> f64 {
     let [start, end] = fade;
     if !(end > start) {
         return 1.0;
     }
-    ((end - w) / (end - start)).clamp(0.0, 1.0)
+    ((end - depth) / (end - start)).clamp(0.0, 1.0)
 }
 
 impl Style {
@@ -174,25 +175,32 @@ impl Style {
     }
 }
 
+/// Twin of `line_key` in common.wgsl: the rank of a line at a pixel, by its intensity in
+/// 1/4095 steps and then by nearness (distance in 1/4096 px steps): the pixel takes the line
+/// with the greatest key, the one that colours it most.
+pub fn line_key(intensity: f64, d: f64) -> u32 {
+    let level = (intensity.clamp(0.0, 1.0) * 4095.0).round() as u32;
+    let q = (d * 4096.0).clamp(0.0, f64::from(KEY_DISTANCE_MAX)) as u32;
+    (level << 20) | (KEY_DISTANCE_MAX - q)
+}
+
+const KEY_DISTANCE_MAX: u32 = 0xf_ffff;
+
 /// How far from an edge its line can colour a pixel, in pixels.
 pub fn line_reach(width: f64) -> f64 {
     (0.5 * width - 1.0).max(0.0) + 2.0
 }
 
 /// Twin of `shade` in common.wgsl: diffuse key light plus ambient, with the normal turned
-/// towards the viewer.
+/// towards the viewer (`facing` is the normal dotted with the direction to the eye).
 pub fn shade(
     base: [f64; 3],
     normal: glam::DVec3,
-    to_eye: glam::DVec3,
+    facing: f64,
     light: glam::DVec3,
     ambient: f64,
 ) -> [f64; 3] {
-    let n = if normal.dot(to_eye) < 0.0 {
-        -normal
-    } else {
-        normal
-    };
+    let n = if facing < 0.0 { -normal } else { normal };
     let k = ambient + (1.0 - ambient) * n.dot(light).max(0.0);
     base.map(|c| c * k)
 }

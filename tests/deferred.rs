@@ -3,13 +3,11 @@
 
 mod common;
 
-use common::{camera, cpu_distance, gpu, load};
-use glam::Vec3;
-use wirepass::gpu::{DeferredPass, GpuMesh, OutputTarget, PassOptions};
-use wirepass::render::{render, Frame, Method, Scene};
-use wirepass::{Camera, EdgeSelection, Mesh, Style};
-
-const BACKGROUND: u32 = u32::MAX;
+use common::{camera, cpu_distance, framing, gpu, load, shoot};
+use glam::{DMat4, Vec3};
+use wirepass::gpu::{DeferredPass, MeshStore, OutputTarget, PassOptions};
+use wirepass::render::{Frame, Method, BACKGROUND};
+use wirepass::{Camera, EdgeSelection, Instance, Mesh, Scene, Style};
 
 /// Draws without outlines: the tests here check each triangle's own edges against the CPU
 /// definition; outlines are checked against the ground truth (tests/ground_truth.rs,
@@ -29,14 +27,7 @@ fn draw_styled(
     edges: EdgeSelection,
     style: Style,
 ) -> Frame {
-    let scene = Scene {
-        mesh,
-        camera,
-        style,
-        size,
-        edges,
-    };
-    render(gpu(), &scene, Method::Deferred).unwrap_or_else(|e| panic!("{e}"))
+    shoot(mesh, camera, &style, size, edges, Method::Deferred)
 }
 
 /// Largest |GPU − CPU| edge distance over covered pixels whose true distance is under
@@ -79,8 +70,7 @@ fn max_distance_error(
 fn suzanne_draws_no_quad_diagonal() {
     let mesh = load("suzanne.obj");
     let size = (256, 256);
-    let (lo, hi) = mesh.bounds();
-    let cam = Camera::framing(lo, hi, 1.0);
+    let cam = framing(&mesh, size);
     // 3 px lines: full line colour within 0.5 px of an edge.
     let style = Style {
         line_width: 3.0,
@@ -135,8 +125,7 @@ fn suzanne_draws_no_quad_diagonal() {
 #[test]
 fn triangle_mesh_with_all_edges_matches_the_cpu_definition() {
     let mesh = load("teapot.obj");
-    let (lo, hi) = mesh.bounds();
-    let cam = Camera::framing(lo, hi, 4.0 / 3.0);
+    let cam = framing(&mesh, (320, 240));
     let frame = draw(&mesh, cam, (320, 240), EdgeSelection::All);
     let (err, n) = max_distance_error(&mesh, &cam, &frame, EdgeSelection::All, 4.0);
     assert!(n > 1000);
@@ -219,8 +208,7 @@ fn seen_crossing(
 #[test]
 fn same_render_twice_is_identical() {
     let mesh = wirepass::mesh::default_scene();
-    let (lo, hi) = mesh.bounds();
-    let cam = Camera::framing(lo, hi, 1.5);
+    let cam = framing(&mesh, (300, 200));
     let a = draw(&mesh, cam, (300, 200), EdgeSelection::Polygon);
     let b = draw(&mesh, cam, (300, 200), EdgeSelection::Polygon);
     assert_eq!(a.rgba, b.rgba);
@@ -229,6 +217,15 @@ fn same_render_twice_is_identical() {
         bytemuck::cast_slice::<f32, u8>(&a.edge_distance),
         bytemuck::cast_slice::<f32, u8>(&b.edge_distance)
     );
+}
+
+/// A mesh in a fresh store, and the scene of one instance of it at the origin.
+fn single(mesh: &Mesh, edges: EdgeSelection, view: wirepass::View) -> (MeshStore, Scene<'static>) {
+    let ctx = gpu();
+    let mut store = MeshStore::new(&ctx.device);
+    let id = store.insert(&ctx.device, &ctx.queue, mesh, edges).unwrap();
+    let scene = Scene::new(view, vec![Instance::new(id, DMat4::IDENTITY)]);
+    (store, scene)
 }
 
 #[test]
@@ -244,29 +241,21 @@ fn overlay_blends_lines_over_the_host_image_and_resizes() {
     )
     .unwrap()
     .with_diagnostics();
-    let gpu_mesh = GpuMesh::new(device, &mesh, EdgeSelection::All).unwrap();
     let style = Style::default();
     let host_color = [0.2_f32, 0.4, 0.6, 1.0];
     for size in [(64u32, 48u32), (96, 96)] {
-        let (lo, hi) = mesh.bounds();
-        let cam = Camera::framing(lo, hi, size.0 as f32 / size.1 as f32);
-        pass.prepare(device, &ctx.queue, &gpu_mesh, &cam, &style, size)
-            .unwrap();
+        let cam = framing(&mesh, size);
+        let aspect = f64::from(size.0) / f64::from(size.1);
+        let (store, scene) = single(&mesh, EdgeSelection::All, cam.to_view(aspect));
+        let frame = pass.prepare(device, &store, &scene, &style, size).unwrap();
         let texture = |usage| {
-            device.create_texture(&wgpu::TextureDescriptor {
-                label: None,
-                size: wgpu::Extent3d {
-                    width: size.0,
-                    height: size.1,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: wgpu::TextureFormat::Rgba16Float,
+            wirepass::gpu::texture_2d(
+                device,
+                "test",
+                size,
+                wgpu::TextureFormat::Rgba16Float,
                 usage,
-                view_formats: &[],
-            })
+            )
         };
         use wgpu::TextureUsages as U;
         let host = texture(U::TEXTURE_BINDING | U::RENDER_ATTACHMENT);
@@ -301,15 +290,22 @@ fn overlay_blends_lines_over_the_host_image_and_resizes() {
         pass.encode(
             device,
             &mut encoder,
-            &gpu_mesh,
+            &store,
+            &frame,
             OutputTarget::Overlay {
                 host: &host_view,
                 output: &out_view,
             },
         )
         .unwrap();
-        pass.encode_edges(device, &mut encoder, &gpu_mesh, OutputTarget::Diagnostic)
-            .unwrap();
+        pass.encode_edges(
+            device,
+            &mut encoder,
+            &store,
+            &frame,
+            OutputTarget::Diagnostic,
+        )
+        .unwrap();
         ctx.queue.submit([encoder.finish()]);
         ctx.finish().unwrap();
         let texels: Vec<[half::f16; 4]> = bytemuck::pod_collect_to_vec(
@@ -320,7 +316,7 @@ fn overlay_blends_lines_over_the_host_image_and_resizes() {
             &wirepass::gpu::read_texture(
                 device,
                 &ctx.queue,
-                pass.diagnostic_texture().unwrap(),
+                frame.diagnostic_texture().unwrap(),
                 wgpu::TextureAspect::All,
             )
             .unwrap(),
@@ -365,26 +361,20 @@ fn timer_reports_every_pass() {
     let mut pass = DeferredPass::new(device, PassOptions::default())
         .unwrap()
         .with_diagnostics();
-    let gpu_mesh = GpuMesh::new(device, &mesh, EdgeSelection::Polygon).unwrap();
-    let (lo, hi) = mesh.bounds();
-    let cam = Camera::framing(lo, hi, 1.0);
-    pass.prepare(
-        device,
-        &ctx.queue,
-        &gpu_mesh,
-        &cam,
-        &Style::default(),
-        (64, 64),
-    )
-    .unwrap();
-    let mut timer = wirepass::gpu::GpuTimer::new(device, &ctx.queue, 4)
+    let cam = framing(&mesh, (64, 64));
+    let (store, scene) = single(&mesh, EdgeSelection::Polygon, cam.to_view(1.0));
+    let frame = pass
+        .prepare(device, &store, &scene, &Style::default(), (64, 64))
+        .unwrap();
+    let mut timer = wirepass::gpu::GpuTimer::new(device, &ctx.queue, 6)
         .expect("software adapters expose TIMESTAMP_QUERY");
     for _ in 0..2 {
         let mut encoder = device.create_command_encoder(&Default::default());
         pass.encode_timed(
             device,
             &mut encoder,
-            &gpu_mesh,
+            &store,
+            &frame,
             OutputTarget::Diagnostic,
             &mut timer,
         )
@@ -393,7 +383,16 @@ fn timer_reports_every_pass() {
         ctx.queue.submit([encoder.finish()]);
         let spans = timer.read(device).unwrap();
         let names: Vec<_> = spans.iter().map(|s| s.0).collect();
-        assert_eq!(names, ["visibility", "outline", "edge"]);
+        assert_eq!(
+            names,
+            [
+                "visibility",
+                "outline.cull",
+                "outline.draw",
+                "edge.main",
+                "edge.refine"
+            ]
+        );
         assert!(
             spans.iter().all(|s| s.1.is_finite() && s.1 >= 0.0),
             "{spans:?}"
@@ -406,10 +405,15 @@ fn vertex_pulling_fallback_matches_primitive_index() {
     let ctx = gpu();
     let device = &ctx.device;
     let mesh = load("suzanne.obj");
-    let gpu_mesh = GpuMesh::new(device, &mesh, EdgeSelection::Polygon).unwrap();
-    let (lo, hi) = mesh.bounds();
-    let cam = Camera::framing(lo, hi, 1.0);
     let size = (128, 128);
+    let cam = framing(&mesh, size);
+    // Two instances, so the pulled pass's triangle numbering per instance is checked too.
+    let (store, mut scene) = single(&mesh, EdgeSelection::Polygon, cam.to_view(1.0));
+    let copy = Instance::new(
+        scene.instances[0].mesh,
+        DMat4::from_translation(glam::DVec3::new(0.4, 0.1, -0.5)),
+    );
+    scene.instances.to_mut().push(copy);
     let read = |pulled: bool| {
         let options = PassOptions::default();
         let pass = if pulled {
@@ -417,28 +421,35 @@ fn vertex_pulling_fallback_matches_primitive_index() {
         } else {
             DeferredPass::new(device, options)
         };
-        let mut pass = pass.unwrap();
-        assert_eq!(
-            pass.uses_vertex_pulling(),
-            pulled || !device.features().contains(wgpu::Features::PRIMITIVE_INDEX)
-        );
-        pass.prepare(device, &ctx.queue, &gpu_mesh, &cam, &Style::default(), size)
+        let mut pass = pass.unwrap().with_diagnostics();
+        let frame = pass
+            .prepare(device, &store, &scene, &Style::default(), size)
             .unwrap();
         let mut encoder = device.create_command_encoder(&Default::default());
-        pass.encode_visibility(device, &mut encoder, &gpu_mesh)
-            .unwrap();
+        pass.encode(
+            device,
+            &mut encoder,
+            &store,
+            &frame,
+            OutputTarget::Diagnostic,
+        )
+        .unwrap();
         ctx.queue.submit([encoder.finish()]);
         ctx.finish().unwrap();
-        let ids = pass.id_texture().unwrap();
+        let ids = frame.id_texture();
         wirepass::gpu::read_texture(device, &ctx.queue, ids, wgpu::TextureAspect::All).unwrap()
     };
     let pulled = read(true);
     let indexed = read(false);
-    let covered = bytemuck::cast_slice::<u8, u32>(&pulled)
-        .iter()
-        .filter(|&&id| id != BACKGROUND)
-        .count();
+    let ids = bytemuck::cast_slice::<u8, [u32; 2]>(&pulled);
+    let covered = ids.iter().filter(|id| id[0] != BACKGROUND).count();
     assert!(covered > 1000);
+    for slot in [0, 1] {
+        assert!(
+            ids.iter().any(|id| id[0] == slot),
+            "no pixel of instance {slot}"
+        );
+    }
     assert_eq!(
         pulled, indexed,
         "the fallback visibility pass must give the same ids"

@@ -5,9 +5,9 @@
 
 mod common;
 
-use common::{camera, gpu};
+use common::{camera, shoot};
 use glam::Vec3;
-use wirepass::render::{render, Frame, Method, Scene};
+use wirepass::render::{Frame, Method};
 use wirepass::{Camera, EdgeSelection, Mesh, Style};
 
 const SIZE: (u32, u32) = (64, 48);
@@ -17,14 +17,7 @@ fn looking_down_z() -> Camera {
 }
 
 fn draw(mesh: &Mesh, cam: Camera, edges: EdgeSelection) -> Frame {
-    let scene = Scene {
-        mesh,
-        camera: cam,
-        style: Style::default(),
-        size: SIZE,
-        edges,
-    };
-    render(gpu(), &scene, Method::Deferred).unwrap_or_else(|e| panic!("{e}"))
+    shoot(mesh, cam, &Style::default(), SIZE, edges, Method::Deferred)
 }
 
 /// Checks the frame's maps; returns how many pixels show a triangle.

@@ -277,7 +277,7 @@ fn run_gpu(cases: &[Case]) -> Vec<[Vec4; 2]> {
 fn run_shader(body: &str, input: &[Vec4], outputs: usize) -> Vec<Vec4> {
     let ctx = gpu();
     let device = &ctx.device;
-    let source = shaders::assemble(body);
+    let source = shaders::assemble(&[body], &[]);
     let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("common.wgsl test"),
@@ -366,7 +366,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let b = cases[6u * i + 1u].xyz;
     let c = cases[6u * i + 2u].xyz;
     let d = cases[6u * i + 3u].xyz;
-    let eye = cases[6u * i + 4u].xyz;
+    let eye = cases[6u * i + 4u];
     let line = cases[6u * i + 5u];
     let fold = select(0.0, 1.0, is_silhouette(a, b, c, d, eye));
     results[i] = vec4<f32>(fold, depth_fade(line.x, line.yz), line_reach(line.w), 0.0);
@@ -374,8 +374,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 "#;
 
 /// `is_silhouette`, `depth_fade` and `line_reach` in WGSL against their Rust twins, on
-/// random folds seen from random eyes (classification margins well above f32 rounding) and
-/// hand-picked ones: a flat pair, a fold seen edge-on, an eye far away.
+/// random folds seen from random eyes, a fifth of them orthographic (a direction, w = 0),
+/// with classification margins well above f32 rounding, and hand-picked ones: a flat pair, a
+/// fold seen edge-on, an eye far away.
 #[test]
 fn wgsl_outline_math_matches_rust() {
     let mut next = uniform(0x2545_f491_4f6c_dd1d);
@@ -405,12 +406,18 @@ fn wgsl_outline_math_matches_rust() {
             DVec3::Z * 1e4,
         ],
     ];
-    for _ in 0..500 {
+    let points = rows.len() + 500;
+    for k in 0..600 {
         let mut v = || DVec3::new(next(), next(), next());
         let row = [v(), v(), v(), v(), v() * 10.0];
-        let [a, b, c, d, eye] = row;
-        let side = |p: DVec3| (a - eye).dot((b - a).cross(p - a));
-        let scale = (a - eye).length() * (b - a).length();
+        let [a, b, c, d, e] = row;
+        let eye = if k < 500 {
+            e.extend(1.0)
+        } else {
+            e.normalize().extend(0.0)
+        };
+        let side = |p: DVec3| edge_math::towards_eye(a, eye).dot((b - a).cross(p - a));
+        let scale = edge_math::towards_eye(a, eye).length() * (b - a).length();
         // Keep cases whose sides are clear of rounding.
         if side(c).abs() > 1e-3 * scale * (c - a).length()
             && side(d).abs() > 1e-3 * scale * (d - a).length()
@@ -430,11 +437,15 @@ fn wgsl_outline_math_matches_rust() {
             [w, start, end, 8.0 * (next() + 1.0)]
         })
         .collect();
+    // Rows from `points` on see the fold along a direction (an orthographic eye).
+    let eye_w = |k: usize| if k < points { 1.0 } else { 0.0 };
     let input: Vec<Vec4> = rows
         .iter()
         .zip(&fades)
-        .flat_map(|(r, f)| {
+        .enumerate()
+        .flat_map(|(k, (r, f))| {
             let mut v: Vec<Vec4> = r.iter().map(|p| p.as_vec3().extend(0.0)).collect();
+            v[4].w = eye_w(k);
             v.push(glam::DVec4::from_array(*f).as_vec4());
             v
         })
@@ -444,6 +455,11 @@ fn wgsl_outline_math_matches_rust() {
     for (k, ((row, fade), g)) in rows.iter().zip(&fades).zip(&got).enumerate() {
         // The Rust side gets the same f32-rounded inputs.
         let [a, b, c, d, eye] = row.map(|p| p.as_vec3().as_dvec3());
+        let eye = if k < points {
+            eye.extend(1.0)
+        } else {
+            eye.as_vec3().extend(0.0).as_dvec4()
+        };
         let want = edge_math::is_silhouette(a, b, c, d, eye);
         folded += usize::from(want);
         assert_eq!(g.x == 1.0, want, "case {k}: is_silhouette");
@@ -457,10 +473,18 @@ fn wgsl_outline_math_matches_rust() {
         );
     }
     assert!(!edge_math::is_silhouette(
-        rows[0][0], rows[0][1], rows[0][2], rows[0][3], rows[0][4]
+        rows[0][0],
+        rows[0][1],
+        rows[0][2],
+        rows[0][3],
+        rows[0][4].extend(1.0)
     ));
     assert!(edge_math::is_silhouette(
-        rows[1][0], rows[1][1], rows[1][2], rows[1][3], rows[1][4]
+        rows[1][0],
+        rows[1][1],
+        rows[1][2],
+        rows[1][3],
+        rows[1][4].extend(1.0)
     ));
     assert!(
         folded > 50 && folded + 50 < rows.len(),
@@ -480,14 +504,14 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let c = Cluster(cases[3u * i].xyz, cases[3u * i].w, cases[3u * i + 1u].xyz, cases[3u * i + 1u].w);
-    results[i] = vec4<f32>(select(0.0, 1.0, cluster_may_fold(c, cases[3u * i + 2u].xyz)));
+    results[i] = vec4<f32>(select(0.0, 1.0, cluster_may_fold(c, cases[3u * i + 2u])));
 }
 "#;
 
-/// `cluster_may_fold` in WGSL against `clusters::may_fold`, on random clusters and eyes
-/// (the angles clear of the 90° threshold by more than f32 rounding) and hand-picked ones:
-/// the eye inside the sphere, a cluster that may fold from anywhere, a patch seen face-on
-/// and edge-on.
+/// `cluster_may_fold` in WGSL against `clusters::may_fold`, on random clusters and eyes, a
+/// fifth of them orthographic (the angles clear of the 90° threshold by more than f32
+/// rounding), and hand-picked ones: the eye inside the sphere, a cluster that may fold from
+/// anywhere, a patch seen face-on and edge-on.
 #[test]
 fn wgsl_cluster_test_matches_rust() {
     use wirepass::mesh::clusters::{may_fold, ClusterBounds, ALWAYS};
@@ -498,11 +522,14 @@ fn wgsl_cluster_test_matches_rust() {
         axis: DVec3::Z,
         spread,
     };
-    let mut rows: Vec<(ClusterBounds, DVec3)> = vec![
-        (patch(0.1), DVec3::new(0.0, 0.05, 0.0)),
-        (patch(ALWAYS), DVec3::Z * 5.0),
-        (patch(0.1), DVec3::Z * 5.0),
-        (patch(0.1), DVec3::X * 5.0),
+    let point = |v: DVec3| v.extend(1.0);
+    let mut rows: Vec<(ClusterBounds, glam::DVec4)> = vec![
+        (patch(0.1), point(DVec3::new(0.0, 0.05, 0.0))),
+        (patch(ALWAYS), point(DVec3::Z * 5.0)),
+        (patch(0.1), point(DVec3::Z * 5.0)),
+        (patch(0.1), point(DVec3::X * 5.0)),
+        (patch(0.1), DVec3::Z.extend(0.0)),
+        (patch(0.1), DVec3::X.extend(0.0)),
     ];
     let quarter = std::f64::consts::FRAC_PI_2;
     while rows.len() < 500 {
@@ -513,9 +540,19 @@ fn wgsl_cluster_test_matches_rust() {
             axis: DVec3::new(r[4], r[5], r[6]).normalize(),
             spread: 0.5 * (r[7] + 1.0),
         };
-        let eye = DVec3::new(r[8], r[9], r[10]) * 4.0;
-        let d = bounds.center - eye;
-        let beta = (bounds.radius / d.length()).asin();
+        let ortho = rows.len().is_multiple_of(5);
+        let e = DVec3::new(r[8], r[9], r[10]) * 4.0;
+        let eye = if ortho {
+            e.normalize().as_vec3().as_dvec3().extend(0.0)
+        } else {
+            e.extend(1.0)
+        };
+        let (d, beta) = if ortho {
+            (-eye.truncate(), 0.0)
+        } else {
+            let d = bounds.center - e;
+            (d, (bounds.radius / d.length()).asin())
+        };
         let gamma = d.angle_between(bounds.axis);
         let reach = beta + bounds.spread;
         if (gamma + reach - quarter).abs() > 1e-4 && (gamma - reach - quarter).abs() > 1e-4 {
@@ -528,7 +565,7 @@ fn wgsl_cluster_test_matches_rust() {
             [
                 b.center.as_vec3().extend(b.radius as f32),
                 b.axis.as_vec3().extend(b.spread as f32),
-                eye.as_vec3().extend(0.0),
+                eye.as_vec4(),
             ]
         })
         .collect();
@@ -540,11 +577,11 @@ fn wgsl_cluster_test_matches_rust() {
         assert_eq!(g.x == 1.0, want, "case {k}: {b:?} from {eye}");
     }
     assert_eq!(
-        rows[..4]
+        rows[..6]
             .iter()
             .map(|(b, e)| may_fold(b, *e))
             .collect::<Vec<_>>(),
-        [true, true, false, true]
+        [true, true, false, true, false, true]
     );
     assert!(
         folds > 50 && folds + 50 < rows.len(),

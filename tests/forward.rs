@@ -13,7 +13,7 @@ use std::collections::BTreeSet;
 use std::path::PathBuf;
 use std::sync::OnceLock;
 use wirepass::gpu::{drawn_edges, GpuContext};
-use wirepass::render::{render, Frame, Method, Scene};
+use wirepass::render::{render, Frame, Method, Shot, World};
 use wirepass::{Camera, Color, EdgeSelection, Mesh, Style};
 
 const BACKGROUND: u32 = u32::MAX;
@@ -51,14 +51,25 @@ fn per_triangle() -> Style {
 }
 
 fn draw(mesh: &Mesh, camera: Camera, size: (u32, u32), style: &Style, method: Method) -> Frame {
-    let scene = Scene {
-        mesh,
-        camera,
-        style: style.clone(),
+    draw_edges(mesh, camera, size, style, EdgeSelection::Polygon, method)
+}
+
+fn draw_edges(
+    mesh: &Mesh,
+    camera: Camera,
+    size: (u32, u32),
+    style: &Style,
+    edges: EdgeSelection,
+    method: Method,
+) -> Frame {
+    let world = World::single(mesh.clone(), edges);
+    let shot = Shot {
+        world: &world,
+        view: camera.to_view(f64::from(size.0) / f64::from(size.1)),
+        style,
         size,
-        edges: EdgeSelection::Polygon,
     };
-    render(gpu(), &scene, method).unwrap_or_else(|e| panic!("{}: {e}", method.name()))
+    render(gpu(), &shot, method).unwrap_or_else(|e| panic!("{}: {e}", method.name()))
 }
 
 /// How two frames of the same scene differ.
@@ -157,7 +168,7 @@ fn forward_matches_deferred_on_ordinary_cameras() {
     let style = per_triangle();
     for name in ["suzanne.obj", "fandisk.obj", "teapot.obj"] {
         let mesh = load(name);
-        let (lo, hi) = mesh.bounds();
+        let (lo, hi) = mesh.bounds_f64();
         let camera = Camera::framing(lo, hi, 1.0);
         let deferred = draw(&mesh, camera, size, &style, Method::Deferred);
         let forward = draw(&mesh, camera, size, &style, Method::Forward);
@@ -380,21 +391,13 @@ fn two_pass_edge_list_is_the_polygon_edges() {
 fn two_pass_draws_no_quad_diagonal() {
     let size = (512, 512);
     let mesh = load("suzanne.obj");
-    let (lo, hi) = mesh.bounds();
+    let (lo, hi) = mesh.bounds_f64();
     let camera = Camera::framing(lo, hi, 1.0);
     let style = Style {
         wire_color: Color([1.0, 0.0, 0.0, 1.0]),
         ..per_triangle()
     };
-    let scene = |edges| Scene {
-        mesh: &mesh,
-        camera,
-        style: style.clone(),
-        size,
-        edges,
-    };
-    let run =
-        |edges, method| render(gpu(), &scene(edges), method).unwrap_or_else(|e| panic!("{e}"));
+    let run = |edges, method| draw_edges(&mesh, camera, size, &style, edges, method);
     let deferred = run(EdgeSelection::Polygon, Method::Deferred);
     let polygon = run(EdgeSelection::Polygon, Method::TwoPass);
     let all = run(EdgeSelection::All, Method::TwoPass);
@@ -474,7 +477,7 @@ fn two_pass_draws_no_quad_diagonal() {
 fn two_pass_fill_and_lines() {
     let size = (256, 256);
     let mesh = load("suzanne.obj");
-    let (lo, hi) = mesh.bounds();
+    let (lo, hi) = mesh.bounds_f64();
     let camera = Camera::framing(lo, hi, 1.0);
     let style = per_triangle();
     let deferred = draw(&mesh, camera, size, &style, Method::Deferred);

@@ -12,11 +12,11 @@
 
 mod common;
 
-use common::{gpu, load};
+use common::{framing, gpu, load, shoot};
 use glam::{DVec3, Vec3};
 use wirepass::compare::{distance_errors, metrics, Metrics};
-use wirepass::raycast::{render_raycast, RayCaster};
-use wirepass::render::{render, Frame, Method, Scene};
+use wirepass::raycast::RayCaster;
+use wirepass::render::{Frame, Method, Shot, World};
 use wirepass::{Camera, EdgeSelection, Mesh, Style};
 
 const SIZE: (u32, u32) = (320, 240);
@@ -26,7 +26,7 @@ const MAX_ERROR_PX: f64 = 0.1;
 
 /// The hard cameras, each built from the mesh itself so it means the same on every mesh.
 #[derive(Clone, Copy, Debug)]
-enum Shot {
+enum Pose {
     /// The automatic framing: front-right-above, whole mesh in view.
     Ordinary,
     /// Looking at a surface point along its tangent plane, 4° above it.
@@ -39,18 +39,19 @@ enum Shot {
     Far,
 }
 
-const SHOTS: [Shot; 5] = [
-    Shot::Ordinary,
-    Shot::Grazing,
-    Shot::Close,
-    Shot::Inside,
-    Shot::Far,
+const POSES: [Pose; 5] = [
+    Pose::Ordinary,
+    Pose::Grazing,
+    Pose::Close,
+    Pose::Inside,
+    Pose::Far,
 ];
 
 /// A surface point seen at the image centre of the framing camera, with its unit face normal
 /// turned towards that camera.
 fn surface_point(mesh: &Mesh, framed: &Camera) -> (DVec3, DVec3) {
-    let caster = RayCaster::new(mesh);
+    let world = World::single(mesh.clone(), EdgeSelection::All);
+    let caster = RayCaster::new(&world);
     let eye = framed.eye.as_dvec3();
     let target = framed.target.as_dvec3();
     let far = eye + (target - eye) * 10.0;
@@ -86,11 +87,10 @@ fn mean_triangle_area(mesh: &Mesh, camera: &Camera) -> f64 {
     total / mesh.triangle_count() as f64
 }
 
-fn camera(mesh: &Mesh, shot: Shot) -> Camera {
-    let (lo, hi) = mesh.bounds();
-    let aspect = SIZE.0 as f32 / SIZE.1 as f32;
-    let framed = Camera::framing(lo, hi, aspect);
-    let radius = (hi - lo).as_dvec3().length() * 0.5;
+fn camera(mesh: &Mesh, pose: Pose) -> Camera {
+    let (lo, hi) = mesh.bounds_f64();
+    let framed = framing(mesh, SIZE);
+    let radius = (hi - lo).length() * 0.5;
     let (p, n) = surface_point(mesh, &framed);
     // A tangent direction, away from the framing eye's side so the view crosses the mesh.
     let toward_eye = framed.eye.as_dvec3() - p;
@@ -112,22 +112,22 @@ fn camera(mesh: &Mesh, shot: Shot) -> Camera {
         near: near as f32,
         far: far as f32,
     };
-    let cam = match shot {
-        Shot::Ordinary => framed,
-        Shot::Grazing => {
+    let cam = match pose {
+        Pose::Ordinary => framed,
+        Pose::Grazing => {
             let a = 4f64.to_radians();
             let eye = p + (tangent * a.cos() + n * a.sin()) * (1.5 * radius);
             make(eye, p, 0.01 * radius, 5.0 * radius)
         }
-        Shot::Close => {
+        Pose::Close => {
             let eye = p + n * (0.02 * radius) + tangent * (0.01 * radius);
             make(eye, p, 0.001 * radius, 4.0 * radius)
         }
-        Shot::Inside => {
+        Pose::Inside => {
             let eye = p - n * (0.01 * radius);
             make(eye, eye - tangent * radius, 0.03 * radius, 4.0 * radius)
         }
-        Shot::Far => {
+        Pose::Far => {
             // Back off until the mean projected triangle covers 0.05 px² (area scales with
             // the inverse square of the distance, near enough at this range).
             let k = (mean_triangle_area(mesh, &framed) / FAR_TRIANGLE_AREA)
@@ -144,7 +144,7 @@ fn camera(mesh: &Mesh, shot: Shot) -> Camera {
             }
         }
     };
-    cam.validate().unwrap_or_else(|e| panic!("{shot:?}: {e}"));
+    cam.validate().unwrap_or_else(|e| panic!("{pose:?}: {e}"));
     cam
 }
 
@@ -156,27 +156,22 @@ const LOOKS: [(EdgeSelection, f32); 2] = [
 
 fn measure(
     mesh: &Mesh,
-    shot: Shot,
+    pose: Pose,
     (edges, line_width): (EdgeSelection, f32),
 ) -> (Metrics, String) {
-    let scene = Scene {
-        mesh,
-        camera: camera(mesh, shot),
-        style: Style {
-            line_width,
-            ..Style::default()
-        },
-        size: SIZE,
-        edges,
+    let style = Style {
+        line_width,
+        ..Style::default()
     };
-    let truth = render_raycast(&scene).unwrap_or_else(|e| panic!("{e}"));
-    let frame = render(gpu(), &scene, Method::Deferred).unwrap_or_else(|e| panic!("{e}"));
+    let cam = camera(mesh, pose);
+    let truth = shoot(mesh, cam, &style, SIZE, edges, Method::Raycast);
+    let frame = shoot(mesh, cam, &style, SIZE, edges, Method::Deferred);
     let m = metrics(&truth, &frame).unwrap_or_else(|e| panic!("{e}"));
     (m, worst_pixels(&truth, &frame))
 }
 
 /// The pixels with the largest distance errors, for the failure message.
-fn worst_pixels(truth: &Frame, frame: &Frame) -> String {
+pub fn worst_pixels(truth: &Frame, frame: &Frame) -> String {
     let errors = distance_errors(truth, frame).unwrap_or_else(|e| panic!("{e}"));
     let mut worst: Vec<(usize, f64)> = errors
         .iter()
@@ -207,18 +202,18 @@ fn check(name: &str) {
     let mesh = load(name);
     let mut failures = Vec::new();
     let mut feature_pixels = 0;
-    for (shot, look) in SHOTS.iter().flat_map(|&s| LOOKS.map(|l| (s, l))) {
-        let (m, worst) = measure(&mesh, shot, look);
+    for (pose, look) in POSES.iter().flat_map(|&s| LOOKS.map(|l| (s, l))) {
+        let (m, worst) = measure(&mesh, pose, look);
         let d = m.distance_error_px;
         let line = format!(
-            "{name:<20} {shot:<9} {:<12} id {:.5} coverage {:.5} distance p99 {:.2e} max {:.2e} ({} px)",
+            "{name:<20} {pose:<9} {:<12} id {:.5} coverage {:.5} distance p99 {:.2e} max {:.2e} ({} px)",
             format!("{:?}", look.0),
             m.id_agreement,
             m.coverage_agreement,
             d.p99.unwrap_or(f64::NAN),
             d.max.unwrap_or(f64::NAN),
             d.pixels,
-            shot = format!("{shot:?}"),
+            pose = format!("{pose:?}"),
         );
         println!("{line}");
         if m.id_agreement < MIN_ID_AGREEMENT {
@@ -278,17 +273,17 @@ fn teapot() {
 fn compare_writes_images_and_report() {
     let mesh = load("suzanne.obj");
     let size = (96, 72);
-    let (lo, hi) = mesh.bounds();
-    let scene = Scene {
-        mesh: &mesh,
-        camera: Camera::framing(lo, hi, 96.0 / 72.0),
-        style: Style::default(),
+    let world = World::single(mesh.clone(), EdgeSelection::Polygon);
+    let style = Style::default();
+    let shot = Shot {
+        world: &world,
+        view: framing(&mesh, size).to_view(96.0 / 72.0),
+        style: &style,
         size,
-        edges: EdgeSelection::Polygon,
     };
     let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("compare_suzanne");
     let _ = std::fs::remove_dir_all(&out);
-    let report = wirepass::compare::run(gpu(), &scene, &out).unwrap_or_else(|e| panic!("{e}"));
+    let report = wirepass::compare::run(gpu(), &shot, &out).unwrap_or_else(|e| panic!("{e}"));
     let text = std::fs::read_to_string(out.join("report.json")).unwrap();
     let json: serde_json::Value = serde_json::from_str(&text).unwrap();
     assert_eq!(json["size"], serde_json::json!([96, 72]));

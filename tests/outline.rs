@@ -4,28 +4,26 @@
 
 mod common;
 
-use common::{gpu, load};
+use common::{framing, load, TestScene};
 use wirepass::compare::metrics;
-use wirepass::raycast::render_raycast;
-use wirepass::render::{render, Frame, Method, Scene};
+use wirepass::render::{Frame, Method};
 use wirepass::style::{line_intensity, DepthFade};
-use wirepass::{Camera, EdgeSelection, Mesh, Style};
+use wirepass::{EdgeSelection, Mesh, Style};
 
 const SIZE: (u32, u32) = (256, 256);
 
-fn scene<'a>(mesh: &'a Mesh, style: Style) -> Scene<'a> {
-    let (lo, hi) = mesh.bounds();
-    Scene {
+fn scene(mesh: &Mesh, style: Style) -> TestScene {
+    TestScene::new(
         mesh,
-        camera: Camera::framing(lo, hi, 1.0),
+        framing(mesh, SIZE),
         style,
-        size: SIZE,
-        edges: EdgeSelection::Feature(30.0),
-    }
+        SIZE,
+        EdgeSelection::Feature(30.0),
+    )
 }
 
-fn draw(scene: &Scene<'_>, method: Method) -> Frame {
-    render(gpu(), scene, method).unwrap_or_else(|e| panic!("{method:?}: {e}"))
+fn draw(scene: &TestScene, method: Method) -> Frame {
+    scene.draw(method)
 }
 
 /// fandisk, feature edges at 3 px: the outer half of the outline lies over the background.
@@ -40,7 +38,7 @@ fn outlines_reach_over_the_background_in_deferred_only() {
         ..Style::default()
     };
     let scene = scene(&mesh, style);
-    let truth = render_raycast(&scene).unwrap_or_else(|e| panic!("{e}"));
+    let truth = draw(&scene, Method::Raycast);
     let deferred = draw(&scene, Method::Deferred);
     let forward = draw(&scene, Method::Forward);
     // Background pixels in the core of the outline (full line colour: within 0.5 px).
@@ -86,7 +84,7 @@ fn outlines_off_keep_lines_inside_their_triangles() {
     };
     let scene = scene(&mesh, style);
     let deferred = draw(&scene, Method::Deferred);
-    let truth = render_raycast(&scene).unwrap_or_else(|e| panic!("{e}"));
+    let truth = draw(&scene, Method::Raycast);
     for f in [&deferred, &truth] {
         let lined_background = (0..f.ids.len())
             .filter(|&i| f.ids[i] == u32::MAX && f.edge_distance[i].is_finite())
@@ -109,9 +107,10 @@ fn lines_fade_with_depth_in_every_method() {
         ..Style::default()
     };
     let plain = scene(&mesh, base.clone());
-    let without_truth = render_raycast(&plain).unwrap_or_else(|e| panic!("{e}"));
+    let without_truth = draw(&plain, Method::Raycast);
     // View depth per covered pixel, from the 0..1 depth of `perspective_rh`.
-    let (n, f) = (f64::from(plain.camera.near), f64::from(plain.camera.far));
+    let cam = framing(&mesh, SIZE);
+    let (n, f) = (f64::from(cam.near), f64::from(cam.far));
     let view_depth = |frame: &Frame, i: usize| {
         let z = f64::from(frame.depth[i]);
         n * f / (f - z * (f - n))
@@ -133,7 +132,7 @@ fn lines_fade_with_depth_in_every_method() {
             ..base
         },
     );
-    let truth = render_raycast(&fading).unwrap_or_else(|e| panic!("{e}"));
+    let truth = draw(&fading, Method::Raycast);
     let deferred = draw(&fading, Method::Deferred);
     let m = metrics(&truth, &deferred).unwrap();
     assert!(m.image_difference.flip_mean < 2e-3, "{m:?}");

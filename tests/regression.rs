@@ -13,7 +13,7 @@ use common::{gpu, load};
 use glam::Vec3;
 use std::path::PathBuf;
 use wirepass::regression::{check_against_reference, Outcome, Threshold};
-use wirepass::render::{render, Method, Scene};
+use wirepass::render::{render, Method, Shot, World};
 use wirepass::{Camera, EdgeSelection, Mesh, Style};
 
 const SIZE: (u32, u32) = (256, 256);
@@ -49,7 +49,7 @@ impl View {
     fn camera(self, mesh: &Mesh) -> Camera {
         let (lo, hi) = mesh.bounds();
         match self {
-            View::Framing => Camera::framing(lo, hi, SIZE.0 as f32 / SIZE.1 as f32),
+            View::Framing => common::framing(mesh, SIZE),
             View::Inside => {
                 let centre = (lo + hi) * 0.5;
                 let extent = (hi - lo).length();
@@ -76,46 +76,46 @@ impl View {
 #[rustfmt::skip]
 const MEASURED: &[(&str, [f32; 2], [f32; 2])] = &[
     // (case, lavapipe [mean, p99], llvmpipe-GL [mean, p99])
-    ("fandisk_deferred_feature30_framing", [0.0, 0.0], [0.00000, 0.00000]),
+    ("fandisk_deferred_feature30_framing", [0.0, 0.0], [0.00001, 0.00007]),
     ("fandisk_deferred_feature30_inside", [0.0, 0.0], [0.00001, 0.00000]),
-    ("fandisk_deferred_polygon_framing", [0.0, 0.0], [0.00002, 0.00026]),
-    ("fandisk_deferred_polygon_inside", [0.0, 0.0], [0.00002, 0.00041]),
-    ("fandisk_forward_feature30_framing", [0.0, 0.0], [0.00001, 0.00003]),
-    ("fandisk_forward_feature30_inside", [0.0, 0.0], [0.03050, 0.63325]),
-    ("fandisk_forward_polygon_framing", [0.0, 0.0], [0.00009, 0.00175]),
-    ("fandisk_forward_polygon_inside", [0.0, 0.0], [0.02985, 0.61738]),
-    ("fandisk_two-pass_feature30_framing", [0.0, 0.0], [0.00218, 0.06256]),
-    ("fandisk_two-pass_feature30_inside", [0.0, 0.0], [0.00090, 0.01562]),
+    ("fandisk_deferred_polygon_framing", [0.0, 0.0], [0.00002, 0.00039]),
+    ("fandisk_deferred_polygon_inside", [0.0, 0.0], [0.00003, 0.00046]),
+    ("fandisk_forward_feature30_framing", [0.0, 0.0], [0.00001, 0.00006]),
+    ("fandisk_forward_feature30_inside", [0.0, 0.0], [0.03050, 0.63335]),
+    ("fandisk_forward_polygon_framing", [0.0, 0.0], [0.00009, 0.00182]),
+    ("fandisk_forward_polygon_inside", [0.0, 0.0], [0.02984, 0.61741]),
+    ("fandisk_two-pass_feature30_framing", [0.0, 0.0], [0.00217, 0.06256]),
+    ("fandisk_two-pass_feature30_inside", [0.0, 0.0], [0.00090, 0.01565]),
     ("fandisk_two-pass_polygon_framing", [0.0, 0.0], [0.04954, 0.42377]),
     ("fandisk_two-pass_polygon_inside", [0.0, 0.0], [0.02902, 0.27023]),
-    ("stanford-bunny_deferred_feature30_framing", [0.0, 0.0], [0.00000, 0.00000]),
-    ("stanford-bunny_deferred_feature30_inside", [0.0, 0.0], [0.00001, 0.00000]),
-    ("stanford-bunny_deferred_polygon_framing", [0.0, 0.0], [0.00001, 0.00000]),
-    ("stanford-bunny_deferred_polygon_inside", [0.0, 0.0], [0.00003, 0.00049]),
-    ("stanford-bunny_forward_feature30_framing", [0.0, 0.0], [0.00001, 0.00019]),
-    ("stanford-bunny_forward_feature30_inside", [0.0, 0.0], [0.00002, 0.00032]),
-    ("stanford-bunny_forward_polygon_framing", [0.0, 0.0], [0.00003, 0.00047]),
-    ("stanford-bunny_forward_polygon_inside", [0.0, 0.0], [0.00021, 0.00350]),
+    ("stanford-bunny_deferred_feature30_framing", [0.0, 0.0], [0.00001, 0.00000]),
+    ("stanford-bunny_deferred_feature30_inside", [0.0, 0.0], [0.00000, 0.00000]),
+    ("stanford-bunny_deferred_polygon_framing", [0.0, 0.0], [0.00001, 0.00003]),
+    ("stanford-bunny_deferred_polygon_inside", [0.0, 0.0], [0.00002, 0.00043]),
+    ("stanford-bunny_forward_feature30_framing", [0.0, 0.0], [0.00000, 0.00000]),
+    ("stanford-bunny_forward_feature30_inside", [0.0, 0.0], [0.00001, 0.00007]),
+    ("stanford-bunny_forward_polygon_framing", [0.0, 0.0], [0.00002, 0.00039]),
+    ("stanford-bunny_forward_polygon_inside", [0.0, 0.0], [0.00020, 0.00347]),
     ("stanford-bunny_two-pass_feature30_framing", [0.0, 0.0], [0.00434, 0.13679]),
-    ("stanford-bunny_two-pass_feature30_inside", [0.0, 0.0], [0.00041, 0.00350]),
+    ("stanford-bunny_two-pass_feature30_inside", [0.0, 0.0], [0.00040, 0.00343]),
     ("stanford-bunny_two-pass_polygon_framing", [0.0, 0.0], [0.02181, 0.49665]),
     ("stanford-bunny_two-pass_polygon_inside", [0.0, 0.0], [0.07779, 0.41234]),
-    ("suzanne_deferred_all_framing", [0.0, 0.0], [0.00001, 0.00005]),
+    ("suzanne_deferred_all_framing", [0.0, 0.0], [0.00001, 0.00013]),
     ("suzanne_deferred_all_inside", [0.0, 0.0], [0.00003, 0.00059]),
-    ("suzanne_deferred_feature30_framing", [0.0, 0.0], [0.00001, 0.00000]),
-    ("suzanne_deferred_feature30_inside", [0.0, 0.0], [0.00002, 0.00018]),
-    ("suzanne_deferred_polygon_framing", [0.0, 0.0], [0.00001, 0.00000]),
-    ("suzanne_deferred_polygon_inside", [0.0, 0.0], [0.00002, 0.00037]),
-    ("suzanne_forward_all_framing", [0.0, 0.0], [0.00005, 0.00096]),
-    ("suzanne_forward_all_inside", [0.0, 0.0], [0.00008, 0.00160]),
-    ("suzanne_forward_feature30_framing", [0.0, 0.0], [0.00002, 0.00046]),
-    ("suzanne_forward_feature30_inside", [0.0, 0.0], [0.00005, 0.00105]),
-    ("suzanne_forward_polygon_framing", [0.0, 0.0], [0.00003, 0.00053]),
-    ("suzanne_forward_polygon_inside", [0.0, 0.0], [0.00005, 0.00099]),
+    ("suzanne_deferred_feature30_framing", [0.0, 0.0], [0.00001, 0.00007]),
+    ("suzanne_deferred_feature30_inside", [0.0, 0.0], [0.00002, 0.00028]),
+    ("suzanne_deferred_polygon_framing", [0.0, 0.0], [0.00001, 0.00007]),
+    ("suzanne_deferred_polygon_inside", [0.0, 0.0], [0.00003, 0.00051]),
+    ("suzanne_forward_all_framing", [0.0, 0.0], [0.00004, 0.00078]),
+    ("suzanne_forward_all_inside", [0.0, 0.0], [0.00007, 0.00135]),
+    ("suzanne_forward_feature30_framing", [0.0, 0.0], [0.00002, 0.00051]),
+    ("suzanne_forward_feature30_inside", [0.0, 0.0], [0.00004, 0.00082]),
+    ("suzanne_forward_polygon_framing", [0.0, 0.0], [0.00003, 0.00060]),
+    ("suzanne_forward_polygon_inside", [0.0, 0.0], [0.00006, 0.00114]),
     ("suzanne_two-pass_all_framing", [0.0, 0.0], [0.01722, 0.27990]),
     ("suzanne_two-pass_all_inside", [0.0, 0.0], [0.01853, 0.24999]),
     ("suzanne_two-pass_feature30_framing", [0.0, 0.0], [0.00955, 0.22468]),
-    ("suzanne_two-pass_feature30_inside", [0.0, 0.0], [0.01084, 0.20464]),
+    ("suzanne_two-pass_feature30_inside", [0.0, 0.0], [0.01083, 0.20464]),
     ("suzanne_two-pass_polygon_framing", [0.0, 0.0], [0.01270, 0.24772]),
     ("suzanne_two-pass_polygon_inside", [0.0, 0.0], [0.01397, 0.22556]),
 ];
@@ -184,13 +184,14 @@ fn every_case_matches_its_reference() {
         let mesh = load(&format!("{mesh_name}.obj"));
         for &mode in modes {
             let edges: EdgeSelection = mode.parse().unwrap_or_else(|e| panic!("{e}"));
+            let world = World::single(mesh.clone(), edges);
+            let style = Style::default();
             for view in [View::Framing, View::Inside] {
-                let scene = Scene {
-                    mesh: &mesh,
-                    camera: view.camera(&mesh),
-                    style: Style::default(),
+                let shot = Shot {
+                    world: &world,
+                    view: view.camera(&mesh).to_view(1.0),
+                    style: &style,
                     size: SIZE,
-                    edges,
                 };
                 for &method in METHODS {
                     cases += 1;
@@ -200,7 +201,7 @@ fn every_case_matches_its_reference() {
                         mode.replace(':', ""),
                         view.name()
                     );
-                    let frame = match render(ctx, &scene, method) {
+                    let frame = match render(ctx, &shot, method) {
                         Ok(frame) => frame,
                         Err(e) => {
                             failures.push(format!("{case}: render failed: {e}"));

@@ -1,12 +1,6 @@
-//! Every WGSL module the crate can build passes naga's parser and validator, with no GPU.
-//!
-//! Covered: the assembled modules the passes create (`VISIBILITY`, `VISIBILITY_PULLED`, the
-//! edge pass for both output formats), and every file in `shaders/`, so a new shader is
-//! validated as soon as it exists. Every file except `common.wgsl` is a body that the crate
-//! appends to `common.wgsl` ([`shaders::assemble`]); a body's output-format placeholder is
-//! filled in and, where it calls `encode_output` without defining it (the Rust side appends
-//! that per format), a definition is appended. A body written to follow another body (e.g.
-//! `two_pass.wgsl` after `forward.wgsl`) validates when assembled after one of the others.
+//! Every WGSL module the crate can build passes naga's parser and validator, with no GPU:
+//! each pass in each specialisation (`shaders::variants`), and every file in `shaders/` is
+//! part of at least one of them, so a new shader is validated as soon as it is used.
 
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 use std::path::{Path, PathBuf};
@@ -21,43 +15,20 @@ fn validate(source: &str) -> Result<(), String> {
     Ok(())
 }
 
-fn check(name: &str, source: &str) {
-    if let Err(e) = validate(source) {
-        panic!("{name} does not validate:\n{e}");
-    }
-}
-
 #[test]
-fn assembled_modules_validate() {
-    check("VISIBILITY", &shaders::assemble(shaders::VISIBILITY));
-    check(
-        "VISIBILITY_PULLED",
-        &shaders::assemble(shaders::VISIBILITY_PULLED),
-    );
-    for format in [
-        wgpu::TextureFormat::Rgba8Unorm,
-        wgpu::TextureFormat::Rgba16Float,
-    ] {
-        let source = shaders::edge_pass(format)
-            .unwrap_or_else(|| panic!("edge_pass has no module for {format:?}"));
-        check(&format!("edge_pass({format:?})"), &source);
-    }
+fn every_variant_validates() {
+    let variants = shaders::variants();
+    assert!(variants.len() > 100, "{} variants", variants.len());
+    let failures: Vec<String> = variants
+        .iter()
+        .filter_map(|(name, source)| validate(source).err().map(|e| format!("{name}:\n{e}")))
+        .collect();
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
 #[test]
 fn common_alone_validates() {
-    check("common.wgsl", shaders::COMMON);
-}
-
-/// A body as the Rust side completes it: placeholder format filled, `encode_output` present.
-fn complete(body: &str) -> String {
-    let mut body = body.replace("OUTPUT_FORMAT", "rgba8unorm");
-    if body.contains("encode_output(") && !body.contains("fn encode_output") {
-        body.push_str(
-            "\nfn encode_output(c: vec4<f32>) -> vec4<f32> { return vec4<f32>(linear_to_srgb(c.rgb), c.a); }\n",
-        );
-    }
-    body
+    validate(shaders::COMMON).unwrap_or_else(|e| panic!("common.wgsl:\n{e}"));
 }
 
 fn shader_files() -> Vec<PathBuf> {
@@ -72,33 +43,28 @@ fn shader_files() -> Vec<PathBuf> {
 }
 
 #[test]
-fn every_shader_file_validates() {
+fn every_shader_file_is_in_a_variant() {
+    let variants = shaders::variants();
     let files = shader_files();
-    let read =
-        |p: &PathBuf| std::fs::read_to_string(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
-    let name = |p: &PathBuf| p.file_name().unwrap().to_string_lossy().into_owned();
-    let bodies: Vec<(String, String)> = files
-        .iter()
-        .filter(|p| name(p) != "common.wgsl")
-        .map(|p| (name(p), read(p)))
-        .collect();
-    assert!(
-        bodies.len() >= 3,
-        "expected the visibility and edge-pass shaders in shaders/, found {:?}",
-        bodies.iter().map(|b| &b.0).collect::<Vec<_>>()
-    );
-    let mut failures = Vec::new();
-    for (file, body) in &bodies {
-        let alone = validate(&shaders::assemble(&complete(body)));
-        let Err(error) = alone else { continue };
-        // Maybe a body that follows another one.
-        let after_another = bodies.iter().any(|(other, first)| {
-            other != file
-                && validate(&shaders::assemble(&complete(&format!("{first}\n{body}")))).is_ok()
-        });
-        if !after_another {
-            failures.push(format!("{file}:\n{error}"));
-        }
+    assert!(files.len() >= 8, "{files:?}");
+    for file in files {
+        let text = std::fs::read_to_string(&file).unwrap();
+        // The first code line that no specialisation can drop.
+        let line = text
+            .lines()
+            .find(|l| {
+                let t = l.trim();
+                !t.is_empty()
+                    && !t.starts_with("//")
+                    && !t.starts_with('#')
+                    && !t.starts_with("enable")
+            })
+            .unwrap_or_else(|| panic!("{} has no code", file.display()))
+            .replace("OUTPUT_FORMAT", "rgba8unorm");
+        assert!(
+            variants.iter().any(|(_, s)| s.contains(&line)),
+            "{} is in no module the crate builds (looked for {line:?})",
+            file.display()
+        );
     }
-    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }

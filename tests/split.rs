@@ -1,20 +1,22 @@
-//! Meshes whose per-triangle buffers exceed `max_storage_buffer_binding_size` are bound as
-//! two ranges of one buffer (src/gpu/mesh.rs). On a device with a lowered limit, every method
-//! must render such a mesh exactly as a device that binds it whole does.
+//! A mesh store whose vertex or per-triangle buffers exceed `max_storage_buffer_binding_size`
+//! is bound as two ranges of each buffer (src/gpu/mesh_store.rs). On a device with a lowered
+//! limit, every method must render such a mesh exactly as a device that binds it whole does.
 
 mod common;
 
 use common::gpu;
-use glam::Vec3;
+use glam::{DMat4, Vec3};
 use std::sync::{Mutex, MutexGuard};
 use wirepass::cli::CameraArgs;
-use wirepass::gpu::{DeferredPass, GpuContext, GpuMesh, PassOptions};
+use wirepass::gpu::{DeferredPass, GpuContext, MeshStore, OutputTarget, PassOptions};
 use wirepass::mesh::Procedural;
-use wirepass::render::{render, Method, Scene};
-use wirepass::{EdgeSelection, Error, Style};
+use wirepass::render::{render, Method, Shot, World, BACKGROUND};
+use wirepass::{EdgeSelection, Error, Instance, Scene, Style};
 
-/// 64 KiB: 5461 triangles of indices per binding.
+/// 64 KiB: 5440 triangles of indices in the first binding (a multiple of 64 triangles, so
+/// the second binding's offset is 256-byte aligned).
 const SMALL: u32 = 1 << 16;
+const FIRST_BINDING_TRIANGLES: u32 = 5440;
 
 /// The tests here hold a second device beside the shared one. wgpu's GL backend gives both
 /// devices one EGL context, and using them from two threads at once loses draws, so these
@@ -45,22 +47,30 @@ fn a_mesh_split_over_two_bindings_renders_as_if_whole() {
         eye: Some(Vec3::new(0.6, -2.5, 1.2)),
         ..CameraArgs::default()
     };
-    let scene = Scene {
-        mesh: &mesh,
-        camera: below.camera(&mesh, size).unwrap(),
-        style: Style::default(),
+    let camera = below.camera(mesh.bounds_f64(), size).unwrap();
+    // The mesh's triangles are stored in cluster order: where each file triangle is stored.
+    let order = &mesh.outline_clusters().order;
+    let mut stored = vec![0u32; order.len()];
+    for (s, &t) in order.iter().enumerate() {
+        stored[t as usize] = s as u32;
+    }
+    let world = World::single(mesh.clone(), EdgeSelection::All);
+    let style = Style::default();
+    let shot = Shot {
+        world: &world,
+        view: camera.to_view(128.0 / 96.0),
+        style: &style,
         size,
-        edges: EdgeSelection::All,
     };
     for method in [Method::Deferred, Method::Forward, Method::TwoPass] {
-        let whole = render(gpu(), &scene, method).unwrap();
-        let split = render(&small, &scene, method).unwrap();
-        assert!(whole.ids.iter().filter(|&&id| id != u32::MAX).count() > 2000);
-        // Both halves are drawn: ids on either side of the split appear.
+        let whole = render(gpu(), &shot, method).unwrap();
+        let split = render(&small, &shot, method).unwrap();
+        assert!(whole.ids.iter().filter(|&&id| id != BACKGROUND).count() > 2000);
+        // Both halves are drawn: triangles on either side of the split appear.
         let high = split
             .ids
             .iter()
-            .filter(|&&id| id != u32::MAX && id > 5461)
+            .filter(|&&id| id != BACKGROUND && stored[id as usize] >= FIRST_BINDING_TRIANGLES)
             .count();
         assert!(
             high > 1000,
@@ -78,14 +88,33 @@ fn a_mesh_split_over_two_bindings_renders_as_if_whole() {
     small.finish().unwrap();
 }
 
+/// A store on `ctx` holding `mesh`, and a scene of one instance of it.
+fn stored(
+    ctx: &GpuContext,
+    mesh: &wirepass::Mesh,
+    size: (u32, u32),
+) -> (MeshStore, Scene<'static>) {
+    let mut store = MeshStore::new(&ctx.device);
+    let id = store
+        .insert(&ctx.device, &ctx.queue, mesh, EdgeSelection::All)
+        .unwrap();
+    let camera = CameraArgs::default()
+        .camera(mesh.bounds_f64(), size)
+        .unwrap();
+    let view = camera.to_view(f64::from(size.0) / f64::from(size.1));
+    (
+        store,
+        Scene::new(view, vec![Instance::new(id, DMat4::IDENTITY)]),
+    )
+}
+
 #[test]
 fn the_pulled_visibility_pass_reads_both_halves() {
     let (small, _turn) = small_device();
     let device = &small.device;
     let mesh = Procedural::Sphere(8000).build().unwrap();
-    let gpu_mesh = GpuMesh::new(device, &mesh, EdgeSelection::All).unwrap();
     let size = (128, 96);
-    let camera = CameraArgs::default().camera(&mesh, size).unwrap();
+    let (store, scene) = stored(&small, &mesh, size);
     let ids = |pulled: bool| {
         let options = PassOptions::default();
         let mut pass = if pulled {
@@ -93,22 +122,23 @@ fn the_pulled_visibility_pass_reads_both_halves() {
         } else {
             DeferredPass::new(device, options)
         }
-        .unwrap();
-        pass.prepare(
+        .unwrap()
+        .with_diagnostics();
+        let frame = pass
+            .prepare(device, &store, &scene, &Style::default(), size)
+            .unwrap();
+        let mut encoder = device.create_command_encoder(&Default::default());
+        pass.encode(
             device,
-            &small.queue,
-            &gpu_mesh,
-            &camera,
-            &Style::default(),
-            size,
+            &mut encoder,
+            &store,
+            &frame,
+            OutputTarget::Diagnostic,
         )
         .unwrap();
-        let mut encoder = device.create_command_encoder(&Default::default());
-        pass.encode_visibility(device, &mut encoder, &gpu_mesh)
-            .unwrap();
         small.queue.submit([encoder.finish()]);
         small.finish().unwrap();
-        let t = pass.id_texture().unwrap();
+        let t = frame.id_texture();
         wirepass::gpu::read_texture(device, &small.queue, t, wgpu::TextureAspect::All).unwrap()
     };
     assert_eq!(ids(true), ids(false));
@@ -128,7 +158,8 @@ fn a_mesh_past_two_bindings_is_a_clear_error() {
         .collect();
     assert!(triangles.len() * 12 > 2 * SMALL as usize);
     let mesh = wirepass::Mesh::new(positions, None, triangles, None).unwrap();
-    let e = match GpuMesh::new(&small.device, &mesh, EdgeSelection::All) {
+    let mut store = MeshStore::new(&small.device);
+    let e = match store.insert(&small.device, &small.queue, &mesh, EdgeSelection::All) {
         Ok(_) => panic!("{} triangles fit", mesh.triangle_count()),
         Err(e) => e,
     };
@@ -145,21 +176,14 @@ fn an_image_past_the_outline_buffer_limit_is_a_clear_error() {
     let (small, _turn) = small_device();
     let device = &small.device;
     let mesh = Procedural::Sphere(200).build().unwrap();
-    let gpu_mesh = GpuMesh::new(device, &mesh, EdgeSelection::All).unwrap();
-    let mut pass = DeferredPass::new(device, PassOptions::default()).unwrap();
     // 4 bytes a pixel: 160 × 120 needs 76 800 bytes, over 64 KiB.
     let size = (160, 120);
-    let camera = CameraArgs::default().camera(&mesh, size).unwrap();
+    let (store, scene) = stored(&small, &mesh, size);
+    let mut pass = DeferredPass::new(device, PassOptions::default()).unwrap();
     let e = pass
-        .prepare(
-            device,
-            &small.queue,
-            &gpu_mesh,
-            &camera,
-            &Style::default(),
-            size,
-        )
-        .unwrap_err();
+        .prepare(device, &store, &scene, &Style::default(), size)
+        .err()
+        .unwrap();
     let msg = e.to_string();
     assert!(
         msg.contains("outline buffer") && msg.contains("max_storage_buffer_binding_size = 65536"),

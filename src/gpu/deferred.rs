@@ -1,31 +1,31 @@
-//! The deferred wireframe pass: a visibility raster pass (triangle id + depth) followed by a
-//! compute pass that reconstructs each pixel's distance to its triangle's edges.
+//! The deferred wireframe pass: the visibility pass, the outline pass (with outlines on) and
+//! the edge pass, for a whole scene of instances at once.
 
-use super::{shaders, texture_2d, FrameUniforms, GpuMesh, GpuTimer};
-use crate::camera::Camera;
+use super::bindings::{store_resources, Compute, Res, Sources};
+use super::frame::{FrameData, Window};
+use super::mesh_store::MeshStore;
+use super::targets::{TargetSpec, Targets, LIST_HEADER};
+use super::visibility::Visibility;
+use super::{shaders, GpuTimer};
 use crate::error::{Error, Result};
+use crate::scene::Scene;
 use crate::style::Style;
+use std::collections::HashMap;
+use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::{Arc, Mutex};
 use wgpu::util::DeviceExt;
 
-/// Format of the triangle-id target; `u32::MAX` marks background.
-pub const ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
-/// Format of the depth target (reverse-Z: 1 at the near plane, 0 at the far plane).
-pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
-/// Format of the diagnostic map: distance in pixels (r) and reverse-Z depth (g) of the
-/// visible point.
-pub const DIAGNOSTIC_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
-/// Format of the resolved-id map the diagnostic mode writes.
-pub const RESOLVED_ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 /// Edge-pass workgroup side (8 × 8 pixels).
 const TILE: u32 = 8;
-/// Outline-pass workgroup size and triangles per cluster, as in outline.wgsl.
-const OUTLINE_GROUP: u32 = crate::mesh::clusters::CLUSTER_TRIANGLES as u32;
+/// Workgroup size of the outline pass and of the refine dispatch.
+const GROUP: u32 = 64;
 
 /// Construction options.
 #[derive(Clone, Copy, Debug)]
 pub struct PassOptions {
-    /// Format of the texture the pass writes: `Rgba8Unorm` (written sRGB-encoded),
-    /// `Rgba16Float` or `Rgba32Float` (linear). It needs `STORAGE_BINDING` usage.
+    /// Format of the storage texture that [`OutputTarget::Shaded`] and
+    /// [`OutputTarget::Overlay`] write: `Rgba8Unorm` (written sRGB-encoded), `Rgba16Float`
+    /// or `Rgba32Float` (linear). It needs `STORAGE_BINDING` usage.
     pub output_format: wgpu::TextureFormat,
 }
 
@@ -39,104 +39,118 @@ impl Default for PassOptions {
 
 /// Where the edge pass writes.
 pub enum OutputTarget<'a> {
-    /// Shade the surface and draw the lines over it.
+    /// Shade the surface and draw the lines over it, into a storage texture of the pass's
+    /// output format and the frame's size.
     Shaded(&'a wgpu::TextureView),
     /// Post-process: blend the lines over the host's colour image `host` (a sampled
-    /// texture of the same size) into `output`. Background pixels copy `host`.
+    /// texture of the frame's size, holding linear values, or sRGB-encoded ones in an sRGB
+    /// format) into `output`. Background pixels copy `host`.
     Overlay {
         /// The host's rendered colour, read as a float texture.
         host: &'a wgpu::TextureView,
         /// Where the blended image goes (the pass's output format).
         output: &'a wgpu::TextureView,
     },
-    /// Diagnostics for tools and tests into the pass's own textures: the edge distance in
-    /// pixels (red) and reverse-Z depth (green) of [`DeferredPass::diagnostic_texture`], and
-    /// the triangle ids after the exact coverage test, [`DeferredPass::resolved_id_texture`].
+    /// Diagnostics for tools and tests into the pass's own textures (needs
+    /// [`DeferredPass::with_diagnostics`]): the distance in pixels to the line and the
+    /// reverse depth of the visible point, and the (instance slot, triangle) after the exact
+    /// coverage test.
     Diagnostic,
     /// The benchmark floor: reads each pixel's id and writes the fill or background colour
     /// into the output, doing none of the edge work. What a deferred pass cannot go below.
     Floor(&'a wgpu::TextureView),
 }
 
-/// Size-dependent targets, rebuilt only when the size changes.
-struct Targets {
-    size: (u32, u32),
-    ids: wgpu::Texture,
-    depth: wgpu::Texture,
-    /// Present when diagnostics are enabled: (distance + depth map, resolved ids).
-    diagnostic: Option<(wgpu::Texture, wgpu::Texture)>,
-    /// One u32 per pixel: what the outline pass leaves for the edge pass.
-    outline: wgpu::Buffer,
+/// What the edge pass writes, which selects its pipeline.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+enum Mode {
+    Shade,
+    Overlay,
+    Diagnostic,
 }
 
-/// The deferred wireframe pass. Construct once with [`DeferredPass::new`], call
-/// [`prepare`](Self::prepare) when the camera, style or size changes, then
-/// [`encode`](Self::encode) into the host's command encoder each frame.
+/// Settings constant over a frame that specialise the compute pipelines.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+struct Variant {
+    split: bool,
+    outlines: bool,
+    colors: bool,
+}
+
+struct EdgePipelines {
+    main: Compute,
+    refine: Compute,
+}
+
+struct OutlinePipelines {
+    cull: Compute,
+    draw: Compute,
+}
+
+/// A frame ready to encode: its scene data on the GPU and the targets it draws with.
+/// Several frames may be prepared and encoded before one submit; each encodes what its own
+/// [`DeferredPass::prepare`] saw.
+pub struct PreparedFrame {
+    pass: u32,
+    pub(crate) data: FrameData,
+    pub(crate) targets: Targets,
+    cull: wgpu::Buffer,
+}
+
+impl PreparedFrame {
+    /// The output size.
+    pub fn output_size(&self) -> (u32, u32) {
+        self.targets.output
+    }
+
+    /// The id target (`Rg32Uint`: instance slot, triangle; `u32::MAX` in the first channel
+    /// on background), covering the output and its guard band.
+    pub fn id_texture(&self) -> &wgpu::Texture {
+        &self.targets.ids
+    }
+
+    /// The reverse depth target (`Depth32Float`, 1 = near plane), as the ids.
+    pub fn depth_texture(&self) -> &wgpu::Texture {
+        &self.targets.depth
+    }
+
+    /// The (instance slot, triangle) each output pixel centre sees after the exact coverage
+    /// test, written by [`OutputTarget::Diagnostic`].
+    pub fn resolved_id_texture(&self) -> Option<&wgpu::Texture> {
+        self.targets.diagnostic.as_ref().map(|d| &d.1)
+    }
+
+    /// The diagnostic map written by [`OutputTarget::Diagnostic`].
+    pub fn diagnostic_texture(&self) -> Option<&wgpu::Texture> {
+        self.targets.diagnostic.as_ref().map(|d| &d.0)
+    }
+
+    /// For each instance slot of the id maps, the index of the instance in the scene.
+    pub fn instance_order(&self) -> &[u32] {
+        &self.data.order
+    }
+
+    /// Pixels of guard band around the output in the id and depth targets.
+    pub fn guard(&self) -> u32 {
+        self.data.guard
+    }
+}
+
+/// The deferred wireframe pass. Construct once with [`DeferredPass::new`]; each frame,
+/// [`prepare`](Self::prepare) the scene, then [`encode`](Self::encode) it into the host's
+/// command encoder.
 pub struct DeferredPass {
+    id: u32,
     format: wgpu::TextureFormat,
-    pulled: bool,
-    visibility: wgpu::RenderPipeline,
-    visibility_layout: wgpu::BindGroupLayout,
-    mesh_layout: wgpu::BindGroupLayout,
-    shade: (wgpu::ComputePipeline, wgpu::BindGroupLayout),
-    overlay: (wgpu::ComputePipeline, wgpu::BindGroupLayout),
-    diagnostic: (wgpu::ComputePipeline, wgpu::BindGroupLayout),
-    floor: (wgpu::ComputePipeline, wgpu::BindGroupLayout),
-    /// The outline pass.
-    outline: OutlinePipelines,
-    /// Layout of the edge pass's read-only view of the outline buffer.
-    outline_read: wgpu::BindGroupLayout,
-    /// Whether the last prepared style draws outlines (runs the outline pass).
-    silhouettes: bool,
-    frame: wgpu::Buffer,
-    draw: wgpu::Buffer,
+    visibility: Visibility,
+    edge: Mutex<HashMap<(Mode, Variant), Arc<EdgePipelines>>>,
+    outline: Mutex<HashMap<Variant, Arc<OutlinePipelines>>>,
+    floor: Compute,
+    /// Header every list starts a frame with: no work, one workgroup row.
+    reset: wgpu::Buffer,
     diagnostics: bool,
     targets: Option<Targets>,
-}
-
-fn entry(
-    binding: u32,
-    visibility: wgpu::ShaderStages,
-    ty: wgpu::BindingType,
-) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty,
-        count: None,
-    }
-}
-
-fn uniform() -> wgpu::BindingType {
-    wgpu::BindingType::Buffer {
-        ty: wgpu::BufferBindingType::Uniform,
-        has_dynamic_offset: false,
-        min_binding_size: None,
-    }
-}
-
-fn storage() -> wgpu::BindingType {
-    wgpu::BindingType::Buffer {
-        ty: wgpu::BufferBindingType::Storage { read_only: true },
-        has_dynamic_offset: false,
-        min_binding_size: None,
-    }
-}
-
-fn texture(sample_type: wgpu::TextureSampleType) -> wgpu::BindingType {
-    wgpu::BindingType::Texture {
-        sample_type,
-        view_dimension: wgpu::TextureViewDimension::D2,
-        multisampled: false,
-    }
-}
-
-fn storage_texture(format: wgpu::TextureFormat) -> wgpu::BindingType {
-    wgpu::BindingType::StorageTexture {
-        access: wgpu::StorageTextureAccess::WriteOnly,
-        format,
-        view_dimension: wgpu::TextureViewDimension::D2,
-    }
+    cull: Option<wgpu::Buffer>,
 }
 
 impl DeferredPass {
@@ -154,211 +168,47 @@ impl DeferredPass {
     }
 
     fn build(device: &wgpu::Device, options: PassOptions, pulled: bool) -> Result<Self> {
+        static NEXT: AtomicU32 = AtomicU32::new(1);
         let format = options.output_format;
-        let edge_source = shaders::edge_pass(format).ok_or_else(|| {
-            Error::InvalidSetting(format!(
-                "output format {format:?} is not one the edge pass can write (Rgba8Unorm, Rgba16Float, Rgba32Float)"
-            ))
-        })?;
-        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-
-        let vs = wgpu::ShaderStages::VERTEX;
-        let fs = wgpu::ShaderStages::FRAGMENT;
-        let cs = wgpu::ShaderStages::COMPUTE;
-        let mut vis_entries = vec![entry(0, vs, uniform()), entry(1, fs | vs, uniform())];
-        if pulled {
-            vis_entries.extend([2, 3, 4].map(|b| entry(b, vs, storage())));
+        if shaders::storage_format_name(format).is_none() {
+            return Err(Error::InvalidSetting(format!(
+                "output format {format:?} is not one the edge pass can write \
+                 (Rgba8Unorm, Rgba16Float, Rgba32Float)"
+            )));
         }
-        let visibility_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("wirepass visibility"),
-            entries: &vis_entries,
-        });
-        let vis_source = shaders::assemble(if pulled {
-            shaders::VISIBILITY_PULLED
-        } else {
-            shaders::VISIBILITY
-        });
-        let vis_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("wirepass visibility"),
-            source: wgpu::ShaderSource::Wgsl(vis_source.into()),
-        });
-        let vis_pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("wirepass visibility"),
-            bind_group_layouts: &[Some(&visibility_layout)],
-            immediate_size: 0,
-        });
-        let position_layout = wgpu::VertexBufferLayout {
-            array_stride: 12,
-            step_mode: wgpu::VertexStepMode::Vertex,
-            attributes: &wgpu::vertex_attr_array![0 => Float32x3],
-        };
-        let buffers = if pulled {
-            vec![]
-        } else {
-            vec![Some(position_layout)]
-        };
-        let visibility = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("wirepass visibility"),
-            layout: Some(&vis_pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &vis_module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &buffers,
-            },
-            primitive: wgpu::PrimitiveState::default(),
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Greater),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &vis_module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(ID_FORMAT.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
-
-        let mesh_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("wirepass edge pass mesh"),
-            entries: &[
-                entry(0, cs, uniform()),
-                entry(1, cs, storage()),
-                entry(2, cs, storage()),
-                entry(3, cs, storage()),
-                entry(4, cs, storage()),
-                entry(5, cs, texture(wgpu::TextureSampleType::Uint)),
-                entry(6, cs, storage()),
-                entry(7, cs, storage()),
-                entry(8, cs, storage()),
-            ],
-        });
-        let edge_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("wirepass edge pass"),
-            source: wgpu::ShaderSource::Wgsl(edge_source.into()),
-        });
-        let outline_read = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("wirepass outline read"),
-            entries: &[entry(0, cs, storage())],
-        });
-        let pipeline = |name: &str, groups: &[Option<&wgpu::BindGroupLayout>]| {
-            let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some(name),
-                bind_group_layouts: groups,
-                immediate_size: 0,
-            });
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(name),
-                layout: Some(&layout),
-                module: &edge_module,
-                entry_point: Some(name),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
-        let compute = |name: &str, entries: &[wgpu::BindGroupLayoutEntry]| {
-            let out_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some(name),
-                entries,
-            });
-            let groups = [Some(&mesh_layout), Some(&out_layout), Some(&outline_read)];
-            (pipeline(name, &groups), out_layout)
-        };
-        let shade = compute("shade_main", &[entry(0, cs, storage_texture(format))]);
-        let overlay = compute(
-            "overlay_main",
-            &[
-                entry(1, cs, storage_texture(format)),
-                entry(
-                    2,
-                    cs,
-                    texture(wgpu::TextureSampleType::Float { filterable: false }),
-                ),
-            ],
-        );
-        let diagnostic = compute(
-            "diagnostic_main",
-            &[
-                entry(3, cs, storage_texture(DIAGNOSTIC_FORMAT)),
-                entry(4, cs, storage_texture(RESOLVED_ID_FORMAT)),
-            ],
-        );
-        let floor = compute("floor_main", &[entry(5, cs, storage_texture(format))]);
-        let read_write = wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only: false },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        };
-        let layout = |label, entries: &[wgpu::BindGroupLayoutEntry]| {
-            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some(label),
-                entries,
-            })
-        };
-        let cull_layout = layout(
-            "wirepass outline cull",
-            &[
-                entry(7, cs, storage()),
-                entry(8, cs, read_write),
-                entry(9, cs, read_write),
-            ],
-        );
-        let draw_layout = layout(
-            "wirepass outline draw",
-            &[
-                entry(6, cs, read_write),
-                entry(8, cs, read_write),
-                entry(10, cs, storage()),
-            ],
-        );
-        let outline = OutlinePipelines {
-            cull: pipeline("outline_cull", &[Some(&mesh_layout), Some(&cull_layout)]),
-            draw: pipeline("outline_main", &[Some(&mesh_layout), Some(&draw_layout)]),
-            cull_layout,
-            draw_layout,
-        };
-
-        let frame = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("wirepass frame"),
-            size: std::mem::size_of::<FrameUniforms>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let draw = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("wirepass draw"),
-            contents: bytemuck::bytes_of(&[0u32; 4]),
-            usage: wgpu::BufferUsages::UNIFORM,
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let visibility = Visibility::new(device, pulled)?;
+        let floor_module = edge_module(device, format, &["MODE_FLOOR"]);
+        let floor = Compute::new(
+            device,
+            &floor_module,
+            "floor_main",
+            vec![Res::Frame, Res::Ids, Res::OutColor],
+            format,
+        )?;
+        let reset = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("wirepass list reset"),
+            contents: bytemuck::cast_slice(&[0u32, 1, 1, 0]),
+            usage: wgpu::BufferUsages::COPY_SRC,
         });
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(Error::Device(format!("creating the deferred pass: {e}")));
         }
         Ok(Self {
+            id: NEXT.fetch_add(1, Ordering::Relaxed),
             format,
-            pulled,
             visibility,
-            visibility_layout,
-            mesh_layout,
-            shade,
-            overlay,
-            diagnostic,
+            edge: Mutex::default(),
+            outline: Mutex::default(),
             floor,
-            outline,
-            outline_read,
-            silhouettes: false,
-            frame,
-            draw,
+            reset,
             diagnostics: false,
             targets: None,
+            cull: None,
         })
     }
 
-    /// Enables [`OutputTarget::Diagnostic`], which needs 20 more bytes of targets per pixel;
+    /// Enables [`OutputTarget::Diagnostic`], which needs 24 more bytes of targets per pixel;
     /// tools and tests use it, a renderer does not need it.
     pub fn with_diagnostics(mut self) -> Self {
         self.diagnostics = true;
@@ -366,474 +216,472 @@ impl DeferredPass {
         self
     }
 
-    /// GPU memory of the size-dependent targets, in bytes (0 before the first prepare).
-    pub fn target_bytes(&self) -> u64 {
-        let Some(t) = &self.targets else { return 0 };
-        let mut textures = vec![&t.ids, &t.depth];
-        if let Some((d, r)) = &t.diagnostic {
-            textures.extend([d, r]);
-        }
-        let texels: u64 = textures
-            .iter()
-            .map(|x| {
-                let texel = x.format().block_copy_size(None).unwrap_or(4);
-                u64::from(x.width()) * u64::from(x.height()) * u64::from(texel)
-            })
-            .sum();
-        texels + t.outline.size()
-    }
-
-    /// True when the visibility pass pulls vertices because the device lacks
-    /// `PRIMITIVE_INDEX`.
-    pub fn uses_vertex_pulling(&self) -> bool {
-        self.pulled
-    }
-
-    /// The output format chosen at construction.
+    /// The format [`OutputTarget::Shaded`] and [`OutputTarget::Overlay`] write.
     pub fn output_format(&self) -> wgpu::TextureFormat {
         self.format
     }
 
-    /// Validates the camera, style and size, uploads the frame's uniforms, and (re)builds the
-    /// id, depth and diagnostic targets when the size changed.
+    /// GPU memory of the size-dependent targets, in bytes (0 before the first prepare).
+    pub fn target_bytes(&self) -> u64 {
+        self.targets.as_ref().map_or(0, Targets::bytes)
+    }
+
+    /// Prepares `scene` for an image of `size` pixels: checks it, writes its uniforms and
+    /// instance records, and makes the targets (rebuilt only when the size changes).
     pub fn prepare(
         &mut self,
         device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        mesh: &GpuMesh,
-        camera: &Camera,
+        store: &MeshStore,
+        scene: &Scene<'_>,
         style: &Style,
         size: (u32, u32),
-    ) -> Result<()> {
-        let view = (camera, style, size);
-        FrameUniforms::validate_and_write(device, queue, &self.frame, mesh, view)?;
-        self.silhouettes = style.silhouettes;
-        if self.targets.as_ref().map(|t| t.size) != Some(size) {
-            let outline_bytes = u64::from(size.0) * u64::from(size.1) * 4;
+    ) -> Result<PreparedFrame> {
+        self.prepare_window(device, store, scene, style, Window::whole(size))
+    }
+
+    /// [`prepare`](Self::prepare) for a window of a larger image (a tile): the frame draws
+    /// exactly the pixels the whole image has there.
+    pub fn prepare_window(
+        &mut self,
+        device: &wgpu::Device,
+        store: &MeshStore,
+        scene: &Scene<'_>,
+        style: &Style,
+        window: Window,
+    ) -> Result<PreparedFrame> {
+        let data = FrameData::new(device, store, scene, style, window, 0)?;
+        let spec = TargetSpec {
+            size: data.target_size(),
+            output: window.size,
+            acc_colors: data.mixed_colors,
+            result: false,
+            diagnostic: self.diagnostics,
+        };
+        if self.targets.as_ref().map(Targets::spec) != Some(spec) {
+            self.targets = Some(Targets::new(device, spec)?);
+        }
+        let cull_bytes = LIST_HEADER + 8 * u64::from(data.uniforms_clusters().max(1));
+        if self.cull.as_ref().map_or(0, wgpu::Buffer::size) < cull_bytes {
             let limit = device.limits().max_storage_buffer_binding_size;
-            if outline_bytes > limit {
+            if cull_bytes > limit {
                 return Err(Error::OverLimit {
-                    what: format!(
-                        "the size in bytes of the outline buffer of a {}x{} image",
-                        size.0, size.1
-                    ),
-                    value: outline_bytes,
+                    what: "the outline pass's cluster list for this scene, in bytes".into(),
+                    value: cull_bytes,
                     limit_name: "max_storage_buffer_binding_size",
                     limit,
                 });
             }
-            let make = |label, format, usage| texture_2d(device, label, size, format, usage);
-            use wgpu::TextureUsages as U;
-            self.targets = Some(Targets {
-                size,
-                ids: make(
-                    "wirepass ids",
-                    ID_FORMAT,
-                    U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC,
-                ),
-                depth: make("wirepass depth", DEPTH_FORMAT, U::RENDER_ATTACHMENT),
-                diagnostic: self.diagnostics.then(|| {
-                    (
-                        make(
-                            "wirepass diagnostic",
-                            DIAGNOSTIC_FORMAT,
-                            U::STORAGE_BINDING | U::COPY_SRC,
-                        ),
-                        make(
-                            "wirepass resolved ids",
-                            RESOLVED_ID_FORMAT,
-                            U::STORAGE_BINDING | U::COPY_SRC,
-                        ),
-                    )
-                }),
-                outline: device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some("wirepass outline"),
-                    size: u64::from(size.0) * u64::from(size.1) * 4,
-                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-                    mapped_at_creation: false,
-                }),
-            });
+            self.cull = Some(device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("wirepass cluster list"),
+                size: cull_bytes.next_power_of_two().min(limit),
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::INDIRECT
+                    | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }));
         }
-        Ok(())
+        let split = data.split();
+        self.visibility.prepare(device, split)?;
+        let targets = self
+            .targets
+            .clone()
+            .ok_or_else(|| Error::Device("no targets".into()))?;
+        let cull = self
+            .cull
+            .clone()
+            .ok_or_else(|| Error::Device("no cluster list".into()))?;
+        Ok(PreparedFrame {
+            pass: self.id,
+            data,
+            targets,
+            cull,
+        })
     }
 
-    fn targets(&self) -> Result<&Targets> {
-        self.targets
-            .as_ref()
-            .ok_or_else(|| Error::InvalidSetting("encode called before prepare".into()))
+    fn variant(&self, frame: &PreparedFrame) -> Variant {
+        Variant {
+            split: frame.data.split(),
+            outlines: frame.data.outlines,
+            colors: frame.data.outlines && frame.data.mixed_colors,
+        }
     }
 
-    /// The size the pass was last prepared for.
-    pub fn size(&self) -> Option<(u32, u32)> {
-        self.targets.as_ref().map(|t| t.size)
+    fn edge_pipelines(
+        &self,
+        device: &wgpu::Device,
+        mode: Mode,
+        v: Variant,
+    ) -> Result<Arc<EdgePipelines>> {
+        let mut cache = self
+            .edge
+            .lock()
+            .map_err(|_| Error::Device("pipeline cache poisoned".into()))?;
+        if let Some(p) = cache.get(&(mode, v)) {
+            return Ok(p.clone());
+        }
+        let mut flags = variant_flags(v);
+        let (out, color) = match mode {
+            Mode::Shade => {
+                flags.push("MODE_SHADE");
+                (vec![Res::OutColor], self.format)
+            }
+            Mode::Overlay => {
+                flags.push("MODE_OVERLAY");
+                (vec![Res::OutColor, Res::HostColor], self.format)
+            }
+            Mode::Diagnostic => {
+                flags.push("MODE_DIAGNOSTIC");
+                (vec![Res::OutDiagnostic, Res::OutIds], self.format)
+            }
+        };
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let module = edge_module(device, self.format, &flags);
+        let mut common = store_resources(v.split, false);
+        common.push(Res::Ids);
+        if v.outlines {
+            common.push(Res::Acc);
+        }
+        let with = |extra: &[Res]| {
+            let mut r = common.clone();
+            r.extend_from_slice(extra);
+            r.extend_from_slice(&out);
+            r
+        };
+        let main = Compute::new(device, &module, "edge_main", with(&[Res::WorkRw]), color)?;
+        let mut refine_res = with(&[Res::Work, Res::Neighbours]);
+        if v.split {
+            refine_res.push(Res::NeighboursHi);
+        }
+        let refine = Compute::new(device, &module, "refine_main", refine_res, color)?;
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(Error::Device(format!("building the edge pass: {e}")));
+        }
+        let p = Arc::new(EdgePipelines { main, refine });
+        cache.insert((mode, v), p.clone());
+        Ok(p)
     }
 
-    /// The triangle-id target (`R32Uint`, `u32::MAX` = background) of the last frame.
-    pub fn id_texture(&self) -> Option<&wgpu::Texture> {
-        self.targets.as_ref().map(|t| &t.ids)
+    fn outline_pipelines(
+        &self,
+        device: &wgpu::Device,
+        v: Variant,
+    ) -> Result<Arc<OutlinePipelines>> {
+        let mut cache = self
+            .outline
+            .lock()
+            .map_err(|_| Error::Device("pipeline cache poisoned".into()))?;
+        if let Some(p) = cache.get(&v) {
+            return Ok(p.clone());
+        }
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let source = shaders::outline_source(&variant_flags(v));
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("wirepass outline pass"),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
+        });
+        let cull = Compute::new(
+            device,
+            &module,
+            "outline_cull",
+            vec![Res::Frame, Res::Instances, Res::Clusters, Res::CullRw],
+            self.format,
+        )?;
+        let mut draw_res = store_resources(v.split, true);
+        draw_res.extend([Res::Ids, Res::Cull, Res::AccRw]);
+        let draw = Compute::new(device, &module, "outline_main", draw_res, self.format)?;
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(Error::Device(format!("building the outline pass: {e}")));
+        }
+        let p = Arc::new(OutlinePipelines { cull, draw });
+        cache.insert(v, p.clone());
+        Ok(p)
     }
 
-    /// The reverse-Z depth target (`Depth32Float`, 1 = near plane) of the last frame.
-    pub fn depth_texture(&self) -> Option<&wgpu::Texture> {
-        self.targets.as_ref().map(|t| &t.depth)
-    }
-
-    /// The triangle each pixel centre sees, after the edge pass's exact coverage test
-    /// (see `resolve` in `edge_pass.wgsl`), written by [`OutputTarget::Diagnostic`]; `None`
-    /// unless diagnostics are enabled.
-    pub fn resolved_id_texture(&self) -> Option<&wgpu::Texture> {
-        Some(&self.targets.as_ref()?.diagnostic.as_ref()?.1)
-    }
-
-    /// The diagnostic map written by [`OutputTarget::Diagnostic`]; `None` unless
-    /// diagnostics are enabled.
-    pub fn diagnostic_texture(&self) -> Option<&wgpu::Texture> {
-        Some(&self.targets.as_ref()?.diagnostic.as_ref()?.0)
-    }
-
-    /// Records the visibility pass and the edge pass into `encoder`.
+    /// Records the visibility pass, the outline pass (where an instance draws its outline)
+    /// and the edge pass into `encoder`. `store` must be the store the frame was prepared
+    /// with, unchanged but for inserted meshes.
     pub fn encode(
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
-        mesh: &GpuMesh,
+        store: &MeshStore,
+        frame: &PreparedFrame,
         target: OutputTarget<'_>,
     ) -> Result<()> {
-        self.visibility(device, encoder, mesh, None)?;
-        self.edges(device, encoder, mesh, target, None)
+        self.encode_inner(device, encoder, store, frame, target, None, true)
     }
 
-    /// [`encode`](Self::encode) with GPU timestamps around each pass, named `"visibility"`,
-    /// `"outline"` (when the style draws outlines) and `"edge"` in `timer`.
+    /// [`encode`](Self::encode) with GPU timestamps around each pass, named
+    /// `"visibility"`, `"outline.cull"` and `"outline.draw"` (when outlines are drawn), and
+    /// `"edge.main"` and `"edge.refine"`, in `timer`.
     pub fn encode_timed(
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
-        mesh: &GpuMesh,
+        store: &MeshStore,
+        frame: &PreparedFrame,
         target: OutputTarget<'_>,
         timer: &mut GpuTimer,
     ) -> Result<()> {
-        self.visibility(device, encoder, mesh, Some(&mut *timer))?;
-        self.edges(device, encoder, mesh, target, Some(timer))
+        self.encode_inner(device, encoder, store, frame, target, Some(timer), true)
     }
 
-    /// Records only the visibility pass (triangle ids and depth).
-    pub fn encode_visibility(
-        &self,
-        device: &wgpu::Device,
-        encoder: &mut wgpu::CommandEncoder,
-        mesh: &GpuMesh,
-    ) -> Result<()> {
-        self.visibility(device, encoder, mesh, None)
-    }
-
-    fn visibility(
-        &self,
-        device: &wgpu::Device,
-        encoder: &mut wgpu::CommandEncoder,
-        mesh: &GpuMesh,
-        timer: Option<&mut GpuTimer>,
-    ) -> Result<()> {
-        let targets = self.targets()?;
-        let ids = targets.ids.create_view(&Default::default());
-        let depth = targets.depth.create_view(&Default::default());
-        let mut entries = vec![
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: self.frame.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: self.draw.as_entire_binding(),
-            },
-        ];
-        if self.pulled {
-            let [indices, indices_hi] = mesh.halves(&mesh.indices);
-            let pulled = [mesh.positions.as_entire_binding(), indices, indices_hi];
-            entries.extend(
-                pulled
-                    .into_iter()
-                    .zip(2..)
-                    .map(|(resource, binding)| wgpu::BindGroupEntry { binding, resource }),
-            );
-        }
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("wirepass visibility"),
-            layout: &self.visibility_layout,
-            entries: &entries,
-        });
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("wirepass visibility"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &ids,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color {
-                        r: f64::from(u32::MAX),
-                        g: 0.0,
-                        b: 0.0,
-                        a: 0.0,
-                    }),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &depth,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(0.0),
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: timer.and_then(|t| t.render_span("visibility")),
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.set_pipeline(&self.visibility);
-        pass.set_bind_group(0, &group, &[]);
-        if self.pulled {
-            pass.draw(0..3 * mesh.triangles, 0..1);
-        } else {
-            pass.set_vertex_buffer(0, mesh.positions.slice(..));
-            pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
-            pass.draw_indexed(0..3 * mesh.triangles, 0, 0..1);
-        }
-        Ok(())
-    }
-
-    /// Records only the edge pass (and the outline pass before it, when the style draws
-    /// outlines); the visibility pass of this frame must precede it.
+    /// Records the outline and edge passes only, over the ids the last encode of this frame
+    /// rasterized: e.g. a second output of the same frame.
     pub fn encode_edges(
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
-        mesh: &GpuMesh,
+        store: &MeshStore,
+        frame: &PreparedFrame,
         target: OutputTarget<'_>,
     ) -> Result<()> {
-        self.edges(device, encoder, mesh, target, None)
+        self.encode_inner(device, encoder, store, frame, target, None, false)
     }
 
-    fn edges(
+    #[allow(clippy::too_many_arguments)]
+    fn encode_inner(
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
-        mesh: &GpuMesh,
+        store: &MeshStore,
+        frame: &PreparedFrame,
         target: OutputTarget<'_>,
-        timer: Option<&mut GpuTimer>,
+        mut timer: Option<&mut GpuTimer>,
+        visibility: bool,
     ) -> Result<()> {
-        let targets = self.targets()?;
-        let ids = targets.ids.create_view(&Default::default());
-        let [indices, indices_hi] = mesh.halves(&mesh.indices);
-        let [neighbours, neighbours_hi] = mesh.halves(&mesh.neighbours);
-        let resources = [
-            self.frame.as_entire_binding(),
-            mesh.positions.as_entire_binding(),
-            mesh.normals.as_entire_binding(),
-            indices,
-            mesh.edge_masks.as_entire_binding(),
-            wgpu::BindingResource::TextureView(&ids),
-            neighbours,
-            indices_hi,
-            neighbours_hi,
-        ];
-        let mesh_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("wirepass edge pass mesh"),
-            layout: &self.mesh_layout,
-            entries: &resources
-                .into_iter()
-                .zip(0..)
-                .map(|(resource, binding)| wgpu::BindGroupEntry { binding, resource })
-                .collect::<Vec<_>>(),
-        });
-        let check = |view: &wgpu::TextureView, what: &str| -> Result<()> {
-            let t = view.texture();
-            if (t.width(), t.height()) != targets.size {
-                return Err(Error::InvalidSetting(format!(
-                    "{what} is {}x{}, but the pass was prepared for {}x{}",
-                    t.width(),
-                    t.height(),
-                    targets.size.0,
-                    targets.size.1
-                )));
-            }
-            Ok(())
-        };
-        let (diagnostic_view, resolved_view);
-        let floor = matches!(target, OutputTarget::Floor(_));
-        let (pipeline, layout, entries) = match target {
-            OutputTarget::Shaded(out) => {
-                check(out, "the output texture")?;
-                (
-                    &self.shade.0,
-                    &self.shade.1,
-                    vec![wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: wgpu::BindingResource::TextureView(out),
-                    }],
-                )
+        if frame.pass != self.id {
+            return Err(Error::Misuse(
+                "the frame was prepared by another DeferredPass".into(),
+            ));
+        }
+        frame.data.check_store(store)?;
+        let t = &frame.targets;
+        let (mode, out_color, host_color) = match &target {
+            OutputTarget::Shaded(v) => {
+                check_storage_output(v, self.format, t.output, "the output texture")?;
+                (Some(Mode::Shade), Some(*v), None)
             }
             OutputTarget::Overlay { host, output } => {
-                check(output, "the output texture")?;
-                check(host, "the host colour texture")?;
-                (
-                    &self.overlay.0,
-                    &self.overlay.1,
-                    vec![
-                        wgpu::BindGroupEntry {
-                            binding: 1,
-                            resource: wgpu::BindingResource::TextureView(output),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 2,
-                            resource: wgpu::BindingResource::TextureView(host),
-                        },
-                    ],
-                )
+                check_storage_output(output, self.format, t.output, "the output texture")?;
+                check_sampled(host, t.output, "the host colour texture")?;
+                (Some(Mode::Overlay), Some(*output), Some(*host))
             }
-            OutputTarget::Floor(out) => {
-                check(out, "the output texture")?;
-                (
-                    &self.floor.0,
-                    &self.floor.1,
-                    vec![wgpu::BindGroupEntry {
-                        binding: 5,
-                        resource: wgpu::BindingResource::TextureView(out),
-                    }],
-                )
+            OutputTarget::Floor(v) => {
+                check_storage_output(v, self.format, t.output, "the output texture")?;
+                (None, Some(*v), None)
             }
             OutputTarget::Diagnostic => {
-                let (diagnostic, resolved) = targets.diagnostic.as_ref().ok_or_else(|| {
-                    Error::InvalidSetting(
+                if t.diagnostic.is_none() {
+                    return Err(Error::Misuse(
                         "diagnostics were not enabled (DeferredPass::with_diagnostics)".into(),
-                    )
-                })?;
-                diagnostic_view = diagnostic.create_view(&Default::default());
-                resolved_view = resolved.create_view(&Default::default());
-                (
-                    &self.diagnostic.0,
-                    &self.diagnostic.1,
-                    vec![
-                        wgpu::BindGroupEntry {
-                            binding: 3,
-                            resource: wgpu::BindingResource::TextureView(&diagnostic_view),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 4,
-                            resource: wgpu::BindingResource::TextureView(&resolved_view),
-                        },
-                    ],
-                )
+                    ));
+                }
+                (Some(Mode::Diagnostic), None, None)
             }
         };
-        let out_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("wirepass edge pass output"),
-            layout,
-            entries: &entries,
-        });
-        let mut timer = timer;
-        if self.silhouettes && !floor {
-            encoder.clear_buffer(&targets.outline, 0, None);
-            self.outline_pass(device, encoder, mesh, &mesh_group, timer.as_deref_mut())?;
+        if visibility {
+            self.visibility
+                .encode(device, encoder, &frame.data, t, timer.as_deref_mut())?;
         }
-        let outline_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("wirepass outline read"),
-            layout: &self.outline_read,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: targets.outline.as_entire_binding(),
-            }],
-        });
+        let ids = t.ids.create_view(&Default::default());
+        let (diag, resolved) = match &t.diagnostic {
+            Some((d, r)) => (
+                Some(d.create_view(&Default::default())),
+                Some(r.create_view(&Default::default())),
+            ),
+            None => (None, None),
+        };
+        let sources = Sources {
+            ids: Some(&ids),
+            acc: Some(&t.acc),
+            cull: Some(&frame.cull),
+            work: Some(&t.work),
+            out_color,
+            host_color,
+            out_diagnostic: diag.as_ref(),
+            out_ids: resolved.as_ref(),
+            ..Sources::frame(&frame.data)
+        };
+        let (w, h) = t.output;
+        let Some(mode) = mode else {
+            let group = self.floor.bind(device, &sources)?;
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("wirepass floor"),
+                timestamp_writes: timer.and_then(|t| t.compute_span("edge.main")),
+            });
+            pass.set_pipeline(&self.floor.pipeline);
+            pass.set_bind_group(0, &group, &[]);
+            pass.dispatch_workgroups(w.div_ceil(TILE), h.div_ceil(TILE), 1);
+            return Ok(());
+        };
+        let variant = self.variant(frame);
+        if variant.outlines {
+            self.outline_pass(
+                device,
+                encoder,
+                frame,
+                &sources,
+                variant,
+                timer.as_deref_mut(),
+            )?;
+        }
+        let edge = self.edge_pipelines(device, mode, variant)?;
+        let main = edge.main.bind(device, &sources)?;
+        let refine = edge.refine.bind(device, &sources)?;
+        encoder.copy_buffer_to_buffer(&self.reset, 0, &t.work, 0, LIST_HEADER);
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("wirepass edge pass"),
+                timestamp_writes: timer
+                    .as_deref_mut()
+                    .and_then(|t| t.compute_span("edge.main")),
+            });
+            pass.set_pipeline(&edge.main.pipeline);
+            pass.set_bind_group(0, &main, &[]);
+            pass.dispatch_workgroups(w.div_ceil(TILE), h.div_ceil(TILE), 1);
+        }
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("wirepass edge pass"),
-            timestamp_writes: timer.and_then(|t| t.compute_span("edge")),
+            label: Some("wirepass edge refine"),
+            timestamp_writes: timer.and_then(|t| t.compute_span("edge.refine")),
         });
-        pass.set_pipeline(pipeline);
-        pass.set_bind_group(0, &mesh_group, &[]);
-        pass.set_bind_group(1, &out_group, &[]);
-        pass.set_bind_group(2, &outline_group, &[]);
-        pass.dispatch_workgroups(
-            targets.size.0.div_ceil(TILE),
-            targets.size.1.div_ceil(TILE),
-            1,
-        );
+        pass.set_pipeline(&edge.refine.pipeline);
+        pass.set_bind_group(0, &refine, &[]);
+        pass.dispatch_workgroups_indirect(&t.work, 0);
         Ok(())
     }
 
-    /// The outline pass (outline.wgsl): `outline_cull` lists the clusters of triangles that
-    /// may hold an outline edge, one invocation per cluster on a 2D grid of workgroups (huge
-    /// meshes need more than one dimension allows); `outline_main` then visits their
-    /// triangles, dispatched indirectly with the size the cull leaves.
+    /// The outline pass: `outline_cull` lists the (instance, cluster) pairs that may hold
+    /// an outline edge, on a 2D grid of workgroups (huge scenes need more than one dimension
+    /// allows); `outline_main` then visits their triangles, dispatched indirectly with the
+    /// size the cull leaves.
     fn outline_pass(
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
-        mesh: &GpuMesh,
-        mesh_group: &wgpu::BindGroup,
-        timer: Option<&mut GpuTimer>,
+        frame: &PreparedFrame,
+        sources: &Sources<'_>,
+        variant: Variant,
+        mut timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
-        let targets = self.targets()?;
-        let group = |label, layout, entries: &[(u32, &wgpu::Buffer)]| {
-            let entries: Vec<_> = entries
-                .iter()
-                .map(|&(binding, buffer)| wgpu::BindGroupEntry {
-                    binding,
-                    resource: buffer.as_entire_binding(),
-                })
-                .collect();
-            device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some(label),
-                layout,
-                entries: &entries,
-            })
-        };
-        let cull_group = group(
-            "wirepass outline cull",
-            &self.outline.cull_layout,
-            &[
-                (7, &mesh.clusters),
-                (8, &mesh.outline_list),
-                (9, &mesh.outline_args),
-            ],
-        );
-        let draw_group = group(
-            "wirepass outline draw",
-            &self.outline.draw_layout,
-            &[
-                (6, &targets.outline),
-                (8, &mesh.outline_list),
-                (10, &mesh.cluster_triangles),
-            ],
-        );
-        encoder.clear_buffer(&mesh.outline_args, 0, None);
-        encoder.clear_buffer(&mesh.outline_list, 0, Some(4));
-        let groups = mesh
-            .triangles
-            .div_ceil(OUTLINE_GROUP)
-            .div_ceil(OUTLINE_GROUP);
+        let p = self.outline_pipelines(device, variant)?;
+        let cull = p.cull.bind(device, sources)?;
+        let draw = p.draw.bind(device, sources)?;
+        encoder.clear_buffer(&frame.targets.acc, 0, None);
+        encoder.copy_buffer_to_buffer(&self.reset, 0, &frame.cull, 0, LIST_HEADER);
+        let groups = frame.data.uniforms_clusters().div_ceil(GROUP);
         let max = device.limits().max_compute_workgroups_per_dimension.max(1);
-        let (x, y) = (groups.min(max), groups.div_ceil(max));
+        let (x, y) = (groups.clamp(1, max), groups.div_ceil(max).max(1));
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("wirepass outline cull"),
+                timestamp_writes: timer
+                    .as_deref_mut()
+                    .and_then(|t| t.compute_span("outline.cull")),
+            });
+            pass.set_pipeline(&p.cull.pipeline);
+            pass.set_bind_group(0, &cull, &[]);
+            pass.dispatch_workgroups(x, y, 1);
+        }
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("wirepass outline pass"),
-            timestamp_writes: timer.and_then(|t| t.compute_span("outline")),
+            timestamp_writes: timer.and_then(|t| t.compute_span("outline.draw")),
         });
-        pass.set_bind_group(0, mesh_group, &[]);
-        pass.set_bind_group(1, &cull_group, &[]);
-        pass.set_pipeline(&self.outline.cull);
-        pass.dispatch_workgroups(x, y, 1);
-        pass.set_bind_group(1, &draw_group, &[]);
-        pass.set_pipeline(&self.outline.draw);
-        pass.dispatch_workgroups_indirect(&mesh.outline_args, 0);
+        pass.set_pipeline(&p.draw.pipeline);
+        pass.set_bind_group(0, &draw, &[]);
+        pass.dispatch_workgroups_indirect(&frame.cull, 0);
         Ok(())
     }
 }
 
-/// The two entry points of the outline pass and the layouts of their own bindings: the
-/// mesh's cluster bounds, list and dispatch size for the cull; the pixel accumulator, the
-/// list and the clusters' triangles for the draw.
-struct OutlinePipelines {
-    cull: wgpu::ComputePipeline,
-    draw: wgpu::ComputePipeline,
-    cull_layout: wgpu::BindGroupLayout,
-    draw_layout: wgpu::BindGroupLayout,
+fn variant_flags(v: Variant) -> Vec<&'static str> {
+    let mut flags = Vec::new();
+    if v.split {
+        flags.push("SPLIT");
+    }
+    if v.outlines {
+        flags.push("OUTLINES");
+    }
+    if v.colors {
+        flags.push("COLORS");
+    }
+    flags
+}
+
+fn edge_module(
+    device: &wgpu::Device,
+    format: wgpu::TextureFormat,
+    flags: &[&str],
+) -> wgpu::ShaderModule {
+    device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("wirepass edge pass"),
+        source: wgpu::ShaderSource::Wgsl(shaders::edge_source(format, flags).into()),
+    })
+}
+
+/// Checks a storage texture the pass writes: format, size, usage, one sample, 2D.
+pub(crate) fn check_storage_output(
+    view: &wgpu::TextureView,
+    format: wgpu::TextureFormat,
+    size: (u32, u32),
+    what: &str,
+) -> Result<()> {
+    let t = view.texture();
+    if t.format() != format {
+        return Err(Error::Misuse(format!(
+            "{what} is {:?}, but the pass was built for {format:?}",
+            t.format()
+        )));
+    }
+    check_texture(t, size, wgpu::TextureUsages::STORAGE_BINDING, what)
+}
+
+/// Checks a texture the pass samples: size, usage, one sample, 2D, a float format.
+pub(crate) fn check_sampled(view: &wgpu::TextureView, size: (u32, u32), what: &str) -> Result<()> {
+    let t = view.texture();
+    let float = matches!(
+        t.format().sample_type(None, None),
+        Some(wgpu::TextureSampleType::Float { .. })
+    );
+    if !float {
+        return Err(Error::Misuse(format!(
+            "{what} is {:?}, which is not a colour format read as float",
+            t.format()
+        )));
+    }
+    check_texture(t, size, wgpu::TextureUsages::TEXTURE_BINDING, what)
+}
+
+fn check_texture(
+    t: &wgpu::Texture,
+    size: (u32, u32),
+    usage: wgpu::TextureUsages,
+    what: &str,
+) -> Result<()> {
+    if (t.width(), t.height()) != size {
+        return Err(Error::Misuse(format!(
+            "{what} is {}x{}, but the frame was prepared for {}x{}",
+            t.width(),
+            t.height(),
+            size.0,
+            size.1
+        )));
+    }
+    if !t.usage().contains(usage) {
+        return Err(Error::Misuse(format!(
+            "{what} lacks the usage {usage:?} (it has {:?})",
+            t.usage()
+        )));
+    }
+    if t.sample_count() != 1 {
+        return Err(Error::Misuse(format!(
+            "{what} has {} samples; the pass writes single-sampled textures (draw into a \
+             multisampled target with the render-pass entry instead)",
+            t.sample_count()
+        )));
+    }
+    if t.dimension() != wgpu::TextureDimension::D2 || t.depth_or_array_layers() != 1 {
+        return Err(Error::Misuse(format!("{what} is not a single 2D texture")));
+    }
+    Ok(())
 }

@@ -1,93 +1,484 @@
-//! The `Frame` uniform block of `common.wgsl`.
+//! What every pass reads each frame: the `Frame` uniforms and the `Instance` records of
+//! `common.wgsl`, built in f64 from the scene, the style and the size, and the list of
+//! instanced draws. One place for all passes, so deferred, forward and two-pass draw the
+//! same scene the same way.
 
-use crate::camera::Camera;
+use super::mesh_store::{MeshRecord, MeshStore, StoreBuffers};
+use crate::camera::View;
+use crate::error::{Error, Result};
+use crate::scene::Scene;
 use crate::style::Style;
-use glam::{DMat4, DVec3, Mat4, Vec4};
+use glam::{DMat3, DMat4, DVec3, DVec4, Mat4, Vec4};
+use wgpu::util::DeviceExt;
 
 /// Mirror of WGSL `struct Frame`; field order and padding match it.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct FrameUniforms {
-    view_proj: [[f32; 4]; 4],
-    depth_row: [f32; 4],
-    eye: [f32; 4],
+    image_size: [f32; 2],
+    target_origin: [f32; 2],
+    target_size: [f32; 2],
+    output_offset: [f32; 2],
+    output_size: [f32; 2],
+    fade: [f32; 2],
+    crop: [f32; 4],
     light_dir: [f32; 4],
-    wire_color: [f32; 4],
     fill_color: [f32; 4],
     background: [f32; 4],
-    size: [f32; 2],
-    line_width: f32,
     ambient: f32,
-    fade: [f32; 2],
-    index_split: u32,
-    silhouettes: u32,
-    triangles: u32,
-    _pad: [u32; 3],
+    instances: u32,
+    vertex_split: u32,
+    triangle_split: u32,
+    clusters: u32,
+    host_depth: u32,
+    _pad: [u32; 2],
 }
 
-impl FrameUniforms {
-    /// Checks the size against `device`, the camera and the style, then writes the frame's
-    /// uniforms for `mesh` into `buffer`: the shared first step of every pass's `prepare`.
-    pub(crate) fn validate_and_write(
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        buffer: &wgpu::Buffer,
-        mesh: &super::GpuMesh,
-        (camera, style, size): (&Camera, &Style, (u32, u32)),
-    ) -> crate::Result<()> {
-        super::check_size(device, size)?;
-        camera.validate()?;
-        style.validate()?;
-        let uniforms = Self {
-            index_split: mesh.split,
-            triangles: mesh.triangles,
-            ..Self::new(camera, style, size, mesh.origin())
-        };
-        queue.write_buffer(buffer, 0, bytemuck::bytes_of(&uniforms));
-        Ok(())
+/// Mirror of WGSL `struct Instance`; field order and padding match it.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct InstanceRecord {
+    clip: [[f32; 4]; 4],
+    depth_row: [f32; 4],
+    eye: [f32; 4],
+    fade_row: [f32; 4],
+    normal: [[f32; 4]; 3],
+    wire_color: [f32; 4],
+    line_width: f32,
+    flags: u32,
+    vertex_base: u32,
+    triangle_base: u32,
+    triangles: u32,
+    cluster_base: u32,
+    cluster_first: u32,
+    index: u32,
+}
+
+/// `Instance.flags`: the instance's edges are drawn.
+const INSTANCE_EDGES: u32 = 1;
+/// `Instance.flags`: the instance's outline is drawn.
+const INSTANCE_OUTLINES: u32 = 2;
+
+/// Most instances a frame may hold; instance slots must fit the outline keys' 20 bits.
+pub const MAX_INSTANCES: u32 = 1 << 20;
+
+/// Byte offset of `InstanceRecord::index`, read as an instance-rate vertex attribute.
+pub(crate) const INSTANCE_INDEX_OFFSET: u64 = 204;
+/// Byte offsets of `vertex_base` and `triangle_base`.
+pub(crate) const INSTANCE_BASES_OFFSET: u64 = 184;
+
+impl InstanceRecord {
+    /// The f32 mesh-local → clip matrix the GPU uses (rows x, y, near, w).
+    pub fn clip(&self) -> Mat4 {
+        Mat4::from_cols_array_2d(&self.clip)
     }
 
-    /// Uniforms for one frame. `origin` is the mesh-local origin its positions were rebased to
-    /// (see [`crate::gpu::GpuMesh`]): the translation is folded into the matrix in f64, so
-    /// meshes far from the world origin keep their precision.
-    pub fn new(camera: &Camera, style: &Style, size: (u32, u32), origin: DVec3) -> Self {
-        let m: DMat4 = camera.view_projection(size.0, size.1) * DMat4::from_translation(origin);
-        let depth_row = m.row(3) - m.row(2);
-        let light = light_world_dir(camera, style);
-        let eye = camera.eye.as_dvec3() - origin;
-        Self {
-            view_proj: m.as_mat4().to_cols_array_2d(),
-            depth_row: depth_row.as_vec4().to_array(),
-            eye: eye.as_vec3().extend(1.0).to_array(),
-            light_dir: light.as_vec3().extend(0.0).to_array(),
-            wire_color: style.wire_color.0,
-            fill_color: style.fill_color.0,
-            background: style.background.0,
-            size: [size.0 as f32, size.1 as f32],
-            line_width: style.line_width,
-            ambient: style.ambient,
-            fade: style.fade_range(),
-            index_split: u32::MAX,
-            silhouettes: u32::from(style.silhouettes),
-            triangles: 0,
-            _pad: [0; 3],
-        }
-    }
-
-    /// The f32 matrix the GPU uses (mesh-local → clip).
-    pub fn view_proj(&self) -> Mat4 {
-        Mat4::from_cols_array_2d(&self.view_proj)
-    }
-
-    /// The reverse-Z depth row.
+    /// The reverse depth row.
     pub fn depth_row(&self) -> Vec4 {
         Vec4::from_array(self.depth_row)
     }
 }
 
+/// Which part of a full image the targets cover: all of it, or a tile of it, with a guard
+/// band of `guard` pixels around the output on every side (so lines just outside the output
+/// are found). Every pixel is addressed in full-image coordinates, so a tile computes
+/// exactly what the whole image computes there.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Window {
+    /// The full image the projection maps onto, in pixels.
+    pub image: (u32, u32),
+    /// The output's first pixel in the full image.
+    pub origin: (u32, u32),
+    /// The output's size in pixels.
+    pub size: (u32, u32),
+}
+
+impl Window {
+    /// The whole image.
+    pub fn whole(size: (u32, u32)) -> Window {
+        Window {
+            image: size,
+            origin: (0, 0),
+            size,
+        }
+    }
+
+    /// Checks that the window lies inside its image.
+    pub fn validate(&self) -> Result<()> {
+        let (w, h) = self.size;
+        let (x, y) = self.origin;
+        let (iw, ih) = self.image;
+        if w == 0 || h == 0 || iw == 0 || ih == 0 {
+            return Err(Error::InvalidSetting(format!(
+                "image size {iw}x{ih} or window size {w}x{h} has a zero side"
+            )));
+        }
+        if u64::from(x) + u64::from(w) > u64::from(iw)
+            || u64::from(y) + u64::from(h) > u64::from(ih)
+        {
+            return Err(Error::InvalidSetting(format!(
+                "the window {w}x{h} at ({x}, {y}) reaches past the {iw}x{ih} image"
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// One instanced draw: a mesh's triangles, for a run of consecutive instance slots.
+#[derive(Clone, Debug)]
+pub(crate) struct DrawGroup {
+    pub mesh: super::MeshId,
+    pub first_index: u32,
+    pub index_count: u32,
+    pub base_vertex: i32,
+    pub triangles: u32,
+    pub instances: std::ops::Range<u32>,
+}
+
+/// A frame's uniforms, instance records and draw list, on the GPU.
+pub(crate) struct FrameData {
+    pub uniforms: FrameUniforms,
+    pub frame: wgpu::Buffer,
+    pub instances: wgpu::Buffer,
+    pub draws: Vec<DrawGroup>,
+    /// For each instance slot, the scene's instance index (slots group instances by mesh).
+    pub order: Vec<u32>,
+    pub store: StoreBuffers,
+    pub store_version: (u32, u64),
+    pub window: Window,
+    /// Pixels of guard band around the output in the targets.
+    pub guard: u32,
+    /// Whether any instance draws an outline.
+    pub outlines: bool,
+    /// Whether instances differ in line colour (the outline pass then keeps, per pixel,
+    /// which instance's line it holds).
+    pub mixed_colors: bool,
+}
+
+impl FrameData {
+    /// Validates the scene, style and window against the device and the store, and builds
+    /// the frame's GPU data.
+    pub fn new(
+        device: &wgpu::Device,
+        store: &MeshStore,
+        scene: &Scene<'_>,
+        style: &Style,
+        window: Window,
+        guard: u32,
+    ) -> Result<FrameData> {
+        window.validate()?;
+        let target = (window.size.0 + 2 * guard, window.size.1 + 2 * guard);
+        super::check_size(device, target)?;
+        scene.validate()?;
+        style.validate()?;
+        // Group instances by mesh (stable, so each mesh's instances keep the scene's order),
+        // so every mesh is one instanced draw.
+        let mut order: Vec<u32> = (0..scene.instances.len() as u32).collect();
+        let keys: Vec<(u32, u32)> = scene
+            .instances
+            .iter()
+            .map(|i| {
+                store
+                    .record(i.mesh)
+                    .map(|r| (r.triangle_base, r.vertex_base))
+            })
+            .collect::<Result<_>>()?;
+        order.sort_by_key(|&i| keys[i as usize]);
+
+        let view = scene.view;
+        let eye = view.eye();
+        let light = light_world_dir(&view, style);
+        let fade_row = view.view_depth_row();
+        let mut records = Vec::with_capacity(order.len());
+        let mut draws: Vec<DrawGroup> = Vec::new();
+        let mut clusters = 0u64;
+        let mut outlines = false;
+        for (slot, &i) in order.iter().enumerate() {
+            let instance = &scene.instances[i as usize];
+            let mesh = store.record(instance.mesh)?;
+            let s = &instance.style;
+            let draws_outline = s.outlines.unwrap_or(style.silhouettes);
+            outlines |= draws_outline;
+            let flags = if s.edges.unwrap_or(true) {
+                INSTANCE_EDGES
+            } else {
+                0
+            } | if draws_outline { INSTANCE_OUTLINES } else { 0 };
+            let record = instance_record(
+                &view,
+                (eye, fade_row),
+                instance.transform,
+                mesh,
+                (
+                    s.wire_color.unwrap_or(style.wire_color).0,
+                    s.line_width.unwrap_or(style.line_width),
+                    flags,
+                ),
+                (slot as u32, clusters as u32),
+            );
+            clusters += u64::from(mesh.clusters);
+            records.push(record);
+            let slot = slot as u32;
+            match draws.last_mut() {
+                Some(d)
+                    if d.first_index == 3 * mesh.triangle_base
+                        && d.base_vertex == mesh.vertex_base as i32 =>
+                {
+                    d.instances.end = slot + 1;
+                }
+                _ => draws.push(DrawGroup {
+                    mesh: instance.mesh,
+                    first_index: 3 * mesh.triangle_base,
+                    index_count: 3 * mesh.triangles,
+                    base_vertex: mesh.vertex_base as i32,
+                    triangles: mesh.triangles,
+                    instances: slot..slot + 1,
+                }),
+            }
+        }
+        let clusters = u32::try_from(clusters)
+            .map_err(|_| Error::InvalidScene(format!("{clusters} clusters over all instances")))?;
+        let mixed_colors = records
+            .windows(2)
+            .any(|w| w[0].wire_color != w[1].wire_color);
+
+        let buffers = store.buffers();
+        let (gx, gy) = (guard as f64, guard as f64);
+        let (iw, ih) = (f64::from(window.image.0), f64::from(window.image.1));
+        let (tw, th) = (f64::from(target.0), f64::from(target.1));
+        // Clip → target NDC: target pixel (0, 0) is image pixel origin − guard.
+        let (ox, oy) = (
+            f64::from(window.origin.0) - gx,
+            f64::from(window.origin.1) - gy,
+        );
+        let crop = [
+            iw / tw,
+            ih / th,
+            (iw - 2.0 * ox) / tw - 1.0,
+            1.0 - (ih - 2.0 * oy) / th,
+        ];
+        let uniforms = FrameUniforms {
+            image_size: [iw as f32, ih as f32],
+            target_origin: [ox as f32, oy as f32],
+            target_size: [target.0 as f32, target.1 as f32],
+            output_offset: [guard as f32; 2],
+            output_size: [window.size.0 as f32, window.size.1 as f32],
+            fade: style.fade_range(),
+            crop: crop.map(|v| v as f32),
+            light_dir: light.as_vec3().extend(0.0).to_array(),
+            fill_color: style.fill_color.0,
+            background: style.background.0,
+            ambient: style.ambient,
+            instances: records.len() as u32,
+            vertex_split: buffers.split.vertices,
+            triangle_split: buffers.split.triangles,
+            clusters,
+            host_depth: 0,
+            _pad: [0; 2],
+        };
+        let frame = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("wirepass frame"),
+            contents: bytemuck::bytes_of(&uniforms),
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        });
+        // Bindings need a non-empty buffer, even for a scene without instances.
+        let mut contents: Vec<u8> = bytemuck::cast_slice(&records).to_vec();
+        if contents.is_empty() {
+            contents = vec![0; std::mem::size_of::<InstanceRecord>()];
+        }
+        let instances = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("wirepass instances"),
+            contents: &contents,
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::VERTEX
+                | wgpu::BufferUsages::COPY_DST,
+        });
+        Ok(FrameData {
+            uniforms,
+            frame,
+            instances,
+            draws,
+            order,
+            store: buffers,
+            store_version: (store.store_id(), store.version()),
+            window,
+            guard,
+            outlines,
+            mixed_colors,
+        })
+    }
+
+    /// Clusters of all instances together.
+    pub fn uniforms_clusters(&self) -> u32 {
+        self.uniforms.clusters
+    }
+
+    /// Whether the store's vertex or per-triangle buffers are bound as two halves.
+    pub fn split(&self) -> bool {
+        let s = &self.store;
+        u64::from(s.split.vertices) * super::mesh_store::VERTEX_BYTES < s.vertices.size()
+            || u64::from(s.split.triangles) * super::mesh_store::TRIANGLE_BYTES < s.indices.size()
+    }
+
+    /// Size of the id and depth targets.
+    pub fn target_size(&self) -> (u32, u32) {
+        (
+            self.window.size.0 + 2 * self.guard,
+            self.window.size.1 + 2 * self.guard,
+        )
+    }
+
+    /// Errors when `store` is not the store this frame was prepared with, or changed since
+    /// in a way that may have overwritten what the frame draws.
+    pub fn check_store(&self, store: &MeshStore) -> Result<()> {
+        if (store.store_id(), store.version()) != self.store_version {
+            return Err(Error::Misuse(
+                "the mesh store is another one, or had a mesh removed, since this frame was \
+                 prepared: prepare the frame again"
+                    .into(),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// One instance's record: its clip rows, eye, view depth row and normal matrix in its mesh's
+/// stored coordinates, all formed in f64.
+fn instance_record(
+    view: &View,
+    (eye, fade_row): (DVec4, DVec4),
+    transform: DMat4,
+    mesh: &MeshRecord,
+    (wire_color, line_width, flags): ([f32; 4], f32, u32),
+    (slot, cluster_first): (u32, u32),
+) -> InstanceRecord {
+    let model = transform * mesh.local_to_mesh();
+    let rows = view.clip_rows(model);
+    let mut local_eye = model.inverse() * eye;
+    local_eye = if local_eye.w != 0.0 {
+        local_eye / local_eye.w
+    } else {
+        local_eye.truncate().normalize_or_zero().extend(0.0)
+    };
+    let normal = DMat3::from_mat4(transform).inverse().transpose();
+    let row = |m: DMat3, i: usize| m.row(i).as_vec3().extend(0.0).to_array();
+    InstanceRecord {
+        clip: rows.clip.as_mat4().to_cols_array_2d(),
+        depth_row: rows.depth.as_vec4().to_array(),
+        eye: local_eye.as_vec4().to_array(),
+        fade_row: (model.transpose() * fade_row).as_vec4().to_array(),
+        normal: [row(normal, 0), row(normal, 1), row(normal, 2)],
+        wire_color,
+        line_width,
+        flags,
+        vertex_base: mesh.vertex_base,
+        triangle_base: mesh.triangle_base,
+        triangles: mesh.triangles,
+        cluster_base: mesh.cluster_base,
+        cluster_first,
+        index: slot,
+    }
+}
+
 /// The style's view-space light direction in world axes, unit length.
-pub fn light_world_dir(camera: &Camera, style: &Style) -> DVec3 {
-    let inv = camera.view().inverse();
+pub fn light_world_dir(view: &View, style: &Style) -> DVec3 {
+    let inv = view.view.inverse();
     inv.transform_vector3(style.light_view_dir.as_dvec3())
         .normalize_or_zero()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn records_match_their_wgsl_layout() {
+        assert_eq!(std::mem::size_of::<InstanceRecord>(), 208);
+        assert_eq!(std::mem::size_of::<FrameUniforms>(), 144);
+        let r = InstanceRecord::zeroed_for_test();
+        let base = &r as *const _ as usize;
+        assert_eq!(
+            &r.index as *const _ as usize - base,
+            INSTANCE_INDEX_OFFSET as usize
+        );
+        assert_eq!(
+            &r.vertex_base as *const _ as usize - base,
+            INSTANCE_BASES_OFFSET as usize
+        );
+    }
+
+    impl InstanceRecord {
+        fn zeroed_for_test() -> Self {
+            bytemuck::Zeroable::zeroed()
+        }
+    }
+
+    #[test]
+    fn crop_maps_the_image_onto_the_targets() {
+        // A 4-pixel guard band around a 100x50 window at (20, 10) of a 200x100 image: the
+        // image point at pixel x lands at target pixel x - (20 - 4).
+        let (iw, ih, tw, th, ox, oy): (f64, f64, f64, f64, f64, f64) =
+            (200.0, 100.0, 108.0, 58.0, 16.0, 6.0);
+        let crop = [
+            iw / tw,
+            ih / th,
+            (iw - 2.0 * ox) / tw - 1.0,
+            1.0 - (ih - 2.0 * oy) / th,
+        ];
+        for (px, py) in [(16.0, 6.0), (70.0, 33.0), (124.0, 64.0)] {
+            let (ndc_x, ndc_y) = (2.0 * px / iw - 1.0, 1.0 - 2.0 * py / ih);
+            let (x, y) = (ndc_x * crop[0] + crop[2], ndc_y * crop[1] + crop[3]);
+            let target = ((x + 1.0) * 0.5 * tw, (1.0 - y) * 0.5 * th);
+            assert!((target.0 - (px - ox)).abs() < 1e-9, "{target:?}");
+            assert!((target.1 - (py - oy)).abs() < 1e-9, "{target:?}");
+        }
+    }
+
+    #[test]
+    fn instance_rows_fold_in_the_mesh_rebase() {
+        let view = crate::camera::Camera {
+            eye: glam::Vec3::new(1.0, 2.0, 6.0),
+            target: glam::Vec3::ZERO,
+            up: glam::Vec3::Y,
+            fov_y_deg: 50.0,
+            near: 0.1,
+            far: 100.0,
+        }
+        .to_view(1.5);
+        let mesh = MeshRecord {
+            vertex_base: 0,
+            vertices: 0,
+            triangle_base: 0,
+            triangles: 0,
+            cluster_base: 0,
+            clusters: 0,
+            origin: DVec3::new(5.0, -3.0, 2.0),
+            scale: 0.25,
+            order: vec![].into(),
+            bounds: (DVec3::ZERO, DVec3::ZERO),
+        };
+        let transform = DMat4::from_scale_rotation_translation(
+            DVec3::new(-1.0, 2.0, 0.5),
+            glam::DQuat::from_rotation_y(0.7),
+            DVec3::new(0.3, 0.0, -1.0),
+        );
+        let r = instance_record(
+            &view,
+            (view.eye(), view.view_depth_row()),
+            transform,
+            &mesh,
+            ([0.0; 4], 1.0, 0),
+            (0, 0),
+        );
+        // A stored point q is the mesh point origin + scale q.
+        let q = DVec3::new(0.4, -0.2, 0.9);
+        let world = transform.transform_point3(mesh.origin + q * mesh.scale);
+        let want = view.clip_rows(DMat4::IDENTITY).clip * world.extend(1.0);
+        let got = r.clip().as_dmat4() * q.extend(1.0);
+        assert!((want - got).length() < 1e-5 * want.length(), "{want} {got}");
+        // The local eye maps back to the world eye.
+        let e = glam::Vec4::from_array(r.eye).as_dvec4();
+        let back = transform.transform_point3(mesh.origin + e.truncate() * mesh.scale);
+        assert!((back - view.eye().truncate()).length() < 1e-4, "{back}");
+    }
 }

@@ -1,21 +1,27 @@
-//! GPU side: device creation, mesh buffers, the per-frame uniforms and the passes.
+//! GPU side: device creation, the mesh store, the per-frame scene data and the passes.
 
+mod bindings;
 mod context;
 mod deferred;
 mod forward;
 mod frame;
-mod mesh;
+mod mesh_store;
+mod raster;
 mod readback;
 pub mod shaders;
+mod targets;
 mod timing;
 mod two_pass;
+mod visibility;
 
 pub use context::{GpuContext, OPTIONAL_FEATURES};
-pub use deferred::{DeferredPass, OutputTarget, PassOptions};
-pub use forward::{forward_source, ForwardPass, MAPS_DIAGNOSTIC_FORMAT};
-pub use frame::{light_world_dir, FrameUniforms};
-pub use mesh::GpuMesh;
+pub use deferred::{DeferredPass, OutputTarget, PassOptions, PreparedFrame};
+pub use forward::{forward_source, ForwardPass};
+pub use frame::{light_world_dir, FrameUniforms, InstanceRecord, Window, MAX_INSTANCES};
+pub use mesh_store::{pack_normal, unpack_normal, MeshId, MeshStore};
+pub use raster::{RasterFrame, MAPS_DIAGNOSTIC_FORMAT};
 pub use readback::read_texture;
+pub use targets::{DEPTH_FORMAT, DIAGNOSTIC_FORMAT, ID_FORMAT, RESOLVED_ID_FORMAT, RESULT_FORMAT};
 pub use timing::GpuTimer;
 pub use two_pass::{drawn_edges, two_pass_source, EdgeLines, TwoPass, FILL_DEPTH_BIAS};
 

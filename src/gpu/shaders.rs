@@ -1,15 +1,25 @@
-//! WGSL sources. Each pass's module is `common.wgsl` followed by the pass's own file, so the
+//! WGSL sources. Each pass's module is `common.wgsl` followed by the pass's own files, so the
 //! shared definitions (edge math, line profile, shading) exist once.
+//!
+//! Settings that are constant over a frame specialise the source itself, with
+//! `#if NAME` / `#else` / `#endif` lines resolved here: a pipeline contains only the code and
+//! the bindings its frame uses (no branch on a uniform that no pixel takes, which a software
+//! rasterizer would still pay for, and no binding a device with default limits cannot
+//! afford).
 
-/// Definitions shared by every pass; the Rust twins live in `edge_math` and `style`.
+/// Definitions shared by every pass; the Rust twins live in `edge_math`, `style` and
+/// `gpu::mesh_store`.
 pub const COMMON: &str = include_str!("../../shaders/common.wgsl");
-/// Visibility pass using `@builtin(primitive_index)`.
+/// The scene's bindings and fetches (instances, the mesh store, the id target), and the
+/// exact per-pixel triangle test, shared by the outline and edge passes.
+pub const SCENE: &str = include_str!("../../shaders/scene.wgsl");
+/// Visibility pass: instanced, with `@builtin(primitive_index)`, or vertex-pulled.
 pub const VISIBILITY: &str = include_str!("../../shaders/visibility.wgsl");
-/// Visibility pass for adapters without `PRIMITIVE_INDEX`: vertex pulling, flat id.
-pub const VISIBILITY_PULLED: &str = include_str!("../../shaders/visibility_pulled.wgsl");
 /// The deferred edge pass (compute).
 pub const EDGE_PASS: &str = include_str!("../../shaders/edge_pass.wgsl");
-/// The outline pass (compute), assembled after [`EDGE_PASS`] into the same module.
+/// The benchmark floor (compute): an id read and a flat colour.
+pub const FLOOR: &str = include_str!("../../shaders/floor.wgsl");
+/// The outline pass (compute).
 pub const OUTLINE: &str = include_str!("../../shaders/outline.wgsl");
 /// The forward single-pass baseline (vertex-pulled altitudes); see `gpu::ForwardPass`.
 pub const FORWARD: &str = include_str!("../../shaders/forward.wgsl");
@@ -26,26 +36,186 @@ pub fn storage_format_name(format: wgpu::TextureFormat) -> Option<&'static str> 
     }
 }
 
-/// A complete module: the common definitions, then `body`. `enable` directives must come
-/// first in WGSL, so they are lifted out of `body`.
-pub fn assemble(body: &str) -> String {
+/// Resolves `#if NAME`, `#else` and `#endif` lines (nesting allowed): a line is kept when
+/// every enclosing condition holds, a condition holding when its name is in `flags`
+/// (`#if !NAME` negates).
+pub fn specialise(source: &str, flags: &[&str]) -> String {
+    let mut stack: Vec<(bool, bool)> = Vec::new(); // (condition, in else)
+    let mut out = String::with_capacity(source.len());
+    for line in source.lines() {
+        let t = line.trim_start();
+        if let Some(name) = t.strip_prefix("#if ") {
+            let name = name.trim();
+            let (neg, name) = match name.strip_prefix('!') {
+                Some(n) => (true, n),
+                None => (false, name),
+            };
+            stack.push((flags.contains(&name) != neg, false));
+            out.push('\n');
+            continue;
+        }
+        if t.starts_with("#else") {
+            if let Some(top) = stack.last_mut() {
+                top.1 = true;
+            }
+            out.push('\n');
+            continue;
+        }
+        if t.starts_with("#endif") {
+            stack.pop();
+            out.push('\n');
+            continue;
+        }
+        // Blank lines keep line numbers, so compiler messages point at the file's lines.
+        if stack.iter().all(|&(cond, in_else)| cond != in_else) {
+            out.push_str(line);
+        }
+        out.push('\n');
+    }
+    out
+}
+
+/// A complete module: `common.wgsl`, then `parts` in order, specialised with `flags`.
+/// `enable` directives must come first in WGSL, so they are lifted out of the parts.
+pub fn assemble(parts: &[&str], flags: &[&str]) -> String {
+    let body = parts.join("\n");
+    let body = specialise(&body, flags);
     let (enables, rest): (Vec<&str>, Vec<&str>) = body
         .lines()
         .partition(|l| l.trim_start().starts_with("enable "));
-    format!("{}\n{COMMON}\n{}\n", enables.join("\n"), rest.join("\n"))
+    format!(
+        "{}\n{}\n{}\n",
+        enables.join("\n"),
+        specialise(COMMON, flags),
+        rest.join("\n")
+    )
 }
 
-/// The edge pass and the outline pass for an output texture of `format`: 8-bit outputs are written sRGB-encoded
-/// (storage textures cannot be sRGB), float outputs linear.
-pub fn edge_pass(format: wgpu::TextureFormat) -> Option<String> {
-    let name = storage_format_name(format)?;
-    let encode = if format == wgpu::TextureFormat::Rgba8Unorm {
+/// The colour encoding of an output format: 8-bit unorm storage textures cannot be sRGB, so
+/// the shader writes sRGB-encoded values into them; float formats hold linear values.
+pub fn encode_output(format: wgpu::TextureFormat) -> &'static str {
+    if format == wgpu::TextureFormat::Rgba8Unorm {
         "fn encode_output(c: vec4<f32>) -> vec4<f32> { return vec4<f32>(linear_to_srgb(c.rgb), c.a); }"
     } else {
         "fn encode_output(c: vec4<f32>) -> vec4<f32> { return c; }"
-    };
-    Some(assemble(&format!(
-        "{}\n{OUTLINE}\n{encode}\n",
-        EDGE_PASS.replace("OUTPUT_FORMAT", name)
-    )))
+    }
+}
+
+/// The visibility pass's module: vertex-pulled or not, for a split store or not.
+pub fn visibility_source(pulled: bool, split: bool) -> String {
+    let mut flags = vec![];
+    if pulled {
+        flags.push("PULLED");
+    }
+    if split {
+        flags.push("SPLIT");
+    }
+    assemble(&[VISIBILITY], &flags)
+}
+
+/// The edge pass's module (with the floor) for an output of `format` (one of
+/// [`storage_format_name`]'s) and the frame's `flags`.
+pub fn edge_source(format: wgpu::TextureFormat, flags: &[&str]) -> String {
+    let name = storage_format_name(format).unwrap_or("rgba8unorm");
+    let edge = EDGE_PASS.replace("OUTPUT_FORMAT", name);
+    let floor = FLOOR.replace("OUTPUT_FORMAT", name);
+    assemble(&[SCENE, &edge, &floor, encode_output(format)], flags)
+}
+
+/// The outline pass's module for the frame's `flags`.
+pub fn outline_source(flags: &[&str]) -> String {
+    assemble(&[SCENE, OUTLINE], flags)
+}
+
+/// Every module the crate builds, named by its settings: each pass in each of its
+/// specialisations, for validation without a GPU.
+pub fn variants() -> Vec<(String, String)> {
+    use wgpu::TextureFormat as F;
+    let mut out = Vec::new();
+    for pulled in [false, true] {
+        for split in [false, true] {
+            out.push((
+                format!("visibility pulled={pulled} split={split}"),
+                visibility_source(pulled, split),
+            ));
+        }
+    }
+    let storage = [F::Rgba8Unorm, F::Rgba16Float, F::Rgba32Float];
+    let modes: &[&[&str]] = &[
+        &["MODE_SHADE"],
+        &["MODE_OVERLAY"],
+        &["MODE_RESULT"],
+        &["MODE_RESULT", "SHADED"],
+        &["MODE_DIAGNOSTIC"],
+        &["MODE_FLOOR"],
+    ];
+    for format in storage {
+        for mode in modes {
+            for split in [false, true] {
+                for (outlines, colors) in [(false, false), (true, false), (true, true)] {
+                    let mut flags = mode.to_vec();
+                    if split {
+                        flags.push("SPLIT");
+                    }
+                    if outlines {
+                        flags.push("OUTLINES");
+                    }
+                    if colors {
+                        flags.push("COLORS");
+                    }
+                    out.push((
+                        format!("edge {format:?} {flags:?}"),
+                        edge_source(format, &flags),
+                    ));
+                }
+            }
+        }
+    }
+    for split in [false, true] {
+        for colors in [false, true] {
+            let mut flags = vec![];
+            if split {
+                flags.push("SPLIT");
+            }
+            if colors {
+                flags.push("COLORS");
+            }
+            out.push((format!("outline {flags:?}"), outline_source(&flags)));
+        }
+        for format in [
+            F::Rgba8Unorm,
+            F::Rgba8UnormSrgb,
+            F::Rgba16Float,
+            F::Rgba32Float,
+        ] {
+            if let Some(s) = super::forward_source(format, split) {
+                out.push((format!("forward {format:?} split={split}"), s));
+            }
+            if let Some(s) = super::two_pass_source(format, split) {
+                out.push((format!("two-pass {format:?} split={split}"), s));
+            }
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn specialise_keeps_what_the_flags_select() {
+        let src = "a\n#if X\nb\n#if !Y\nc\n#else\nd\n#endif\n#else\ne\n#endif\nf";
+        let lines = |flags: &[&str]| -> Vec<String> {
+            specialise(src, flags)
+                .lines()
+                .filter(|l| !l.is_empty())
+                .map(str::to_owned)
+                .collect()
+        };
+        assert_eq!(lines(&[]), ["a", "e", "f"]);
+        assert_eq!(lines(&["X"]), ["a", "b", "c", "f"]);
+        assert_eq!(lines(&["X", "Y"]), ["a", "b", "d", "f"]);
+        assert_eq!(specialise(src, &[]).lines().count(), src.lines().count());
+    }
 }

@@ -1,50 +1,54 @@
 //! The two-pass baseline, the "standard" approach the single-pass paper set out to beat: a
 //! shaded fill pushed back with a depth bias, then the drawn edges as hardware lines over it.
 //!
-//! The issue allows `PolygonMode::Line` for the second pass, but that draws every triangle
-//! edge, polygon diagonals included, and needs `Features::POLYGON_MODE_LINE`, which WebGPU and
-//! GL lack. This pass draws a `LineList` of the **unique drawn edges** instead ([`EdgeLines`],
-//! built once per mesh and edge selection on the CPU): masked edges are never drawn, each
-//! shared edge is drawn once (so a translucent wire colour is not blended twice), and it runs
-//! on every adapter. So it needs no optional feature and never returns
+//! `PolygonMode::Line` for the second pass would draw every triangle edge, polygon diagonals
+//! included, and needs `Features::POLYGON_MODE_LINE`, which WebGPU and GL lack. This pass
+//! draws, per mesh, an instanced `LineList` of the mesh's **unique drawn edges** instead
+//! ([`EdgeLines`], built once per mesh and edge selection on the CPU): masked edges are never
+//! drawn, each shared edge is drawn once (so a translucent wire colour is not blended twice),
+//! and it runs on every adapter. So it needs no optional feature and never returns
 //! [`Error::MissingFeature`] for one.
 
-use super::forward::{
-    check_vertex_storage, clear_color, color_targets, depth_state, encode_snippet, mesh_group,
-    mesh_layout, Targets, Uniforms,
+use super::mesh_store::VERTEX_BYTES;
+use super::raster::{
+    check_vertex_storage, color_targets, depth_state, encode_snippet, pipeline_layout, slot_layout,
+    RasterFrame,
 };
-use super::{shaders, FrameUniforms, GpuMesh, GpuTimer, PassOptions};
-use crate::camera::Camera;
+use super::{shaders, GpuTimer, MeshId, MeshStore, PassOptions};
 use crate::error::{Error, Result};
 use crate::mesh::{EdgeSelection, Mesh};
+use crate::scene::Scene;
 use crate::style::Style;
 use std::collections::{BTreeSet, HashMap};
+use std::sync::atomic::{AtomicU32, Ordering};
 use wgpu::util::DeviceExt;
 
-/// The fill's depth bias: the customary `glPolygonOffset(1, 1)`, mirrored for reverse-Z, where
-/// nearer is *greater*, so pushing the fill back means a **negative** bias. The slope term
-/// covers the difference between where a line and the fill sample the same edge (up to about
-/// a pixel apart); without it about an eighth of the edge pixels lose their line (Suzanne at
-/// 512²). Its cost is the method's known artefact: at grazing angles the slope term pushes a
-/// triangle behind the surface behind it, so near silhouettes the fill's ids differ from the
-/// deferred pass's (0.4 % of Suzanne's pixels at 256²) and hidden lines can show through.
+/// The fill's depth bias: the customary `glPolygonOffset(1, 1)`, mirrored for reverse depth,
+/// where nearer is *greater*, so pushing the fill back means a **negative** bias. The slope
+/// term covers the difference between where a line and the fill sample the same edge (up to
+/// about a pixel apart); without it about an eighth of the edge pixels lose their line
+/// (Suzanne at 512²). Its cost is the method's known artefact: at grazing angles the slope
+/// term pushes a triangle behind the surface behind it, so near silhouettes the fill's ids
+/// differ from the deferred pass's (0.4 % of Suzanne's pixels at 256²) and hidden lines can
+/// show through.
 pub const FILL_DEPTH_BIAS: wgpu::DepthBiasState = wgpu::DepthBiasState {
     constant: -1,
     slope_scale: -1.0,
     clamp: 0.0,
 };
 
-/// The two-pass module for an output of `format`: common.wgsl + forward.wgsl + two_pass.wgsl.
-pub fn two_pass_source(format: wgpu::TextureFormat) -> Option<String> {
+/// The two-pass module for an output of `format`: common.wgsl, scene.wgsl, forward.wgsl
+/// and two_pass.wgsl.
+pub fn two_pass_source(format: wgpu::TextureFormat, split: bool) -> Option<String> {
     if !two_pass_format(format) {
         return None;
     }
     let encode = encode_snippet(format)?;
-    Some(shaders::assemble(&format!(
-        "{}\n{}\n{encode}\n",
-        shaders::FORWARD,
-        shaders::TWO_PASS
-    )))
+    let flags: &[&str] = if split { &["SPLIT"] } else { &[] };
+    Some(shaders::assemble(
+        &[shaders::SCENE, shaders::FORWARD, shaders::TWO_PASS, encode],
+        flags,
+    ))
 }
 
 /// Output formats the line pass can alpha-blend into without extra features.
@@ -85,19 +89,36 @@ pub fn drawn_edges(mesh: &Mesh, edges: EdgeSelection) -> Vec<[u32; 2]> {
     set.into_iter().collect()
 }
 
-/// A mesh's drawn edges as a `LineList` index buffer over its [`GpuMesh`] positions, for
-/// [`TwoPass`]. Build it once per mesh and edge selection (and again after
-/// [`GpuMesh::set_edges`]).
+/// The meshes' drawn edges as `LineList` index buffers over the [`MeshStore`]'s vertices,
+/// for [`TwoPass`]: one list per mesh, built on the CPU from the mesh and its edge
+/// selection (insert it again after [`MeshStore::set_edges`]).
+#[derive(Default)]
 pub struct EdgeLines {
-    indices: Option<wgpu::Buffer>,
-    edges: u32,
-    triangles: u32,
-    vertices: u32,
+    lists: HashMap<MeshId, (Option<wgpu::Buffer>, u32)>,
 }
 
 impl EdgeLines {
-    /// Builds the index buffer of [`drawn_edges`].
-    pub fn new(device: &wgpu::Device, mesh: &Mesh, edges: EdgeSelection) -> Result<Self> {
+    /// No lists yet.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Builds the index buffer of [`drawn_edges`] for mesh `id`, inserted from `mesh`.
+    pub fn insert(
+        &mut self,
+        device: &wgpu::Device,
+        store: &MeshStore,
+        id: MeshId,
+        mesh: &Mesh,
+        edges: EdgeSelection,
+    ) -> Result<()> {
+        let stored = store.triangle_count(id)?;
+        if u64::from(stored) != mesh.triangle_count() as u64 {
+            return Err(Error::Misuse(format!(
+                "edge lines of a {}-triangle mesh for a stored mesh of {stored}",
+                mesh.triangle_count(),
+            )));
+        }
         let list = drawn_edges(mesh, edges);
         let bytes = list.len() as u64 * 8;
         let limit = device.limits().max_buffer_size;
@@ -116,39 +137,32 @@ impl EdgeLines {
                 usage: wgpu::BufferUsages::INDEX,
             })
         });
-        Ok(Self {
-            indices,
-            edges: list.len() as u32,
-            triangles: mesh.triangle_count() as u32,
-            vertices: mesh.positions().len() as u32,
-        })
-    }
-
-    /// GPU memory of the line index buffer, in bytes.
-    pub fn gpu_bytes(&self) -> u64 {
-        u64::from(self.edges) * 8
-    }
-
-    /// Number of lines drawn.
-    pub fn edge_count(&self) -> u32 {
-        self.edges
-    }
-
-    fn check(&self, mesh: &GpuMesh) -> Result<()> {
-        let vertices = mesh.positions.size() / 12;
-        if self.triangles != mesh.triangles || u64::from(self.vertices) != vertices {
-            return Err(Error::InvalidMesh(format!(
-                "edge lines built for {} triangles and {} vertices used with a mesh of {} and {vertices}",
-                self.triangles, self.vertices, mesh.triangles
-            )));
-        }
+        self.lists.insert(id, (indices, list.len() as u32));
         Ok(())
     }
+
+    /// GPU memory of the line index buffers, in bytes.
+    pub fn gpu_bytes(&self) -> u64 {
+        self.lists.values().map(|l| u64::from(l.1) * 8).sum()
+    }
+
+    /// Lines drawn for one instance of each mesh.
+    pub fn edge_count(&self) -> u32 {
+        self.lists.values().map(|l| l.1).sum()
+    }
+}
+
+struct Pipelines {
+    layout: wgpu::BindGroupLayout,
+    fill: wgpu::RenderPipeline,
+    fill_maps: wgpu::RenderPipeline,
+    lines: wgpu::RenderPipeline,
+    lines_maps: wgpu::RenderPipeline,
 }
 
 /// The two-pass wireframe baseline: a shaded fill (the deferred pass's shading) with a depth
 /// bias ([`FILL_DEPTH_BIAS`]), then the drawn edges ([`EdgeLines`]) as 1-pixel hardware lines
-/// in the wire colour, alpha-blended, depth-tested against the fill.
+/// in each instance's wire colour, alpha-blended, depth-tested against the fill.
 ///
 /// Hardware lines are one pixel wide whatever the style's line width (wgpu has no wide
 /// lines) and are not antialiased; a line width of 0 draws no lines. With an `Rgba8Unorm`
@@ -160,16 +174,9 @@ impl EdgeLines {
 /// estimated: 0 where a line fragment was drawn (background included, where a silhouette
 /// line spills over), 3e38 (no edge) everywhere else.
 pub struct TwoPass {
+    id: u32,
     format: wgpu::TextureFormat,
-    layout: wgpu::BindGroupLayout,
-    fill: wgpu::RenderPipeline,
-    fill_maps: wgpu::RenderPipeline,
-    lines: wgpu::RenderPipeline,
-    lines_maps: wgpu::RenderPipeline,
-    uniforms: Uniforms,
-    background: [f32; 4],
-    draw_lines: bool,
-    targets: Option<Targets>,
+    pipelines: [Option<Pipelines>; 2],
 }
 
 impl TwoPass {
@@ -177,27 +184,36 @@ impl TwoPass {
     /// `Rgba8UnormSrgb` or `Rgba16Float` (the line pass blends, which `Rgba32Float` cannot
     /// without an extra feature). The output needs `RENDER_ATTACHMENT` usage.
     pub fn new(device: &wgpu::Device, options: PassOptions) -> Result<Self> {
+        static NEXT: AtomicU32 = AtomicU32::new(1);
         let format = options.output_format;
-        let source = two_pass_source(format).ok_or_else(|| {
-            Error::InvalidSetting(format!(
+        if two_pass_source(format, false).is_none() {
+            return Err(Error::InvalidSetting(format!(
                 "output format {format:?} is not one the two-pass method can render to \
                  (Rgba8Unorm, Rgba8UnormSrgb, Rgba16Float)"
-            ))
-        })?;
-        check_vertex_storage(device)?;
+            )));
+        }
+        check_vertex_storage(device, &device.adapter_info().name)?;
+        let mut pass = Self {
+            id: NEXT.fetch_add(1, Ordering::Relaxed) | 0x4000_0000,
+            format,
+            pipelines: [None, None],
+        };
+        pass.pipelines[0] = Some(pass.build(device, false)?);
+        Ok(pass)
+    }
+
+    fn build(&self, device: &wgpu::Device, split: bool) -> Result<Pipelines> {
+        let format = self.format;
+        let source = two_pass_source(format, split)
+            .ok_or_else(|| Error::InvalidSetting(format!("{format:?}")))?;
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let layout = mesh_layout(device, "wirepass two-pass");
+        let (layout, pipeline_layout) = pipeline_layout(device, "wirepass two-pass", split)?;
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("wirepass two-pass"),
             source: wgpu::ShaderSource::Wgsl(source.into()),
         });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("wirepass two-pass"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
         let position_layout = wgpu::VertexBufferLayout {
-            array_stride: 12,
+            array_stride: VERTEX_BYTES,
             step_mode: wgpu::VertexStepMode::Vertex,
             attributes: &wgpu::vertex_attr_array![0 => Float32x3],
         };
@@ -218,15 +234,15 @@ impl TwoPass {
                 color_targets(output, maps, wgpu::ColorWrites::ALL, wgpu::ColorWrites::ALL)
             };
             let (vs, fs) = match (line, maps) {
-                (false, false) => ("vs_fill", "fs_fill"),
-                (false, true) => ("vs_fill", "fs_fill_maps"),
+                (false, false) => ("vs_main", "fs_fill"),
+                (false, true) => ("vs_main", "fs_fill_maps"),
                 (true, false) => ("vs_line", "fs_line"),
                 (true, true) => ("vs_line", "fs_line_maps"),
             };
             let buffers = if line {
-                vec![Some(position_layout.clone())]
+                vec![Some(position_layout.clone()), Some(slot_layout())]
             } else {
-                vec![]
+                vec![Some(slot_layout())]
             };
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(if line {
@@ -269,26 +285,17 @@ impl TwoPass {
                 cache: None,
             })
         };
-        let fill = pipeline(false, false);
-        let fill_maps = pipeline(false, true);
-        let lines = pipeline(true, false);
-        let lines_maps = pipeline(true, true);
-        let uniforms = Uniforms::new(device);
+        let p = Pipelines {
+            layout,
+            fill: pipeline(false, false),
+            fill_maps: pipeline(false, true),
+            lines: pipeline(true, false),
+            lines_maps: pipeline(true, true),
+        };
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(Error::Device(format!("creating the two-pass method: {e}")));
         }
-        Ok(Self {
-            format,
-            layout,
-            fill,
-            fill_maps,
-            lines,
-            lines_maps,
-            uniforms,
-            background: [0.0; 4],
-            draw_lines: true,
-            targets: None,
-        })
+        Ok(p)
     }
 
     /// The output format chosen at construction.
@@ -296,60 +303,33 @@ impl TwoPass {
         self.format
     }
 
-    /// Validates the camera, style and size, uploads the frame's uniforms, and (re)builds the
-    /// depth, id and diagnostic targets when the size changed.
+    /// Validates the scene, style and size and uploads the frame.
     pub fn prepare(
         &mut self,
         device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        mesh: &GpuMesh,
-        camera: &Camera,
+        store: &MeshStore,
+        scene: &Scene<'_>,
         style: &Style,
         size: (u32, u32),
-    ) -> Result<()> {
-        let view = (camera, style, size);
-        FrameUniforms::validate_and_write(device, queue, &self.uniforms.frame, mesh, view)?;
-        self.background = style.background.0;
-        self.draw_lines = style.line_width > 0.0;
-        Targets::ensure(&mut self.targets, device, size);
-        Ok(())
+    ) -> Result<RasterFrame> {
+        let frame = RasterFrame::new(self.id, device, store, scene, style, size)?;
+        if frame.data.split() && self.pipelines[1].is_none() {
+            self.pipelines[1] = Some(self.build(device, true)?);
+        }
+        Ok(frame)
     }
 
-    /// The size the pass was last prepared for.
-    pub fn size(&self) -> Option<(u32, u32)> {
-        self.targets.as_ref().map(|t| t.size)
-    }
-
-    /// The triangle-id target (`R32Uint`, `u32::MAX` = background) from the fill, written by
-    /// [`encode_with_maps`](Self::encode_with_maps).
-    pub fn id_texture(&self) -> Option<&wgpu::Texture> {
-        self.targets.as_ref().map(|t| &t.ids)
-    }
-
-    /// The reverse-Z depth target (`Depth32Float`, 1 = near plane), biased by the fill.
-    pub fn depth_texture(&self) -> Option<&wgpu::Texture> {
-        self.targets.as_ref().map(|t| &t.depth)
-    }
-
-    /// The diagnostic map written by [`encode_with_maps`](Self::encode_with_maps), `f32` bits
-    /// in an `Rgba32Uint` texture (see [`MAPS_DIAGNOSTIC_FORMAT`](super::MAPS_DIAGNOSTIC_FORMAT)):
-    /// red = 0 where a line was drawn and 3e38 elsewhere, green = the fill's reverse-Z raster
-    /// depth as `@builtin(position).z` reports it, which includes the depth bias on Mesa's
-    /// lavapipe and llvmpipe (the depth the method really tests lines against).
-    pub fn diagnostic_texture(&self) -> Option<&wgpu::Texture> {
-        self.targets.as_ref().map(|t| &t.diagnostic)
-    }
-
-    /// Records both passes into `output` (cleared to the background first).
+    /// Records both passes into `output` (cleared to the background first). `lines` holds
+    /// the edge list of every mesh the frame draws.
     pub fn encode(
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
-        mesh: &GpuMesh,
-        lines: &EdgeLines,
+        (store, lines): (&MeshStore, &EdgeLines),
+        frame: &RasterFrame,
         output: &wgpu::TextureView,
     ) -> Result<()> {
-        self.record(device, encoder, mesh, (lines, output), false, None)
+        self.record(device, encoder, (store, lines), frame, output, false, None)
     }
 
     /// [`encode`](Self::encode) with GPU timestamps around the pass (fill and lines share
@@ -358,57 +338,81 @@ impl TwoPass {
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
-        mesh: &GpuMesh,
-        lines: &EdgeLines,
+        (store, lines): (&MeshStore, &EdgeLines),
+        frame: &RasterFrame,
         output: &wgpu::TextureView,
         timer: &mut GpuTimer,
     ) -> Result<()> {
-        self.record(device, encoder, mesh, (lines, output), false, Some(timer))
+        self.record(
+            device,
+            encoder,
+            (store, lines),
+            frame,
+            output,
+            false,
+            Some(timer),
+        )
     }
 
-    /// Like [`encode`](Self::encode), and also writes the triangle ids and the diagnostic map.
+    /// Like [`encode`](Self::encode), and also writes the ids and the diagnostic map.
     pub fn encode_with_maps(
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
-        mesh: &GpuMesh,
-        lines: &EdgeLines,
+        (store, lines): (&MeshStore, &EdgeLines),
+        frame: &RasterFrame,
         output: &wgpu::TextureView,
     ) -> Result<()> {
-        self.record(device, encoder, mesh, (lines, output), true, None)
+        self.record(device, encoder, (store, lines), frame, output, true, None)
     }
 
+    #[allow(clippy::too_many_arguments)]
     fn record(
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
-        mesh: &GpuMesh,
-        (lines, output): (&EdgeLines, &wgpu::TextureView),
+        (store, lines): (&MeshStore, &EdgeLines),
+        frame: &RasterFrame,
+        output: &wgpu::TextureView,
         maps: bool,
         timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
-        let targets = Targets::get(&self.targets)?;
-        targets.check_output(output, self.format)?;
-        lines.check(mesh)?;
-        let group = mesh_group(device, &self.layout, &self.uniforms, mesh);
-        let background = clear_color(self.format, self.background);
+        frame.check(self.id, store)?;
+        frame.check_output(output, self.format)?;
+        let draws = &frame.data.draws;
+        let mut lists = Vec::with_capacity(draws.len());
+        for d in draws {
+            let list = lines.lists.get(&d.mesh).ok_or_else(|| {
+                Error::Misuse("a mesh of the frame has no edge lines (EdgeLines::insert)".into())
+            })?;
+            lists.push(list);
+        }
+        let p = self.pipelines[usize::from(frame.data.split())]
+            .as_ref()
+            .ok_or_else(|| Error::Misuse("the frame was not prepared by this pass".into()))?;
+        let group = frame.bind(device, &p.layout)?;
         let writes = timer.and_then(|t| t.render_span("draw"));
-        let mut pass = targets.begin(
+        let mut pass = frame.begin(
             encoder,
             "wirepass two-pass",
-            output,
-            background,
+            (output, self.format),
             maps,
             writes,
         );
-        pass.set_pipeline(if maps { &self.fill_maps } else { &self.fill });
+        pass.set_pipeline(if maps { &p.fill_maps } else { &p.fill });
         pass.set_bind_group(0, &group, &[]);
-        pass.draw(0..3 * mesh.triangles, 0..1);
-        if let (true, Some(indices)) = (self.draw_lines, &lines.indices) {
-            pass.set_pipeline(if maps { &self.lines_maps } else { &self.lines });
-            pass.set_vertex_buffer(0, mesh.positions.slice(..));
-            pass.set_index_buffer(indices.slice(..), wgpu::IndexFormat::Uint32);
-            pass.draw_indexed(0..2 * lines.edges, 0, 0..1);
+        pass.set_vertex_buffer(0, frame.data.instances.slice(..));
+        for d in draws {
+            pass.draw(0..3 * d.triangles, d.instances.clone());
+        }
+        pass.set_pipeline(if maps { &p.lines_maps } else { &p.lines });
+        pass.set_vertex_buffer(0, frame.data.store.vertices.slice(..));
+        pass.set_vertex_buffer(1, frame.data.instances.slice(..));
+        for (d, (indices, count)) in draws.iter().zip(lists) {
+            if let Some(indices) = indices {
+                pass.set_index_buffer(indices.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(0..2 * count, d.base_vertex, d.instances.clone());
+            }
         }
         Ok(())
     }
@@ -446,7 +450,7 @@ mod tests {
 
     #[test]
     fn float32_output_is_refused() {
-        assert!(two_pass_source(wgpu::TextureFormat::Rgba32Float).is_none());
-        assert!(two_pass_source(wgpu::TextureFormat::Rgba8UnormSrgb).is_some());
+        assert!(two_pass_source(wgpu::TextureFormat::Rgba32Float, false).is_none());
+        assert!(two_pass_source(wgpu::TextureFormat::Rgba8UnormSrgb, false).is_some());
     }
 }

@@ -14,8 +14,8 @@
 //! has an outline edge.
 
 use super::adjacency::{fold_bound, ANY_FOLD};
-use glam::DVec3;
 use crate::par::*;
+use glam::DVec3;
 
 /// Triangles per cluster (the last may have fewer); the outline pass's workgroup size.
 pub const CLUSTER_TRIANGLES: usize = 64;
@@ -145,19 +145,25 @@ fn bound(
     }
 }
 
-/// Twin of `cluster_may_fold` in common.wgsl: false when, seen from `eye`, no triangle of the
+/// Twin of `cluster_may_fold` in common.wgsl: false when, seen from `eye` (homogeneous: a
+/// point with w = 1, or a direction towards the viewer with w = 0), no triangle of the
 /// cluster can have an outline edge. The directions from the eye into the sphere lie within
-/// β = asin(r / D) of its centre's; the angle γ between that and the axis then bounds every
-/// direction-to-normal angle within γ ± (β + spread), and the cluster may fold when that
-/// interval reaches 90°. An eye inside the sphere sees every direction.
+/// β = asin(r / D) of its centre's (β = 0 for an orthographic eye); the angle γ between that
+/// and the axis then bounds every direction-to-normal angle within γ ± (β + spread), and the
+/// cluster may fold when that interval reaches 90°. An eye inside the sphere sees every
+/// direction.
 #[allow(clippy::neg_cmp_op_on_partial_ord)] // as in WGSL: a NaN distance may fold
-pub fn may_fold(bounds: &ClusterBounds, eye: DVec3) -> bool {
-    let d = bounds.center - eye;
-    let distance = d.length();
-    if !(distance > bounds.radius) {
-        return true;
-    }
-    let beta = (bounds.radius / distance).asin();
+pub fn may_fold(bounds: &ClusterBounds, eye: glam::DVec4) -> bool {
+    let (d, beta) = if eye.w != 0.0 {
+        let d = bounds.center - eye.truncate() / eye.w;
+        let distance = d.length();
+        if !(distance > bounds.radius) {
+            return true;
+        }
+        (d, (bounds.radius / distance).asin())
+    } else {
+        (-eye.truncate(), 0.0)
+    };
     let gamma = d.cross(bounds.axis).length().atan2(d.dot(bounds.axis));
     let reach = beta + bounds.spread;
     let quarter = std::f64::consts::FRAC_PI_2;

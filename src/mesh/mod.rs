@@ -9,7 +9,9 @@ mod procedural;
 
 #[cfg(feature = "formats")]
 pub use obj::load_obj;
-pub use procedural::{default_scene, grid, layers, sphere, torus, Procedural, LAYER_TRIANGLES};
+pub use procedural::{
+    default_parts, default_scene, grid, layers, sphere, torus, Procedural, LAYER_TRIANGLES,
+};
 
 use crate::error::{Error, Result};
 use glam::Vec3;
@@ -65,6 +67,8 @@ pub struct Mesh {
     normals: Vec<Vec3>,
     triangles: Vec<[u32; 3]>,
     polygon_edges: Vec<u8>,
+    /// Edges that may be outlines, when the file restricts them.
+    outline_mask: Option<Vec<u8>>,
     /// Edge adjacency, computed on first use.
     neighbours: std::sync::OnceLock<Vec<[u32; 3]>>,
     /// Per triangle, what lets the outline pass skip it: see [`Mesh::outline_hints`].
@@ -150,6 +154,7 @@ impl Mesh {
             normals,
             triangles,
             polygon_edges,
+            outline_mask: None,
             neighbours: Default::default(),
             outline_hints: Default::default(),
             outline_clusters: Default::default(),
@@ -243,6 +248,36 @@ impl Mesh {
         self.outline_clusters.get_or_init(|| {
             clusters::clusters(&self.positions, &self.triangles, self.outline_hints())
         })
+    }
+
+    /// Per triangle, the edges that may be drawn as outlines (bit `i` for edge `i`): all of
+    /// them unless the file says otherwise (see [`Mesh::with_outline_mask`]).
+    pub fn outline_mask(&self) -> std::borrow::Cow<'_, [u8]> {
+        match &self.outline_mask {
+            Some(mask) => mask.as_slice().into(),
+            None => vec![ALL_EDGES; self.triangles.len()].into(),
+        }
+    }
+
+    /// This mesh with only the edges `mask` sets (bit `i` for edge `i` of each triangle) drawn
+    /// as outlines where they are silhouettes or boundaries; files that say which edges are
+    /// silhouette edges (glTF's `EXT_mesh_primitive_edge_visibility`) give it.
+    pub fn with_outline_mask(mut self, mask: Vec<u8>) -> Result<Mesh> {
+        if mask.len() != self.triangles.len() {
+            return Err(Error::InvalidMesh(format!(
+                "{} outline masks for {} triangles",
+                mask.len(),
+                self.triangles.len()
+            )));
+        }
+        self.outline_mask = Some(mask.into_iter().map(|m| m & ALL_EDGES).collect());
+        Ok(self)
+    }
+
+    /// Axis-aligned bounds `(min, max)` of the positions that triangles use, in f64.
+    pub fn bounds_f64(&self) -> (glam::DVec3, glam::DVec3) {
+        let (lo, hi) = self.bounds();
+        (lo.as_dvec3(), hi.as_dvec3())
     }
 
     /// Axis-aligned bounds `(min, max)` of the positions that triangles use.

@@ -230,10 +230,29 @@ pub fn default_scene() -> Mesh {
         normals: scene.normals,
         triangles: scene.triangles,
         polygon_edges: scene.edges,
+        outline_mask: None,
         neighbours: Default::default(),
         outline_hints: Default::default(),
         outline_clusters: Default::default(),
     }
+}
+
+/// The built-in scene's two meshes with their placements: the torus of [`default_scene`],
+/// tilted 40° about X, and its unit sphere, tilted, halved and moved 2 along X.
+pub fn default_parts() -> Result<[(Mesh, glam::DMat4); 2]> {
+    use glam::{DMat4, DQuat, DVec3};
+    let tilt = DQuat::from_rotation_x(40f64.to_radians());
+    Ok([
+        (torus_parts(64, 24).into_mesh()?, DMat4::from_quat(tilt)),
+        (
+            uv_sphere(10, 20).into_mesh()?,
+            DMat4::from_scale_rotation_translation(
+                DVec3::splat(0.5),
+                tilt,
+                DVec3::new(2.0, 0.0, 0.0),
+            ),
+        ),
+    ])
 }
 
 /// Vertex and triangle buffers that a generator fills before they become a [`Mesh`].

@@ -5,7 +5,8 @@ use glam::{DVec2, Vec3};
 use std::path::PathBuf;
 use std::sync::OnceLock;
 use wirepass::gpu::GpuContext;
-use wirepass::{edge_math, Camera, EdgeSelection, Mesh};
+use wirepass::render::{render, Frame, Method, Shot, World};
+use wirepass::{edge_math, Camera, EdgeSelection, Mesh, Style};
 
 /// One device for the whole test binary. A missing adapter fails loudly: GPU tests never
 /// pass by skipping.
@@ -60,4 +61,84 @@ pub fn cpu_distance(
     let pixel = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
     let size = DVec2::new(f64::from(size.0), f64::from(size.1));
     edge_math::edge_eval(clip, mask, pixel, size).min_distance()
+}
+
+/// Renders one mesh, placed once at the origin, with `method`.
+pub fn shoot(
+    mesh: &Mesh,
+    camera: Camera,
+    style: &Style,
+    size: (u32, u32),
+    edges: EdgeSelection,
+    method: Method,
+) -> Frame {
+    let world = World::single(mesh.clone(), edges);
+    shoot_world(
+        &world,
+        camera.to_view(f64::from(size.0) / f64::from(size.1)),
+        style,
+        size,
+        method,
+    )
+}
+
+/// Renders a world with `method`.
+pub fn shoot_world(
+    world: &World,
+    view: wirepass::View,
+    style: &Style,
+    size: (u32, u32),
+    method: Method,
+) -> Frame {
+    let shot = Shot {
+        world,
+        view,
+        style,
+        size,
+    };
+    render(gpu(), &shot, method).unwrap_or_else(|e| panic!("{}: {e}", method.name()))
+}
+
+/// The camera that frames `mesh` for an image of `size`.
+pub fn framing(mesh: &Mesh, size: (u32, u32)) -> Camera {
+    let (lo, hi) = mesh.bounds_f64();
+    Camera::framing(lo, hi, f64::from(size.0) / f64::from(size.1))
+}
+
+/// One mesh at the origin, a camera, a style and a size: what most tests render.
+pub struct TestScene {
+    pub world: World,
+    pub view: wirepass::View,
+    pub style: Style,
+    pub size: (u32, u32),
+}
+
+impl TestScene {
+    pub fn new(
+        mesh: &Mesh,
+        camera: Camera,
+        style: Style,
+        size: (u32, u32),
+        edges: EdgeSelection,
+    ) -> TestScene {
+        TestScene {
+            world: World::single(mesh.clone(), edges),
+            view: camera.to_view(f64::from(size.0) / f64::from(size.1)),
+            style,
+            size,
+        }
+    }
+
+    pub fn shot(&self) -> Shot<'_> {
+        Shot {
+            world: &self.world,
+            view: self.view,
+            style: &self.style,
+            size: self.size,
+        }
+    }
+
+    pub fn draw(&self, method: Method) -> Frame {
+        render(gpu(), &self.shot(), method).unwrap_or_else(|e| panic!("{}: {e}", method.name()))
+    }
 }

@@ -1,0 +1,187 @@
+// The scene as the compute passes see it: the frame, the instances, the mesh store and the
+// id target, with the exact test of one triangle at one screen point. Assembled after
+// common.wgsl, before the outline and edge passes.
+//
+// Flags: SPLIT (the store's vertex and per-triangle buffers are bound as two halves each).
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(0) @binding(1) var<storage, read> instances: array<Instance>;
+// Per vertex: local position (xyz) and the packed normal's bits (w).
+@group(0) @binding(2) var<storage, read> vertices: array<vec4<f32>>;
+#if SPLIT
+@group(0) @binding(3) var<storage, read> vertices_hi: array<vec4<f32>>;
+#endif
+// Three vertex indices per triangle, relative to the mesh's first vertex.
+@group(0) @binding(4) var<storage, read> indices: array<u32>;
+#if SPLIT
+@group(0) @binding(5) var<storage, read> indices_hi: array<u32>;
+#endif
+// The triangle across each edge (edge i = corner i -> i+1), relative to the mesh's first
+// triangle, or BACKGROUND_ID for boundary and non-manifold edges.
+@group(0) @binding(6) var<storage, read> neighbours: array<u32>;
+#if SPLIT
+@group(0) @binding(7) var<storage, read> neighbours_hi: array<u32>;
+#endif
+// Per triangle (src/gpu/mesh_store.rs, triangle_info): bits 0-2 the drawn edges, bit 3 a
+// boundary edge, bits 4-7 the fold code, bits 8-10 the edges that may be outlines.
+@group(0) @binding(8) var<storage, read> info: array<u32>;
+// (instance slot, triangle of its mesh) per target pixel; BACKGROUND_ID or HOST_ID in x.
+@group(0) @binding(10) var ids: texture_2d<u32>;
+
+fn vertex_at(v: u32) -> vec4<f32> {
+#if SPLIT
+    if v >= frame.vertex_split {
+        return vertices_hi[v - frame.vertex_split];
+    }
+#endif
+    return vertices[v];
+}
+
+// Vertex indices of the store's triangle t (relative to its mesh's first vertex).
+fn corners(t: u32) -> vec3<u32> {
+#if SPLIT
+    if t >= frame.triangle_split {
+        let k = 3u * (t - frame.triangle_split);
+        return vec3<u32>(indices_hi[k], indices_hi[k + 1u], indices_hi[k + 2u]);
+    }
+#endif
+    return vec3<u32>(indices[3u * t], indices[3u * t + 1u], indices[3u * t + 2u]);
+}
+
+// The triangle across edge i of the store's triangle t (relative to its mesh).
+fn neighbour(t: u32, i: u32) -> u32 {
+#if SPLIT
+    if t >= frame.triangle_split {
+        return neighbours_hi[3u * (t - frame.triangle_split) + i];
+    }
+#endif
+    return neighbours[3u * t + i];
+}
+
+// The id target at a target pixel, clamped to the targets.
+fn id_at(q: vec2<i32>) -> vec2<u32> {
+    let last = vec2<i32>(frame.target_size) - 1;
+    return textureLoad(ids, vec2<u32>(clamp(q, vec2<i32>(0), last)), 0).xy;
+}
+
+// Full-image coordinates of a target pixel's centre.
+fn pixel_centre(xy: vec2<u32>) -> vec2<f32> {
+    return vec2<f32>(xy) + frame.target_origin + 0.5;
+}
+
+// Pixels whose centre lies within this many pixels of their triangle's boundary are checked
+// against the triangles of their 3×3 neighbourhood. Rasterizers snap vertices to a sub-pixel
+// grid (8 bits on lavapipe, llvmpipe and desktop GPUs: errors up to 1/512 px), so such a
+// centre may have been given to the wrong side of an edge; the exact test decides.
+const COVERAGE_MARGIN: f32 = 1.0 / 128.0;
+
+// One triangle of one instance seen from one screen point.
+struct Sample {
+    inst: u32,
+    // The triangle, relative to its mesh.
+    tri: u32,
+    // Corners: local position and packed normal.
+    v0: vec4<f32>,
+    v1: vec4<f32>,
+    v2: vec4<f32>,
+    // Corners in clip space (rows x, y, near, w).
+    clip0: vec4<f32>,
+    clip1: vec4<f32>,
+    clip2: vec4<f32>,
+    // Screen lines of the three edges, relative to the point (see `edge_eval`).
+    l0: vec3<f32>,
+    l1: vec3<f32>,
+    l2: vec3<f32>,
+    bary: vec3<f32>,
+    // The point's ray hits the triangle between the near and far planes.
+    covers: bool,
+    // Distances from the point to the three edge lines, drawn or not.
+    lines: vec3<f32>,
+    // The smallest of them.
+    margin: f32,
+    // Near row and w of the hit point: along one ray, a smaller near row is nearer.
+    near: f32,
+    w: f32,
+    // Reverse depth of the hit point (1 at the near plane, 0 at the far plane).
+    depth: f32,
+}
+
+fn sample(inst: u32, tri: u32, point: vec2<f32>) -> Sample {
+    var s: Sample;
+    s.inst = inst;
+    s.tri = tri;
+    let clip = instances[inst].clip;
+    let depth_row = instances[inst].depth_row;
+    let base = instances[inst].vertex_base;
+    let v = corners(instances[inst].triangle_base + tri) + base;
+    s.v0 = vertex_at(v.x);
+    s.v1 = vertex_at(v.y);
+    s.v2 = vertex_at(v.z);
+    let h0 = vec4<f32>(s.v0.xyz, 1.0);
+    let h1 = vec4<f32>(s.v1.xyz, 1.0);
+    let h2 = vec4<f32>(s.v2.xyz, 1.0);
+    s.clip0 = clip * h0;
+    s.clip1 = clip * h1;
+    s.clip2 = clip * h2;
+    let p0 = pixel_relative(s.clip0, point, frame.image_size);
+    let p1 = pixel_relative(s.clip1, point, frame.image_size);
+    let p2 = pixel_relative(s.clip2, point, frame.image_size);
+    s.l0 = cross(p0, p1);
+    s.l1 = cross(p1, p2);
+    s.l2 = cross(p2, p0);
+    let e = vec3<f32>(s.l1.z, s.l2.z, s.l0.z);
+    let sum = e.x + e.y + e.z;
+    s.bary = select(vec3<f32>(-1.0), e / sum, sum != 0.0);
+    let b = s.bary;
+    let hit = b.x * s.clip0 + b.y * s.clip1 + b.z * s.clip2;
+    let r = b.x * dot(depth_row, h0) + b.y * dot(depth_row, h1) + b.z * dot(depth_row, h2);
+    s.covers = all(b >= vec3<f32>(0.0)) && hit.z >= 0.0 && r >= 0.0;
+    s.near = hit.z;
+    s.w = hit.w;
+    s.depth = r / hit.w;
+    s.lines = vec3<f32>(line_distance(s.l0), line_distance(s.l1), line_distance(s.l2));
+    s.margin = min(s.lines.x, min(s.lines.y, s.lines.z));
+    return s;
+}
+
+// True when `a` is nearer than `b` at the same screen point by more than f32 rounding:
+// triangles that meet at an edge or a vertex agree there only to rounding.
+const HIDDEN_MARGIN: f32 = 1.0e-4;
+
+fn nearer(a_near: f32, b_near: f32, b_w: f32) -> bool {
+    return a_near < b_near - HIDDEN_MARGIN * (abs(b_near) + b_w);
+}
+
+// Steps of a walk across edges (`locate`): enough to go round a vertex's fan of small
+// triangles from a rasterized neighbour to the one that owns the point, and, in the
+// outline pass, to cross the few pixels' worth of sub-pixel triangles between a rasterized
+// triangle and one that hides a point of an outline.
+const WALK_STEPS: u32 = 24u;
+
+// Point location by walking: from triangle `tri` of instance `inst`, cross the edge `point`
+// lies beyond, for at most `steps` steps, until a triangle covers it; returns the last
+// triangle's sample. Finds the owner of a point that the rasterizer gave to a neighbour when
+// the owner (a sub-pixel triangle, say) has no rasterized pixel of its own. The walk stays
+// within the instance. With 0 steps it is the sample of `tri` itself. One `sample` in one
+// loop, so a shader holds one copy of it.
+fn locate(inst: u32, tri: u32, point: vec2<f32>, steps: u32) -> Sample {
+    var t = tri;
+    var s: Sample;
+    for (var step = 0u; step <= steps; step++) {
+        s = sample(inst, t, point);
+        let b = s.bary;
+        let lowest = min(b.x, min(b.y, b.z));
+        // Covered, or inside but beyond the near or far plane, or degenerate: stop.
+        if s.covers || lowest >= 0.0 || any(b == vec3<f32>(-1.0)) || step == steps {
+            break;
+        }
+        // Corner k's weight is negative beyond the opposite edge k + 1 (mod 3).
+        let edge = select(select(0u, 2u, b.y == lowest), 1u, b.x == lowest);
+        let next = neighbour(instances[inst].triangle_base + t, edge);
+        if next == BACKGROUND_ID {
+            break;
+        }
+        t = next;
+    }
+    return s;
+}

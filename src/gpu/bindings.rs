@@ -1,0 +1,309 @@
+//! One scaffolding for every pass's bindings. Each shader resource has one fixed binding
+//! number in group 0 (the WGSL files declare the same numbers); a pipeline lists the
+//! resources its entry point reads, and its layout and bind groups are built from that list
+//! alone. So a pipeline binds only what it uses, which keeps every pipeline within
+//! `wgpu::Limits::default()` (8 storage buffers per stage), and no two passes spell out the
+//! same layout.
+
+use super::frame::FrameData;
+use super::mesh_store::{TRIANGLE_BYTES, VERTEX_BYTES};
+use crate::error::{Error, Result};
+
+/// A shader resource and its binding number in group 0.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) enum Res {
+    Frame = 0,
+    Instances = 1,
+    Vertices = 2,
+    VerticesHi = 3,
+    Indices = 4,
+    IndicesHi = 5,
+    Neighbours = 6,
+    NeighboursHi = 7,
+    Info = 8,
+    Clusters = 9,
+    Ids = 10,
+    AccRw = 11,
+    Acc = 12,
+    CullRw = 13,
+    Cull = 14,
+    WorkRw = 15,
+    Work = 16,
+    /// The output colour (a storage texture of the pass's format, or the frame's result).
+    OutColor = 20,
+    /// The host's colour image, for overlay.
+    HostColor = 21,
+    OutDiagnostic = 22,
+    OutIds = 23,
+}
+
+impl Res {
+    fn layout_entry(
+        self,
+        stages: wgpu::ShaderStages,
+        color: wgpu::TextureFormat,
+    ) -> wgpu::BindGroupLayoutEntry {
+        let buffer = |ty| wgpu::BindingType::Buffer {
+            ty,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        };
+        let read = buffer(wgpu::BufferBindingType::Storage { read_only: true });
+        let write = buffer(wgpu::BufferBindingType::Storage { read_only: false });
+        let storage_texture = |format| wgpu::BindingType::StorageTexture {
+            access: wgpu::StorageTextureAccess::WriteOnly,
+            format,
+            view_dimension: wgpu::TextureViewDimension::D2,
+        };
+        let texture = |sample_type| wgpu::BindingType::Texture {
+            sample_type,
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        };
+        use Res::*;
+        let ty = match self {
+            Frame => buffer(wgpu::BufferBindingType::Uniform),
+            AccRw | CullRw | WorkRw => write,
+            Ids => texture(wgpu::TextureSampleType::Uint),
+            HostColor => texture(wgpu::TextureSampleType::Float { filterable: false }),
+            OutColor => storage_texture(color),
+            OutDiagnostic => storage_texture(super::targets::DIAGNOSTIC_FORMAT),
+            OutIds => storage_texture(super::targets::RESOLVED_ID_FORMAT),
+            _ => read,
+        };
+        wgpu::BindGroupLayoutEntry {
+            binding: self as u32,
+            visibility: stages,
+            ty,
+            count: None,
+        }
+    }
+
+    /// Storage buffers among `resources`.
+    pub fn storage_buffers(resources: &[Res]) -> u32 {
+        use Res::*;
+        resources
+            .iter()
+            .filter(|r| {
+                !matches!(
+                    r,
+                    Frame | Ids | HostColor | OutColor | OutDiagnostic | OutIds
+                )
+            })
+            .count() as u32
+    }
+}
+
+/// The scene resources a pass over the mesh store reads, with the second halves of the
+/// split buffers where the store is split.
+pub(crate) fn store_resources(split: bool, neighbours: bool) -> Vec<Res> {
+    let mut r = vec![
+        Res::Frame,
+        Res::Instances,
+        Res::Vertices,
+        Res::Indices,
+        Res::Info,
+    ];
+    if neighbours {
+        r.push(Res::Neighbours);
+    }
+    if split {
+        r.extend([Res::VerticesHi, Res::IndicesHi]);
+        if neighbours {
+            r.push(Res::NeighboursHi);
+        }
+    }
+    r
+}
+
+/// A bind group layout for `resources`, checked against the device's storage buffer limit.
+pub(crate) fn layout(
+    device: &wgpu::Device,
+    label: &str,
+    resources: &[Res],
+    stages: wgpu::ShaderStages,
+    color: wgpu::TextureFormat,
+) -> Result<wgpu::BindGroupLayout> {
+    let storage = Res::storage_buffers(resources);
+    let limit = device.limits().max_storage_buffers_per_shader_stage;
+    if storage > limit {
+        return Err(Error::OverLimit {
+            what: format!("the storage buffers of the {label} pipeline"),
+            value: u64::from(storage),
+            limit_name: "max_storage_buffers_per_shader_stage",
+            limit: u64::from(limit),
+        });
+    }
+    let entries: Vec<_> = resources
+        .iter()
+        .map(|r| r.layout_entry(stages, color))
+        .collect();
+    Ok(
+        device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some(label),
+            entries: &entries,
+        }),
+    )
+}
+
+/// A compute pipeline with the resources it binds.
+pub(crate) struct Compute {
+    pub pipeline: wgpu::ComputePipeline,
+    pub layout: wgpu::BindGroupLayout,
+    pub resources: Vec<Res>,
+}
+
+impl Compute {
+    /// Builds entry point `entry` of `module`, binding `resources`.
+    pub fn new(
+        device: &wgpu::Device,
+        module: &wgpu::ShaderModule,
+        entry: &str,
+        resources: Vec<Res>,
+        color: wgpu::TextureFormat,
+    ) -> Result<Compute> {
+        let label = format!("wirepass {entry}");
+        let layout = layout(
+            device,
+            &label,
+            &resources,
+            wgpu::ShaderStages::COMPUTE,
+            color,
+        )?;
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(&label),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(&label),
+            layout: Some(&pipeline_layout),
+            module,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        Ok(Compute {
+            pipeline,
+            layout,
+            resources,
+        })
+    }
+
+    /// The bind group of this pipeline for `sources`.
+    pub fn bind(&self, device: &wgpu::Device, sources: &Sources<'_>) -> Result<wgpu::BindGroup> {
+        bind_group(device, &self.layout, &self.resources, sources)
+    }
+}
+
+/// Everything a binding may refer to in one frame.
+pub(crate) struct Sources<'a> {
+    pub frame: &'a FrameData,
+    pub ids: Option<&'a wgpu::TextureView>,
+    pub acc: Option<&'a wgpu::Buffer>,
+    pub cull: Option<&'a wgpu::Buffer>,
+    pub work: Option<&'a wgpu::Buffer>,
+    pub out_color: Option<&'a wgpu::TextureView>,
+    pub host_color: Option<&'a wgpu::TextureView>,
+    pub out_diagnostic: Option<&'a wgpu::TextureView>,
+    pub out_ids: Option<&'a wgpu::TextureView>,
+}
+
+impl<'a> Sources<'a> {
+    /// Sources with only the frame's scene.
+    pub fn frame(frame: &'a FrameData) -> Sources<'a> {
+        Sources {
+            frame,
+            ids: None,
+            acc: None,
+            cull: None,
+            work: None,
+            out_color: None,
+            host_color: None,
+            out_diagnostic: None,
+            out_ids: None,
+        }
+    }
+}
+
+/// The first or second binding of a store buffer split after `split` elements of `stride`
+/// bytes; unsplit (`split` at or past the end), the first binds it whole.
+fn half(buffer: &wgpu::Buffer, split: u32, stride: u64, second: bool) -> wgpu::BindingResource<'_> {
+    let at = u64::from(split) * stride;
+    if at >= buffer.size() {
+        return buffer.as_entire_binding();
+    }
+    let (offset, size) = if second {
+        (at, None)
+    } else {
+        (0, wgpu::BufferSize::new(at))
+    };
+    wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+        buffer,
+        offset,
+        size,
+    })
+}
+
+/// A bind group of `layout` binding `resources` from `sources`.
+pub(crate) fn bind_group(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    resources: &[Res],
+    sources: &Sources<'_>,
+) -> Result<wgpu::BindGroup> {
+    let f = sources.frame;
+    let store = &f.store;
+    let missing = |r: Res| Error::Device(format!("no source for the {r:?} binding"));
+    let mut entries = Vec::with_capacity(resources.len());
+    for &r in resources {
+        use Res::*;
+        let resource = match r {
+            Frame => f.frame.as_entire_binding(),
+            Instances => f.instances.as_entire_binding(),
+            Vertices => half(&store.vertices, store.split.vertices, VERTEX_BYTES, false),
+            VerticesHi => half(&store.vertices, store.split.vertices, VERTEX_BYTES, true),
+            Indices => half(&store.indices, store.split.triangles, TRIANGLE_BYTES, false),
+            IndicesHi => half(&store.indices, store.split.triangles, TRIANGLE_BYTES, true),
+            Neighbours => half(
+                &store.neighbours,
+                store.split.triangles,
+                TRIANGLE_BYTES,
+                false,
+            ),
+            NeighboursHi => half(
+                &store.neighbours,
+                store.split.triangles,
+                TRIANGLE_BYTES,
+                true,
+            ),
+            Info => store.info.as_entire_binding(),
+            Clusters => store.clusters.as_entire_binding(),
+            Ids => wgpu::BindingResource::TextureView(sources.ids.ok_or_else(|| missing(r))?),
+            AccRw | Acc => sources.acc.ok_or_else(|| missing(r))?.as_entire_binding(),
+            CullRw | Cull => sources.cull.ok_or_else(|| missing(r))?.as_entire_binding(),
+            WorkRw | Work => sources.work.ok_or_else(|| missing(r))?.as_entire_binding(),
+            OutColor => {
+                wgpu::BindingResource::TextureView(sources.out_color.ok_or_else(|| missing(r))?)
+            }
+            HostColor => {
+                wgpu::BindingResource::TextureView(sources.host_color.ok_or_else(|| missing(r))?)
+            }
+            OutDiagnostic => wgpu::BindingResource::TextureView(
+                sources.out_diagnostic.ok_or_else(|| missing(r))?,
+            ),
+            OutIds => {
+                wgpu::BindingResource::TextureView(sources.out_ids.ok_or_else(|| missing(r))?)
+            }
+        };
+        entries.push(wgpu::BindGroupEntry {
+            binding: r as u32,
+            resource,
+        });
+    }
+    Ok(device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("wirepass"),
+        layout,
+        entries: &entries,
+    }))
+}

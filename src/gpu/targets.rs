@@ -1,0 +1,170 @@
+//! The deferred pass's size-dependent targets, rebuilt only when the size changes: the id
+//! and depth targets of the visibility pass, the outline pass's per-pixel lines, the edge
+//! pass's list of pixels to refine, and, where asked for, the result for compositing and the
+//! diagnostic maps.
+
+use crate::error::{Error, Result};
+
+/// Format of the id target: (instance slot, triangle of its mesh); `u32::MAX` in the first
+/// channel marks background, `u32::MAX − 1` host geometry in front.
+pub const ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Uint;
+/// Format of the depth target (reverse depth: 1 at the near plane, 0 at the far plane).
+pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// Format of the resolved ids the diagnostic output writes: (instance slot, triangle) in the
+/// first two channels (a storage format every backend can write, which `Rg32Uint` is not).
+pub const RESOLVED_ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Uint;
+/// Format of the diagnostic map: distance in pixels (r) and reverse depth (g).
+pub const DIAGNOSTIC_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+/// Format of the result a frame composites into the host's render pass: premultiplied
+/// linear RGBA.
+pub const RESULT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
+/// Size of the header (indirect dispatch size x, y, z, then a count) of the outline and
+/// refine lists.
+pub(crate) const LIST_HEADER: u64 = 16;
+
+#[derive(Clone)]
+pub(crate) struct Targets {
+    /// Size of the id and depth targets (the output plus the guard band).
+    pub size: (u32, u32),
+    /// Size of the output.
+    pub output: (u32, u32),
+    pub ids: wgpu::Texture,
+    pub depth: wgpu::Texture,
+    /// One u32 per target pixel, or two where instances differ in line colour.
+    pub acc: wgpu::Buffer,
+    pub acc_colors: bool,
+    /// The refine list: header, then one packed pixel per entry.
+    pub work: wgpu::Buffer,
+    pub result: Option<wgpu::Texture>,
+    pub diagnostic: Option<(wgpu::Texture, wgpu::Texture)>,
+}
+
+/// What a set of targets must hold.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct TargetSpec {
+    pub size: (u32, u32),
+    pub output: (u32, u32),
+    pub acc_colors: bool,
+    pub result: bool,
+    pub diagnostic: bool,
+}
+
+impl Targets {
+    pub fn spec(&self) -> TargetSpec {
+        TargetSpec {
+            size: self.size,
+            output: self.output,
+            acc_colors: self.acc_colors,
+            result: self.result.is_some(),
+            diagnostic: self.diagnostic.is_some(),
+        }
+    }
+
+    /// Targets for `spec`, after checking them against the device's limits.
+    pub fn new(device: &wgpu::Device, spec: TargetSpec) -> Result<Targets> {
+        let (w, h) = spec.size;
+        let pixels = u64::from(w) * u64::from(h);
+        let binding = device.limits().max_storage_buffer_binding_size;
+        let acc_bytes = pixels * 4 * if spec.acc_colors { 2 } else { 1 };
+        if acc_bytes > binding {
+            return Err(Error::OverLimit {
+                what: format!("the outline buffer for a {w}x{h} target, in bytes"),
+                value: acc_bytes,
+                limit_name: "max_storage_buffer_binding_size",
+                limit: binding,
+            });
+        }
+        let work_bytes = LIST_HEADER + 4 * u64::from(spec.output.0) * u64::from(spec.output.1);
+        if work_bytes > binding {
+            return Err(Error::OverLimit {
+                what: format!(
+                    "the refine list for a {}x{} output, in bytes",
+                    spec.output.0, spec.output.1
+                ),
+                value: work_bytes,
+                limit_name: "max_storage_buffer_binding_size",
+                limit: binding,
+            });
+        }
+        use wgpu::TextureUsages as U;
+        let texture =
+            |label, size, format, usage| super::texture_2d(device, label, size, format, usage);
+        let buffer = |label, size, usage| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | usage,
+                mapped_at_creation: false,
+            })
+        };
+        Ok(Targets {
+            size: spec.size,
+            output: spec.output,
+            ids: texture(
+                "wirepass ids",
+                spec.size,
+                ID_FORMAT,
+                U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC,
+            ),
+            depth: texture(
+                "wirepass depth",
+                spec.size,
+                DEPTH_FORMAT,
+                U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC,
+            ),
+            acc: buffer(
+                "wirepass outline lines",
+                acc_bytes,
+                wgpu::BufferUsages::empty(),
+            ),
+            acc_colors: spec.acc_colors,
+            work: buffer(
+                "wirepass refine list",
+                work_bytes,
+                wgpu::BufferUsages::INDIRECT,
+            ),
+            result: spec.result.then(|| {
+                texture(
+                    "wirepass result",
+                    spec.output,
+                    RESULT_FORMAT,
+                    U::STORAGE_BINDING | U::TEXTURE_BINDING,
+                )
+            }),
+            diagnostic: spec.diagnostic.then(|| {
+                (
+                    texture(
+                        "wirepass diagnostic",
+                        spec.output,
+                        DIAGNOSTIC_FORMAT,
+                        U::STORAGE_BINDING | U::COPY_SRC,
+                    ),
+                    texture(
+                        "wirepass resolved ids",
+                        spec.output,
+                        RESOLVED_ID_FORMAT,
+                        U::STORAGE_BINDING | U::COPY_SRC,
+                    ),
+                )
+            }),
+        })
+    }
+
+    /// GPU memory of these targets, in bytes.
+    pub fn bytes(&self) -> u64 {
+        let tex = |t: &wgpu::Texture| {
+            let texel = t.format().block_copy_size(None).unwrap_or(4);
+            u64::from(t.width()) * u64::from(t.height()) * u64::from(texel)
+        };
+        let mut n = tex(&self.ids) + 4 * u64::from(self.size.0) * u64::from(self.size.1);
+        n += self.acc.size() + self.work.size();
+        if let Some(r) = &self.result {
+            n += tex(r);
+        }
+        if let Some((d, i)) = &self.diagnostic {
+            n += tex(d) + tex(i);
+        }
+        n
+    }
+}

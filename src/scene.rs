@@ -1,0 +1,161 @@
+//! What a frame draws: instances of uploaded meshes, each with its own model transform and
+//! style overrides, seen through one [`View`].
+
+// `!(a > b)` is deliberate throughout: NaN must take the rejecting branch.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+use crate::camera::View;
+use crate::error::{Error, Result};
+use crate::gpu::MeshId;
+use crate::style::{Color, MAX_LINE_WIDTH};
+use glam::DMat4;
+
+/// Per-instance departures from the frame's [`Style`](crate::Style); `None` keeps the
+/// style's setting.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct InstanceStyle {
+    /// Colour of this instance's lines (its edges and its outline).
+    pub wire_color: Option<Color>,
+    /// Width of this instance's lines, in pixels.
+    pub line_width: Option<f32>,
+    /// `Some(false)` draws none of this instance's edges; it still occludes, and still has
+    /// its outline unless `outlines` is `Some(false)` too.
+    pub edges: Option<bool>,
+    /// Whether this instance's outline (silhouettes and boundaries) is drawn; the style's
+    /// [`silhouettes`](crate::Style::silhouettes) otherwise.
+    pub outlines: Option<bool>,
+}
+
+/// One placement of a mesh: which mesh, where (any affine model → world transform,
+/// non-uniform scale and mirroring included), and how it looks.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Instance {
+    /// The mesh, as [`MeshStore::insert`](crate::gpu::MeshStore::insert) returned it.
+    pub mesh: MeshId,
+    /// Model → world, in f64 (precision is kept until the matrix reaches the GPU).
+    pub transform: DMat4,
+    /// Style overrides.
+    pub style: InstanceStyle,
+}
+
+impl Instance {
+    /// An instance of `mesh` at `transform`, in the frame's style.
+    pub fn new(mesh: MeshId, transform: DMat4) -> Instance {
+        Instance {
+            mesh,
+            transform,
+            style: InstanceStyle::default(),
+        }
+    }
+
+    /// This instance with `style` overrides.
+    pub fn with_style(self, style: InstanceStyle) -> Instance {
+        Instance { style, ..self }
+    }
+
+    /// Checks the transform and overrides; `index` names the instance in errors.
+    pub fn validate(&self, index: usize) -> Result<()> {
+        check_transform(&self.transform, index)?;
+        self.style.validate(index)
+    }
+}
+
+impl InstanceStyle {
+    /// Checks the overrides; `index` names the instance in errors.
+    pub fn validate(&self, index: usize) -> Result<()> {
+        let bad = |m: String| Err(Error::InvalidScene(format!("instance {index}: {m}")));
+        if let Some(w) = self.line_width {
+            if !(0.0..=MAX_LINE_WIDTH).contains(&w) {
+                return bad(format!(
+                    "line width {w} is not in 0..={MAX_LINE_WIDTH} pixels"
+                ));
+            }
+        }
+        if let Some(c) = self.wire_color {
+            if c.0.iter().any(|v| !v.is_finite()) {
+                return bad(format!("wire colour {:?} is not finite", c.0));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Checks a model transform: finite, affine (last row 0, 0, 0, 1) and not singular.
+/// `index` names the instance in errors.
+pub fn check_transform(t: &DMat4, index: usize) -> Result<()> {
+    let bad = |m: String| Err(Error::InvalidScene(format!("instance {index}: {m}")));
+    if !t.is_finite() {
+        return bad("the transform has a non-finite entry".into());
+    }
+    if t.row(3) != glam::DVec4::W {
+        return bad(format!(
+            "the transform's last row is {}, not (0, 0, 0, 1): model transforms are affine",
+            t.row(3)
+        ));
+    }
+    if !(t.determinant().abs() > 0.0) {
+        return bad("the transform is singular (a zero scale)".into());
+    }
+    Ok(())
+}
+
+/// A frame's scene: the instances to draw and the view to draw them through.
+///
+/// Every instance goes through one visibility pass and one edge pass, so instances occlude
+/// each other exactly, and each pixel knows which instance and which of its mesh's
+/// triangles it shows.
+///
+/// ```
+/// use wirepass::glam::DMat4;
+/// use wirepass::{Instance, Scene, View};
+/// # fn scene(bunny: wirepass::gpu::MeshId, view: View) -> Scene<'static> {
+/// let instances = vec![
+///     Instance::new(bunny, DMat4::IDENTITY),
+///     // A mirrored, stretched copy beside it.
+///     Instance::new(bunny, DMat4::from_translation((2.0, 0.0, 0.0).into())
+///         * DMat4::from_scale((-1.0, 1.5, 1.0).into())),
+/// ];
+/// Scene::new(view, instances)
+/// # }
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scene<'a> {
+    /// How the scene is seen.
+    pub view: View,
+    /// What is drawn, in order (the order numbers instances in dumps and ids).
+    pub instances: std::borrow::Cow<'a, [Instance]>,
+}
+
+impl<'a> Scene<'a> {
+    /// A scene owning its instance list.
+    pub fn new(view: View, instances: Vec<Instance>) -> Scene<'static> {
+        Scene {
+            view,
+            instances: instances.into(),
+        }
+    }
+
+    /// A scene borrowing the host's instance list.
+    pub fn borrowed(view: View, instances: &'a [Instance]) -> Scene<'a> {
+        Scene {
+            view,
+            instances: instances.into(),
+        }
+    }
+
+    /// Checks the view and every instance.
+    pub fn validate(&self) -> Result<()> {
+        self.view.validate()?;
+        if self.instances.len() >= crate::gpu::MAX_INSTANCES as usize {
+            return Err(Error::InvalidScene(format!(
+                "{} instances; at most {} are supported",
+                self.instances.len(),
+                crate::gpu::MAX_INSTANCES - 1
+            )));
+        }
+        for (i, instance) in self.instances.iter().enumerate() {
+            instance.validate(i)?;
+        }
+        Ok(())
+    }
+}

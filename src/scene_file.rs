@@ -1,0 +1,502 @@
+//! Scene files: a JSON description of objects (meshes with transforms and styles) and a
+//! camera, for `wirepass render|compare|bench SCENE.json`.
+//!
+//! ```json
+//! {
+//!   "objects": [
+//!     { "mesh": "bunny.obj", "transform": { "translate": [0, 0, 0], "rotate_deg": [0, 90, 0], "scale": 2 } },
+//!     { "mesh": "sphere:20000", "transform": [1,0,0,0, 0,1,0,0, 0,0,1,0, 3,0,0,1],
+//!       "edges": "feature:30", "outlines": false, "wire_color": "#c03020", "line_width": 3 }
+//!   ],
+//!   "camera": { "eye": [4, 3, 6], "target": [0, 0, 0], "up": [0, 1, 0], "fov": 40, "near": 0.1, "far": 100 }
+//! }
+//! ```
+//!
+//! - `mesh`: a path relative to the scene file, or a procedural mesh (`sphere:N`, `grid:N`,
+//!   `torus:N`, `layers:K`). Objects naming the same mesh with the same edges share it.
+//! - `transform`: 16 numbers, column-major, or `{"translate", "rotate_deg", "scale"}` (each
+//!   optional): `rotate_deg` turns about X, then Y, then Z (R = Rz·Ry·Rx), `scale` is three
+//!   numbers or one, and the transform is T·R·S.
+//! - `edges`: `all`, `polygon`, `feature[:DEG]` or `none` (draws none of the object's edges;
+//!   it still occludes, and still has its outline unless `outlines` is false). Edge
+//!   selection (feature angles, adjacency, welding) is computed per mesh in its own
+//!   coordinates. Default: the command line's `--edges`.
+//! - `outlines`, `wire_color` (`#rrggbb[aa]`, sRGB), `line_width` (pixels): per-object
+//!   overrides of the command line's style.
+//! - `camera`: `{"eye", "target", "up", "fov", "near", "far"}` (a perspective look-at;
+//!   `far` may be `null` for an infinite far plane), or `{"view": [16], "projection": [16],
+//!   "depth": "standard"|"reversed"}` (column-major matrices as a renderer has them), or
+//!   `{"eye", "target", "up", "orthographic": {"height", "near", "far"}}` (`height` is the
+//!   full height of the view volume in world units). Optional: without it the camera frames
+//!   the scene.
+
+// `!(a > b)` is deliberate throughout: NaN must take the rejecting branch.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+use crate::camera::{Camera, DepthRange, View};
+use crate::error::{Error, Result};
+use crate::mesh::EdgeSelection;
+use crate::render::{Object, World, WorldMesh};
+use crate::scene::InstanceStyle;
+use crate::style::Color;
+use glam::{DMat4, DQuat, DVec3, EulerRot};
+use serde_json::Value;
+use std::collections::HashMap;
+use std::path::Path;
+use std::sync::Arc;
+
+/// A scene file's camera.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FileCamera {
+    /// A perspective look-at camera (its aspect comes from the image size).
+    Perspective(Camera),
+    /// An orthographic look-at view: eye, target, up, full height, near, far.
+    Orthographic {
+        /// Eye position.
+        eye: DVec3,
+        /// Point looked at.
+        target: DVec3,
+        /// Up direction.
+        up: DVec3,
+        /// Height of the view volume in world units.
+        height: f64,
+        /// Near plane distance (may be negative).
+        near: f64,
+        /// Far plane distance.
+        far: f64,
+    },
+    /// The renderer's own matrices, used as they are.
+    Matrices(View),
+}
+
+impl FileCamera {
+    /// The view for an image of aspect `aspect` (width / height).
+    pub fn view(&self, aspect: f64) -> View {
+        match *self {
+            FileCamera::Perspective(c) => c.to_view(aspect),
+            FileCamera::Orthographic {
+                eye,
+                target,
+                up,
+                height,
+                near,
+                far,
+            } => View::orthographic((eye, target, up), height, aspect, (near, far)),
+            FileCamera::Matrices(v) => v,
+        }
+    }
+}
+
+/// Loads a scene file. Objects without `edges` draw `edges`; meshes named more than once (with
+/// the same edges) are loaded once. `load_mesh` turns a mesh spec (procedural name or path,
+/// already made relative to the scene file's folder) into a mesh.
+pub fn load(
+    path: &Path,
+    edges: EdgeSelection,
+    load_mesh: &dyn Fn(&str) -> Result<crate::Mesh>,
+) -> Result<(World, Option<FileCamera>)> {
+    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+        path: path.to_owned(),
+        source,
+    })?;
+    let fail = |message: String| Error::SceneFile {
+        path: path.to_owned(),
+        message,
+    };
+    let json: Value = serde_json::from_str(&text).map_err(|e| fail(format!("not JSON: {e}")))?;
+    let top = json
+        .as_object()
+        .ok_or_else(|| fail("the scene is not a JSON object".into()))?;
+    for key in top.keys() {
+        if key != "objects" && key != "camera" {
+            return Err(fail(format!("unknown field {key:?} (objects, camera)")));
+        }
+    }
+    let objects = top
+        .get("objects")
+        .ok_or_else(|| fail("no \"objects\" list".into()))?
+        .as_array()
+        .ok_or_else(|| fail("\"objects\" is not a list".into()))?;
+    if objects.is_empty() {
+        return Err(fail("\"objects\" is empty".into()));
+    }
+    let base = path.parent().unwrap_or(Path::new("."));
+    let mut world = World::default();
+    let mut loaded: HashMap<(String, String), usize> = HashMap::new();
+    for (i, o) in objects.iter().enumerate() {
+        let field = |name: &str| format!("objects[{i}].{name}");
+        let o = o
+            .as_object()
+            .ok_or_else(|| fail(format!("objects[{i}] is not an object")))?;
+        for key in o.keys() {
+            if ![
+                "mesh",
+                "transform",
+                "edges",
+                "outlines",
+                "wire_color",
+                "line_width",
+            ]
+            .contains(&key.as_str())
+            {
+                return Err(fail(format!(
+                    "{}: unknown field (mesh, transform, edges, outlines, wire_color, line_width)",
+                    field(key)
+                )));
+            }
+        }
+        let spec = o
+            .get("mesh")
+            .and_then(Value::as_str)
+            .ok_or_else(|| fail(format!("{}: missing, or not a string", field("mesh"))))?;
+        let (object_edges, hidden) = match o.get("edges") {
+            None => (edges, false),
+            Some(Value::String(s)) if s == "none" => (edges, true),
+            Some(Value::String(s)) => (
+                s.parse::<EdgeSelection>()
+                    .map_err(|e| fail(format!("{}: {e}", field("edges"))))?,
+                false,
+            ),
+            Some(_) => return Err(fail(format!("{}: not a string", field("edges")))),
+        };
+        let resolved = resolve(base, spec);
+        let key = (resolved.clone(), format!("{object_edges:?}"));
+        let mesh = match loaded.get(&key) {
+            Some(&m) => m,
+            None => {
+                let mesh =
+                    load_mesh(&resolved).map_err(|e| fail(format!("{}: {e}", field("mesh"))))?;
+                world.meshes.push(WorldMesh {
+                    mesh: Arc::new(mesh),
+                    edges: object_edges,
+                    name: spec.to_owned(),
+                });
+                loaded.insert(key, world.meshes.len() - 1);
+                world.meshes.len() - 1
+            }
+        };
+        let transform = match o.get("transform") {
+            None => DMat4::IDENTITY,
+            Some(t) => transform(t).map_err(|m| fail(format!("{}: {m}", field("transform"))))?,
+        };
+        crate::scene::check_transform(&transform, i)
+            .map_err(|e| fail(format!("{}: {e}", field("transform"))))?;
+        let mut style = InstanceStyle {
+            edges: hidden.then_some(false),
+            ..InstanceStyle::default()
+        };
+        if let Some(v) = o.get("outlines") {
+            style.outlines = Some(
+                v.as_bool()
+                    .ok_or_else(|| fail(format!("{}: not true or false", field("outlines"))))?,
+            );
+        }
+        if let Some(v) = o.get("wire_color") {
+            let s = v
+                .as_str()
+                .ok_or_else(|| fail(format!("{}: not a string", field("wire_color"))))?;
+            style.wire_color = Some(
+                Color::from_hex(s).map_err(|e| fail(format!("{}: {e}", field("wire_color"))))?,
+            );
+        }
+        if let Some(v) = o.get("line_width") {
+            let w = v
+                .as_f64()
+                .ok_or_else(|| fail(format!("{}: not a number", field("line_width"))))?;
+            style.line_width = Some(w as f32);
+        }
+        style
+            .validate(i)
+            .map_err(|e| fail(format!("objects[{i}]: {e}")))?;
+        world.objects.push(Object {
+            mesh,
+            transform,
+            style,
+        });
+    }
+    world.validate().map_err(|e| fail(e.to_string()))?;
+    let camera = match top.get("camera") {
+        None => None,
+        Some(c) => Some(camera(c).map_err(|m| fail(format!("camera{m}")))?),
+    };
+    Ok((world, camera))
+}
+
+/// A mesh spec relative to the scene file's folder: procedural names stay as they are.
+fn resolve(base: &Path, spec: &str) -> String {
+    let procedural = spec.parse::<crate::mesh::Procedural>().is_ok();
+    if procedural && !base.join(spec).exists() {
+        return spec.to_owned();
+    }
+    base.join(spec).to_string_lossy().into_owned()
+}
+
+fn numbers(v: &Value, n: usize) -> std::result::Result<Vec<f64>, String> {
+    let list = v
+        .as_array()
+        .ok_or_else(|| format!("expected a list of {n} numbers"))?;
+    if list.len() != n {
+        return Err(format!("expected {n} numbers, got {}", list.len()));
+    }
+    list.iter()
+        .map(|x| {
+            x.as_f64()
+                .filter(|x| x.is_finite())
+                .ok_or_else(|| format!("{x} is not a finite number"))
+        })
+        .collect()
+}
+
+fn vec3(v: &Value) -> std::result::Result<DVec3, String> {
+    numbers(v, 3).map(|n| DVec3::new(n[0], n[1], n[2]))
+}
+
+fn transform(v: &Value) -> std::result::Result<DMat4, String> {
+    if v.is_array() {
+        let n = numbers(v, 16)?;
+        let mut a = [0.0; 16];
+        a.copy_from_slice(&n);
+        return Ok(DMat4::from_cols_array(&a));
+    }
+    let o = v
+        .as_object()
+        .ok_or_else(|| "expected 16 numbers or {translate, rotate_deg, scale}".to_string())?;
+    for key in o.keys() {
+        if !["translate", "rotate_deg", "scale"].contains(&key.as_str()) {
+            return Err(format!(
+                ".{key}: unknown field (translate, rotate_deg, scale)"
+            ));
+        }
+    }
+    let translate = match o.get("translate") {
+        Some(t) => vec3(t).map_err(|m| format!(".translate: {m}"))?,
+        None => DVec3::ZERO,
+    };
+    let rotate = match o.get("rotate_deg") {
+        Some(r) => vec3(r).map_err(|m| format!(".rotate_deg: {m}"))?,
+        None => DVec3::ZERO,
+    };
+    let scale = match o.get("scale") {
+        None => DVec3::ONE,
+        Some(Value::Number(s)) => DVec3::splat(
+            s.as_f64()
+                .filter(|s| s.is_finite())
+                .ok_or(".scale: not a finite number")?,
+        ),
+        Some(s) => vec3(s).map_err(|m| format!(".scale: {m}"))?,
+    };
+    // R = Rz · Ry · Rx: about X first.
+    let r = DQuat::from_euler(
+        EulerRot::ZYX,
+        rotate.z.to_radians(),
+        rotate.y.to_radians(),
+        rotate.x.to_radians(),
+    );
+    Ok(DMat4::from_scale_rotation_translation(scale, r, translate))
+}
+
+fn camera(v: &Value) -> std::result::Result<FileCamera, String> {
+    let o = v.as_object().ok_or(": not an object")?;
+    let get = |k: &str| o.get(k);
+    let num = |k: &str| -> std::result::Result<Option<f64>, String> {
+        match get(k) {
+            None | Some(Value::Null) => Ok(None),
+            Some(x) => x
+                .as_f64()
+                .filter(|x| x.is_finite())
+                .map(Some)
+                .ok_or_else(|| format!(".{k}: not a finite number")),
+        }
+    };
+    let v3 = |k: &str| -> std::result::Result<Option<DVec3>, String> {
+        get(k)
+            .map(|x| vec3(x).map_err(|m| format!(".{k}: {m}")))
+            .transpose()
+    };
+    if let Some(view) = get("view") {
+        for key in o.keys() {
+            if !["view", "projection", "depth"].contains(&key.as_str()) {
+                return Err(format!(
+                    ".{key}: unknown field next to view (projection, depth)"
+                ));
+            }
+        }
+        let m = |x: &Value, k: &str| -> std::result::Result<DMat4, String> {
+            let n = numbers(x, 16).map_err(|m| format!(".{k}: {m}"))?;
+            let mut a = [0.0; 16];
+            a.copy_from_slice(&n);
+            Ok(DMat4::from_cols_array(&a))
+        };
+        let projection = get("projection").ok_or(".projection: missing next to view")?;
+        let depth = match get("depth").map(|d| d.as_str()) {
+            None | Some(Some("standard")) => DepthRange::Standard,
+            Some(Some("reversed")) => DepthRange::Reversed,
+            _ => return Err(".depth: not \"standard\" or \"reversed\"".into()),
+        };
+        let view = View::new(m(view, "view")?, m(projection, "projection")?, depth);
+        view.validate().map_err(|e| format!(": {e}"))?;
+        return Ok(FileCamera::Matrices(view));
+    }
+    let allowed = ["eye", "target", "up", "fov", "near", "far", "orthographic"];
+    for key in o.keys() {
+        if !allowed.contains(&key.as_str()) {
+            return Err(format!(
+                ".{key}: unknown field (eye, target, up, fov, near, far, orthographic, or view and projection)"
+            ));
+        }
+    }
+    let eye = v3("eye")?.ok_or(".eye: missing")?;
+    let target = v3("target")?.unwrap_or(DVec3::ZERO);
+    let up = v3("up")?.unwrap_or(DVec3::Y);
+    if let Some(ortho) = get("orthographic") {
+        let p = ortho.as_object().ok_or(".orthographic: not an object")?;
+        let f = |k: &str| -> std::result::Result<f64, String> {
+            p.get(k)
+                .and_then(Value::as_f64)
+                .filter(|x| x.is_finite())
+                .ok_or_else(|| format!(".orthographic.{k}: missing, or not a finite number"))
+        };
+        let (height, near, far) = (f("height")?, f("near")?, f("far")?);
+        if !(height > 0.0) {
+            return Err(format!(".orthographic.height: {height} is not > 0"));
+        }
+        if !(far > near) {
+            return Err(format!(".orthographic: far {far} is not > near {near}"));
+        }
+        let cam = FileCamera::Orthographic {
+            eye,
+            target,
+            up,
+            height,
+            near,
+            far,
+        };
+        cam.view(1.0).validate().map_err(|e| format!(": {e}"))?;
+        return Ok(cam);
+    }
+    let camera = Camera {
+        eye: eye.as_vec3(),
+        target: target.as_vec3(),
+        up: up.as_vec3(),
+        fov_y_deg: num("fov")?.unwrap_or(40.0) as f32,
+        near: num("near")?.ok_or(".near: missing")? as f32,
+        far: num("far")?.map_or(f32::INFINITY, |f| f as f32),
+    };
+    camera.validate().map_err(|e| format!(": {e}"))?;
+    Ok(FileCamera::Perspective(camera))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn write(name: &str, text: &str) -> std::path::PathBuf {
+        let dir = std::env::temp_dir().join(format!("wirepass-scene-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        path
+    }
+
+    fn procedural(spec: &str) -> Result<crate::Mesh> {
+        spec.parse::<crate::mesh::Procedural>()?.build()
+    }
+
+    #[test]
+    fn trs_is_translate_rotate_scale_about_x_then_y_then_z() {
+        let t = transform(&serde_json::json!({
+            "translate": [1, 2, 3], "rotate_deg": [90, 90, 0], "scale": 2
+        }))
+        .unwrap();
+        // x axis: scaled to 2, turned about X (stays), then about Y: to -z.
+        let p = t.transform_point3(DVec3::X);
+        assert!((p - DVec3::new(1.0, 2.0, 1.0)).length() < 1e-12, "{p}");
+        // y axis: about X to +z, then about Y to +x.
+        let q = t.transform_point3(DVec3::Y);
+        assert!((q - DVec3::new(3.0, 2.0, 3.0)).length() < 1e-12, "{q}");
+    }
+
+    #[test]
+    fn objects_share_meshes_and_take_overrides() {
+        let path = write(
+            "two.json",
+            r##"{"objects": [
+                {"mesh": "sphere:200"},
+                {"mesh": "sphere:200", "transform": {"translate": [3, 0, 0]}, "edges": "none",
+                 "wire_color": "#ff0000", "line_width": 3},
+                {"mesh": "sphere:200", "edges": "all", "outlines": false}
+            ],
+            "camera": {"eye": [0, 0, 5], "orthographic": {"height": 4, "near": 0.1, "far": 20}}}"##,
+        );
+        let (world, camera) = load(&path, EdgeSelection::Polygon, &procedural).unwrap();
+        assert_eq!(world.meshes.len(), 2, "same mesh and edges load once");
+        assert_eq!(world.objects.len(), 3);
+        assert_eq!(world.objects[1].style.edges, Some(false));
+        assert_eq!(world.objects[1].style.line_width, Some(3.0));
+        assert_eq!(world.objects[2].style.outlines, Some(false));
+        assert!(camera.unwrap().view(1.5).is_orthographic());
+    }
+
+    #[test]
+    fn bad_scene_files_name_the_field() {
+        let cases = [
+            ("{", "not JSON"),
+            ("[]", "not a JSON object"),
+            (r#"{"objects": []}"#, "\"objects\" is empty"),
+            (r#"{"objects": [{"mesh": 3}]}"#, "objects[0].mesh"),
+            (
+                r#"{"objects": [{"mesh": "sphere:100", "transform": [1, 2]}]}"#,
+                "objects[0].transform: expected 16 numbers, got 2",
+            ),
+            (
+                r#"{"objects": [{"mesh": "sphere:100", "transform": {"scale": 0}}]}"#,
+                "singular",
+            ),
+            (
+                r#"{"objects": [{"mesh": "sphere:100", "edges": "some"}]}"#,
+                "objects[0].edges",
+            ),
+            (
+                r##"{"objects": [{"mesh": "sphere:100", "colour": "#fff"}]}"##,
+                "objects[0].colour: unknown field",
+            ),
+            (
+                r#"{"objects": [{"mesh": "sphere:100", "line_width": 1000}]}"#,
+                "line width 1000",
+            ),
+            (
+                r#"{"objects": [{"mesh": "missing.obj"}]}"#,
+                "objects[0].mesh",
+            ),
+            (
+                r#"{"objects": [{"mesh": "sphere:100"}], "camera": {"target": [0, 0, 0]}}"#,
+                "camera.eye: missing",
+            ),
+            (
+                r#"{"objects": [{"mesh": "sphere:100"}], "camera": {"view": [1]}}"#,
+                "camera.projection",
+            ),
+            (
+                r#"{"objects": [{"mesh": "sphere:100"}], "camera": {"eye": [0, 0, 5], "orthographic": {"height": -1, "near": 0, "far": 1}}}"#,
+                "camera.orthographic.height",
+            ),
+        ];
+        for (k, (text, want)) in cases.iter().enumerate() {
+            let path = write(&format!("bad{k}.json"), text);
+            let loader = |s: &str| match s.parse::<crate::mesh::Procedural>() {
+                Ok(p) => p.build(),
+                Err(_) => Err(Error::Io {
+                    path: s.into(),
+                    source: std::io::Error::from(std::io::ErrorKind::NotFound),
+                }),
+            };
+            let e = load(&path, EdgeSelection::Polygon, &loader)
+                .err()
+                .unwrap_or_else(|| panic!("{text} loaded"))
+                .to_string();
+            assert!(e.contains(want), "{text}: {e}");
+            assert!(e.contains(&format!("bad{k}.json")), "{e}");
+            assert_eq!(e.lines().count(), 1, "{e}");
+        }
+    }
+}
