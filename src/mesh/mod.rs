@@ -5,6 +5,8 @@ pub mod adjacency;
 pub mod clusters;
 #[cfg(feature = "formats")]
 mod obj;
+#[cfg(feature = "formats")]
+mod polygon;
 mod procedural;
 
 #[cfg(feature = "formats")]
