@@ -4,11 +4,15 @@
 pub mod adjacency;
 pub mod clusters;
 #[cfg(feature = "formats")]
+mod load;
+#[cfg(feature = "formats")]
 mod obj;
 #[cfg(feature = "formats")]
 mod polygon;
 mod procedural;
 
+#[cfg(feature = "formats")]
+pub use load::{format_of, load, Format, FORMATS};
 #[cfg(feature = "formats")]
 pub use obj::load_obj;
 pub use procedural::{default_scene, grid, layers, sphere, torus, Procedural, LAYER_TRIANGLES};

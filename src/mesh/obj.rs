@@ -2,37 +2,23 @@
 //! polygons are triangulated here (not by tobj, whose fan breaks concave faces) so that the
 //! diagonals the triangulation adds can be left out of the polygon edge mask.
 
+use super::load::{build, file_error, io_error, open};
 use super::polygon::{polygon_edges, triangulate};
 use super::Mesh;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use glam::Vec3;
+use std::io::Read;
 use std::path::Path;
 
 /// Loads an OBJ file as one mesh: all objects and groups merged in file order, polygons
 /// ear-clipped, normals taken from the file when every vertex has one (otherwise smooth
 /// normals are computed). Lines, points, materials and texture coordinates are ignored.
 pub fn load_obj(path: &Path) -> Result<Mesh> {
-    let io = |source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    if std::fs::metadata(path).map_err(io)?.is_dir() {
-        return Err(file_error(
-            path,
-            None,
-            "is a directory, not an OBJ file".into(),
-        ));
-    }
-    let bytes = std::fs::read(path).map_err(io)?;
+    let (mut file, len) = open(path, "an OBJ")?;
+    let mut bytes = Vec::with_capacity(usize::try_from(len).unwrap_or(0));
+    file.read_to_end(&mut bytes)
+        .map_err(|e| io_error(path, e))?;
     parse_obj(path, &bytes)
-}
-
-fn file_error(path: &Path, line: Option<usize>, message: String) -> Error {
-    Error::MeshFile {
-        path: path.to_path_buf(),
-        line,
-        message,
-    }
 }
 
 /// Parses the bytes of an OBJ file; `path` only names the file in errors.
@@ -118,10 +104,7 @@ fn parse_obj(path: &Path, bytes: &[u8]) -> Result<Mesh> {
             }
         }
     }
-    Mesh::new(positions, normals, triangles, Some(edges)).map_err(|e| match e {
-        Error::InvalidMesh(message) => fail(None, message),
-        e => e,
-    })
+    build(path, positions, normals, triangles, Some(edges))
 }
 
 /// The three kinds of face index, singular and plural, in the order of `v/vt/vn`.
@@ -484,7 +467,7 @@ mod tests {
     fn missing_files_and_directories_are_io_errors() {
         let missing = std::env::temp_dir().join("wirepass-no-such-file-4711.obj");
         let e = load_obj(&missing).unwrap_err();
-        assert!(matches!(e, Error::Io { .. }), "{e:?}");
+        assert!(matches!(e, crate::Error::Io { .. }), "{e:?}");
         assert!(e.to_string().contains("wirepass-no-such-file-4711.obj"));
         let e = load_obj(&std::env::temp_dir()).unwrap_err();
         assert!(e.to_string().contains("is a directory"), "{e}");
