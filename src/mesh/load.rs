@@ -17,11 +17,18 @@ pub struct Format {
 }
 
 /// The formats [`load`] reads, by extension.
-pub const FORMATS: &[Format] = &[Format {
-    extension: "obj",
-    name: "OBJ",
-    load: super::obj::load_obj,
-}];
+pub const FORMATS: &[Format] = &[
+    Format {
+        extension: "obj",
+        name: "OBJ",
+        load: super::obj::load_obj,
+    },
+    Format {
+        extension: "stl",
+        name: "STL",
+        load: super::stl::load_stl,
+    },
+];
 
 /// The format of `path` by its extension, compared case-insensitively.
 pub fn format_of(path: &Path) -> Option<&'static Format> {
@@ -31,8 +38,9 @@ pub fn format_of(path: &Path) -> Option<&'static Format> {
         .find(|f| f.extension.eq_ignore_ascii_case(extension))
 }
 
-/// Loads a mesh file with the loader its extension names (`.obj`, in any case). A missing file is an [`Error::Io`]; an unknown extension is an
-/// [`Error::MeshFile`] that names the supported ones.
+/// Loads a mesh file with the loader its extension names (`.obj`, `.stl`, in any case).
+/// A missing file is an [`Error::Io`]; an unknown extension is an [`Error::MeshFile`] that
+/// names the supported ones.
 pub fn load(path: &Path) -> Result<Mesh> {
     if let Some(format) = format_of(path) {
         return (format.load)(path);

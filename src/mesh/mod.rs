@@ -10,12 +10,16 @@ mod obj;
 #[cfg(feature = "formats")]
 mod polygon;
 mod procedural;
+#[cfg(feature = "formats")]
+mod stl;
 
 #[cfg(feature = "formats")]
 pub use load::{format_of, load, Format, FORMATS};
 #[cfg(feature = "formats")]
 pub use obj::load_obj;
 pub use procedural::{default_scene, grid, layers, sphere, torus, Procedural, LAYER_TRIANGLES};
+#[cfg(feature = "formats")]
+pub use stl::load_stl;
 
 use crate::error::{Error, Result};
 use glam::Vec3;
