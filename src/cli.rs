@@ -6,15 +6,15 @@ use crate::mesh::{self, Mesh, Procedural};
 use glam::Vec3;
 use std::path::Path;
 
-/// Loads `spec`: a procedural name (`sphere:N`, `grid:N`, `torus:N`), an OBJ file, or, when
-/// `None`, the built-in default scene.
+/// Loads `spec`: a procedural name (`sphere:N`, `grid:N`, `torus:N`), a mesh file (OBJ, STL
+/// or PLY, by extension: see [`mesh::load`]), or, when `None`, the built-in default scene.
 pub fn load_mesh(spec: Option<&str>) -> Result<Mesh> {
     match spec {
         None => Ok(mesh::default_scene()),
         Some(s) if !Path::new(s).exists() && s.contains(':') && !s.contains(['/', '\\']) => {
             s.parse::<Procedural>()?.build()
         }
-        Some(s) => mesh::load_obj(Path::new(s)),
+        Some(s) => mesh::load(Path::new(s)),
     }
 }
 

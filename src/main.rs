@@ -22,7 +22,8 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Render a mesh (an OBJ file, `sphere:N`, `grid:N`, `torus:N`, or the built-in scene).
+    /// Render a mesh (an OBJ, STL or PLY file, `sphere:N`, `grid:N`, `torus:N`, or the
+    /// built-in scene).
     Render(RenderArgs),
     /// Render one scene with the CPU ray-cast ground truth and every GPU method, and report
     /// how closely each matches it (images, error maps, sheet.png, report.json).
@@ -41,7 +42,8 @@ fn parse_edges(s: &str) -> std::result::Result<EdgeSelection, String> {
 /// What to draw and how it looks: shared by `render` and `compare`.
 #[derive(clap::Args)]
 struct SceneArgs {
-    /// OBJ file or procedural mesh (`sphere:20000`, `grid:1k`, `torus:5000`); default: built-in scene.
+    /// OBJ, STL or PLY file, or procedural mesh (`sphere:20000`, `grid:1k`, `torus:5000`);
+    /// default: built-in scene.
     mesh: Option<String>,
     /// Image size WIDTHxHEIGHT.
     #[arg(long, default_value = "800x600")]
@@ -194,8 +196,8 @@ fn compare_command(args: &CompareArgs) -> Result<()> {
 
 #[derive(clap::Args)]
 struct BenchArgs {
-    /// Scenes: OBJ files or procedural meshes (`sphere:20000 sphere:2M`); default: the
-    /// built-in scene.
+    /// Scenes: OBJ, STL or PLY files or procedural meshes (`sphere:20000 sphere:2M`);
+    /// default: the built-in scene.
     scenes: Vec<String>,
     /// Image sizes, comma separated: 1280x720,1920x1080.
     #[arg(long, default_value = "1280x720")]

@@ -28,6 +28,11 @@ pub const FORMATS: &[Format] = &[
         name: "STL",
         load: super::stl::load_stl,
     },
+    Format {
+        extension: "ply",
+        name: "PLY",
+        load: super::ply::load_ply,
+    },
 ];
 
 /// The format of `path` by its extension, compared case-insensitively.
@@ -38,9 +43,9 @@ pub fn format_of(path: &Path) -> Option<&'static Format> {
         .find(|f| f.extension.eq_ignore_ascii_case(extension))
 }
 
-/// Loads a mesh file with the loader its extension names (`.obj`, `.stl`, in any case).
-/// A missing file is an [`Error::Io`]; an unknown extension is an [`Error::MeshFile`] that
-/// names the supported ones.
+/// Loads a mesh file with the loader its extension names (`.obj`, `.stl`, `.ply`, in any
+/// case). A missing file is an [`Error::Io`]; an unknown extension is an
+/// [`Error::MeshFile`] that names the supported ones.
 pub fn load(path: &Path) -> Result<Mesh> {
     if let Some(format) = format_of(path) {
         return (format.load)(path);

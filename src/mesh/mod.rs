@@ -8,6 +8,8 @@ mod load;
 #[cfg(feature = "formats")]
 mod obj;
 #[cfg(feature = "formats")]
+mod ply;
+#[cfg(feature = "formats")]
 mod polygon;
 mod procedural;
 #[cfg(feature = "formats")]
@@ -17,6 +19,8 @@ mod stl;
 pub use load::{format_of, load, Format, FORMATS};
 #[cfg(feature = "formats")]
 pub use obj::load_obj;
+#[cfg(feature = "formats")]
+pub use ply::load_ply;
 pub use procedural::{default_scene, grid, layers, sphere, torus, Procedural, LAYER_TRIANGLES};
 #[cfg(feature = "formats")]
 pub use stl::load_stl;
