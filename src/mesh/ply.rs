@@ -499,7 +499,15 @@ impl<R: BufRead> Loader<'_, R> {
                 self.line += 1;
                 parser.read_ascii_element(&self.text, def).map_err(|e| {
                     let shown: String = self.text.trim().chars().take(80).collect();
-                    format!("cannot read '{shown}': {}", first_line(&e))
+                    let why = first_line(&e);
+                    let why = if why.starts_with("Couldn't parse element line") {
+                        "it is not a list of numbers".to_owned()
+                    } else if why.starts_with("Parse error") {
+                        "a value does not fit its property's type".to_owned()
+                    } else {
+                        why
+                    };
+                    format!("cannot read '{shown}': {why}")
                 })
             }
             Encoding::BinaryLittleEndian => parser

@@ -19,6 +19,8 @@ use std::path::Path;
 const HEADER: u64 = 84;
 /// Bytes of one binary triangle: normal, three corners, attribute count.
 const RECORD: u64 = 50;
+/// Bytes looked at to tell an ASCII file from a binary one whose header says "solid".
+const SNIFF: u64 = 512;
 
 /// Loads a binary or ASCII STL file as one mesh.
 ///
@@ -36,17 +38,20 @@ pub fn load_stl(path: &Path) -> Result<Mesh> {
         return Err(fail(None, "empty file: not an STL file".into()));
     }
     let mut reader = BufReader::new(file);
-    let mut head = Vec::with_capacity(HEADER as usize);
+    // The header, the count and what follows, to tell text from binary.
+    let mut head = Vec::with_capacity(SNIFF as usize);
     (&mut reader)
-        .take(HEADER)
+        .take(SNIFF)
         .read_to_end(&mut head)
         .map_err(|e| io_error(path, e))?;
     reader
         .seek(SeekFrom::Start(0))
         .map_err(|e| io_error(path, e))?;
-    let declared = (head.len() == HEADER as usize)
-        .then(|| u32::from_le_bytes([head[80], head[81], head[82], head[83]]));
+    let declared = head
+        .get(80..84)
+        .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]));
     let expected = declared.map(|n| HEADER + RECORD * u64::from(n));
+    // Control characters other than whitespace mean binary data.
     let text = head.starts_with(b"solid") && !head.iter().any(|&b| b < 9 || (14..32).contains(&b));
 
     if let (Some(n), Some(size)) = (declared, expected) {
