@@ -356,13 +356,18 @@ fn missing_files_and_directories_are_one_clear_line() {
         "{msg}"
     );
 
+    for (name, what) in [
+        ("a-folder.obj", "an OBJ"),
+        ("a-folder.stl", "an STL"),
+        ("a-folder.ply", "a PLY"),
+    ] {
+        let folder = dir.join(name);
+        std::fs::create_dir_all(&folder).unwrap();
+        let msg = load(&folder).unwrap_err().to_string();
+        let expected = format!("{}: is a directory, not {what} file", folder.display());
+        assert_eq!(msg, expected);
+    }
     let folder = dir.join("a-folder.obj");
-    std::fs::create_dir_all(&folder).unwrap();
-    let msg = load(&folder).unwrap_err().to_string();
-    assert!(
-        msg.starts_with(&format!("{}: ", folder.display())) && msg.contains("is a directory"),
-        "{msg}"
-    );
 
     for (path, what) in [(&missing, "No such file"), (&folder, "is a directory")] {
         let (ok, lines, stderr) = render_cli(path, "32x24");

@@ -91,7 +91,7 @@ pub(crate) fn open(path: &Path, format: &str) -> Result<(std::fs::File, u64)> {
         return Err(file_error(
             path,
             None,
-            format!("is a directory, not an {format} file"),
+            format!("is a directory, not {format} file"),
         ));
     }
     Ok((file, metadata.len()))
