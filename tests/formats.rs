@@ -120,6 +120,10 @@ fn stl_binary_and_ascii_load_the_torus_welded() {
         ),
         ("ascii.stl", ascii_stl(&torus, "torus")),
         ("no-name.STL", ascii_stl(&torus, "")),
+        ("no-endsolid.stl", {
+            let text = ascii_stl(&torus, "torus");
+            text[..text.len() - "endsolid torus\n".len()].to_vec()
+        }),
     ] {
         let stl = loaded(&write(name, &bytes));
         check_stl_twin(&stl, &torus);

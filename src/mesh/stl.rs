@@ -30,7 +30,7 @@ const SNIFF: u64 = 512;
 /// facet normals of the file are ignored and smooth normals computed from the welded
 /// triangles: facet normals are flat per triangle (and often zero or stale in real files),
 /// so keeping them would need unwelded corners. Every triangle edge is a polygon edge.
-/// An ASCII file is read up to its first `endsolid`.
+/// An ASCII file is read up to its first `endsolid` (or its end, if that is missing).
 pub fn load_stl(path: &Path) -> Result<Mesh> {
     let (file, len) = open(path, "an STL")?;
     let fail = |line, message| file_error(path, line, message);
@@ -217,6 +217,14 @@ fn read_ascii<R: Read + Seek>(path: &Path, reader: R) -> Result<Mesh> {
     for (t, facet) in facets.enumerate() {
         let facet = match facet {
             Ok(f) => f,
+            // The file ends after a whole facet without `endsolid`, as some writers leave it.
+            Err(e)
+                if e.kind() == std::io::ErrorKind::UnexpectedEof
+                    && e.to_string()
+                        .starts_with("EOF while expecting facet or endsolid") =>
+            {
+                break;
+            }
             Err(e)
                 if e.kind() == std::io::ErrorKind::InvalidData
                     || e.kind() == std::io::ErrorKind::UnexpectedEof =>
