@@ -12,7 +12,8 @@ use glam::{DVec3, Vec3};
 use std::path::Path;
 
 /// Loads one mesh from `spec`: a procedural name (`sphere:N`, `grid:N`, `torus:N`,
-/// `layers:K`), a mesh file, or, when `None`, the built-in default scene as one mesh.
+/// `layers:K`), a mesh file (OBJ, STL or PLY, by extension: see [`mesh::load`]), or, when
+/// `None`, the built-in default scene as one mesh.
 pub fn load_mesh(spec: Option<&str>) -> Result<Mesh> {
     match spec {
         None => Ok(mesh::default_scene()),
@@ -25,7 +26,7 @@ fn mesh_spec(s: &str) -> Result<Mesh> {
     if !Path::new(s).exists() && s.contains(':') && !s.contains(['/', '\\']) {
         return s.parse::<Procedural>()?.build();
     }
-    mesh::load_obj(Path::new(s))
+    mesh::load(Path::new(s))
 }
 
 /// Loads what `spec` names as a world: a scene file (`.json`, with its camera if it has

@@ -22,8 +22,8 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Render a scene (a SCENE.json file, a mesh file, `sphere:N`, `grid:N`, `torus:N`,
-    /// `layers:K`, or the built-in scene).
+    /// Render a scene (a SCENE.json file, an OBJ, STL or PLY file, `sphere:N`, `grid:N`,
+    /// `torus:N`, `layers:K`, or the built-in scene).
     Render(RenderArgs),
     /// Render one scene with the CPU ray-cast ground truth and every GPU method, and report
     /// how closely each matches it (images, error maps, sheet.png, report.json).
@@ -42,8 +42,9 @@ fn parse_edges(s: &str) -> std::result::Result<EdgeSelection, String> {
 /// What to draw and how it looks: shared by `render` and `compare`.
 #[derive(clap::Args)]
 struct SceneArgs {
-    /// Scene file (.json: objects with transforms and styles, and a camera), mesh file, or
-    /// procedural mesh (`sphere:20000`, `grid:1k`, `torus:5000`); default: the built-in scene.
+    /// Scene file (.json: objects with transforms and styles, and a camera), OBJ, STL or PLY
+    /// file, or procedural mesh (`sphere:20000`, `grid:1k`, `torus:5000`); default: the
+    /// built-in scene.
     mesh: Option<String>,
     /// Image size WIDTHxHEIGHT.
     #[arg(long, default_value = "800x600")]
@@ -196,7 +197,8 @@ fn compare_command(args: &CompareArgs) -> Result<()> {
 
 #[derive(clap::Args)]
 struct BenchArgs {
-    /// Scenes: scene files, mesh files or procedural meshes (`sphere:20000 sphere:2M`);
+    /// Scenes: scene files, OBJ, STL or PLY files, or procedural meshes
+    /// (`sphere:20000 sphere:2M`);
     /// default: the built-in scene.
     scenes: Vec<String>,
     /// Which edges to draw (all, polygon, feature[:DEGREES]).

@@ -1,11 +1,43 @@
-//! The catalogue of bad mesh files in `tests/data/bad/`: each one is an `Err` from the
-//! library that names the file, says what is wrong and, where the format has lines, where;
-//! and on the command line it is a non-zero exit with exactly one error line naming the
-//! file, never a panic. A 10,000-corner polygon, a valid face, loads quickly.
+//! The catalogue of bad mesh files in `tests/data/bad/` (OBJ, STL, PLY and an unknown
+//! extension), and binary ones written here: each one is an `Err` from
+//! `wirepass::mesh::load` that names the file, says what is wrong and where (the line in
+//! text formats, the byte offset in binary ones); and on the command line it is a non-zero
+//! exit with exactly one error line naming the file, never a panic. Headers that declare
+//! billions of elements over a few bytes fail at once, without reserving for them. A
+//! 10,000-corner polygon, a valid face, loads quickly.
 
+use std::alloc::{GlobalAlloc, Layout, System};
 use std::path::{Path, PathBuf};
 use std::process::Command;
-use wirepass::mesh::load_obj;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use wirepass::mesh::{load, load_obj};
+
+/// The system allocator, recording the largest single request: a loader that reserves for
+/// a count that a header declares shows up here long before it runs out of memory.
+struct Recording;
+
+static LARGEST: AtomicUsize = AtomicUsize::new(0);
+
+unsafe impl GlobalAlloc for Recording {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        LARGEST.fetch_max(layout.size(), Ordering::Relaxed);
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
+        LARGEST.fetch_max(layout.size(), Ordering::Relaxed);
+        unsafe { System.alloc_zeroed(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        LARGEST.fetch_max(new_size, Ordering::Relaxed);
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static ALLOCATOR: Recording = Recording;
 
 fn bad(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -54,7 +86,158 @@ const CATALOGUE: &[(&str, Option<usize>, &[&str])] = &[
     ("infinite_coordinate.obj", Some(3), &["inf", "not finite"]),
     ("overflowing_coordinate.obj", Some(4), &["not finite"]),
     ("vertices_no_faces.obj", None, &["no faces"]),
+    ("empty.stl", None, &["empty file", "not an STL file"]),
+    (
+        "malformed_facet.stl",
+        Some(12),
+        &["facet 2", "expected 'vertex X Y Z', found 'vertex 1 0'"],
+    ),
+    (
+        "nan_coordinate.stl",
+        Some(5),
+        &["facet 1", "vertex coordinate 'nan' is not finite"],
+    ),
+    ("empty.ply", None, &["empty file", "not a PLY file"]),
+    (
+        "out_of_range_index.ply",
+        Some(14),
+        &["face 2", "vertex index 7, but there are only 3 vertices"],
+    ),
+    (
+        "unknown_property_type.ply",
+        Some(5),
+        &["unknown property type 'int128'"],
+    ),
+    (
+        "huge_vertex_count.ply",
+        None,
+        &[
+            "declares 4000000000 vertex elements",
+            "only 26 bytes follow",
+        ],
+    ),
+    ("no_faces.ply", None, &["no face element", "no faces"]),
+    (
+        "infinite_coordinate.ply",
+        Some(11),
+        &["vertex 2", "y = inf is not finite"],
+    ),
+    (
+        "unknown_extension.xyz",
+        None,
+        &["unknown mesh file extension '.xyz'", ".obj, .stl, .ply"],
+    ),
 ];
+
+/// A binary STL: an 80-byte header, the declared `count`, then `triangles`.
+fn binary_stl(count: u32, triangles: &[[f32; 9]]) -> Vec<u8> {
+    let mut bytes = b"solid looks like text, but is binary".to_vec();
+    bytes.resize(80, b' ');
+    bytes.extend(count.to_le_bytes());
+    for t in triangles {
+        bytes.extend([0u8; 12]);
+        for x in t {
+            bytes.extend(x.to_le_bytes());
+        }
+        bytes.extend([0, 0]);
+    }
+    bytes
+}
+
+/// A binary little-endian PLY header for `vertices` float vertices and `faces` faces.
+fn ply_header(vertices: u64, faces: u64) -> Vec<u8> {
+    format!(
+        "ply\nformat binary_little_endian 1.0\nelement vertex {vertices}\nproperty float x\n\
+         property float y\nproperty float z\nelement face {faces}\n\
+         property list uchar uint vertex_indices\nend_header\n"
+    )
+    .into_bytes()
+}
+
+/// Binary bad files, written here rather than kept in the repository: each one's bytes, the
+/// line of its error (None: binary files have none), and words its message must contain.
+fn binary_cases() -> Vec<(PathBuf, Option<usize>, Vec<String>)> {
+    let tri = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+    let mut nan = tri;
+    nan[7] = f32::NAN;
+    let mut ply_nan = ply_header(3, 1);
+    let data_start = ply_nan.len();
+    for v in [[0.0, 0.0, 0.0], [1.0, f32::INFINITY, 0.0], [0.0, 1.0, 0.0]] {
+        for x in v {
+            ply_nan.extend(x.to_le_bytes());
+        }
+    }
+    ply_nan.push(3);
+    for i in [0u32, 1, 2] {
+        ply_nan.extend(i.to_le_bytes());
+    }
+    let mut ply_huge = ply_header(4_000_000_000, 1);
+    ply_huge.extend([0u8; 40]);
+    let cases: Vec<(&str, Vec<u8>, Vec<String>)> = vec![
+        (
+            "truncated.stl",
+            binary_stl(1000, &[tri]),
+            vec![
+                "binary STL header declares 1000 triangles, 50084 bytes".into(),
+                "the file has 134 bytes (truncated)".into(),
+            ],
+        ),
+        (
+            "huge_count.stl",
+            binary_stl(u32::MAX, &[tri, tri]),
+            vec!["declares 4294967295 triangles".into(), "truncated".into()],
+        ),
+        (
+            "nan_coordinate.stl",
+            binary_stl(2, &[tri, nan]),
+            vec![
+                // Triangle 2 at 134, its corners from 146, the third's y at 146 + 24 + 4.
+                "at byte 174: triangle 2 of 2 has coordinate y = NaN, which is not finite".into(),
+            ],
+        ),
+        (
+            "infinite_coordinate.ply",
+            ply_nan,
+            vec![format!(
+                "at byte {}: vertex 2: y = inf is not finite",
+                data_start + 12
+            )],
+        ),
+        (
+            "huge_vertex_count.ply",
+            ply_huge,
+            vec![
+                "declares 4000000000 vertex elements, at least 48000000000 bytes".into(),
+                "only 40 bytes follow".into(),
+            ],
+        ),
+    ];
+    let dir = temp_dir().join("binary");
+    std::fs::create_dir_all(&dir).unwrap();
+    cases
+        .into_iter()
+        .map(|(name, bytes, words)| {
+            let path = dir.join(name);
+            std::fs::write(&path, bytes).unwrap();
+            (path, None, words)
+        })
+        .collect()
+}
+
+/// Every bad file: the catalogue's and the binary ones.
+fn all_cases() -> Vec<(PathBuf, Option<usize>, Vec<String>)> {
+    CATALOGUE
+        .iter()
+        .map(|&(name, line, words)| {
+            (
+                bad(name),
+                line,
+                words.iter().map(|w| w.to_string()).collect(),
+            )
+        })
+        .chain(binary_cases())
+        .collect()
+}
 
 /// Runs `wirepass render FILE -o out.png`; returns success and the program's own error lines
 /// (drivers may print notices of their own, which are ignored).
@@ -92,9 +275,9 @@ fn catalogue_files_are_errors_that_name_file_line_and_problem() {
             "tests/data/bad/{name} is not in the catalogue"
         );
     }
-    for &(name, line, words) in CATALOGUE {
-        let path = bad(name);
-        let e = match load_obj(&path) {
+    for (path, line, words) in all_cases() {
+        let name = path.display();
+        let e = match load(&path) {
             Ok(m) => panic!("{name} loaded {} triangles", m.triangle_count()),
             Err(e) => e,
         };
@@ -103,34 +286,61 @@ fn catalogue_files_are_errors_that_name_file_line_and_problem() {
             "{name}: {e:?}"
         );
         let msg = e.to_string();
+        assert!(!msg.contains('\n'), "{name}: '{msg}' is more than one line");
         let at = match line {
-            Some(l) => format!("{}:{l}: ", path.display()),
-            None => format!("{}: ", path.display()),
+            Some(l) => format!("{name}:{l}: "),
+            None => format!("{name}: "),
         };
         assert!(
             msg.starts_with(&at),
             "{name}: '{msg}' does not start '{at}'"
         );
-        for w in words {
-            assert!(msg.contains(w), "{name}: '{msg}' lacks '{w}'");
+        for w in &words {
+            assert!(msg.contains(w.as_str()), "{name}: '{msg}' lacks '{w}'");
         }
     }
 }
 
 #[test]
 fn catalogue_files_give_one_cli_error_line_naming_the_file() {
-    for &(name, line, _) in CATALOGUE {
-        let path = bad(name);
+    for (path, line, _) in all_cases() {
+        let name = path.display();
         let (ok, lines, stderr) = render_cli(&path, "32x24");
         assert!(!ok, "{name}: the render succeeded");
         assert_eq!(lines.len(), 1, "{name}: {stderr}");
-        let expected = format!("wirepass: error: {}", load_obj(&path).unwrap_err());
+        let expected = format!("wirepass: error: {}", load(&path).unwrap_err());
         assert_eq!(lines[0], expected, "{name}");
         let at = match line {
-            Some(l) => format!("{}:{l}:", path.display()),
-            None => format!("{}:", path.display()),
+            Some(l) => format!("{name}:{l}:"),
+            None => format!("{name}:"),
         };
         assert!(lines[0].contains(&at), "{name}: {}", lines[0]);
+    }
+}
+
+/// Headers that declare billions of vertices or triangles over a few bytes: each load
+/// fails at once, and no allocation along the way comes near the declared size.
+#[test]
+fn huge_declared_counts_fail_fast_without_reserving_them() {
+    let huge: Vec<PathBuf> = all_cases()
+        .into_iter()
+        .map(|(path, ..)| path)
+        .filter(|p| p.to_string_lossy().contains("huge"))
+        .collect();
+    assert_eq!(huge.len(), 3);
+    for path in huge {
+        LARGEST.store(0, Ordering::Relaxed);
+        let start = std::time::Instant::now();
+        assert!(load(&path).is_err(), "{}", path.display());
+        let took = start.elapsed();
+        let largest = LARGEST.load(Ordering::Relaxed);
+        assert!(took.as_secs_f64() < 1.0, "{}: {took:?}", path.display());
+        // Other tests run alongside, but none of theirs comes near this either.
+        assert!(
+            largest < 16 << 20,
+            "{}: an allocation of {largest} bytes",
+            path.display()
+        );
     }
 }
 
@@ -138,7 +348,7 @@ fn catalogue_files_give_one_cli_error_line_naming_the_file() {
 fn missing_files_and_directories_are_one_clear_line() {
     let dir = temp_dir();
     let missing = dir.join("no-such-mesh.obj");
-    let e = load_obj(&missing).unwrap_err();
+    let e = load(&missing).unwrap_err();
     assert!(matches!(e, wirepass::Error::Io { .. }), "{e:?}");
     let msg = e.to_string();
     assert!(
@@ -146,13 +356,18 @@ fn missing_files_and_directories_are_one_clear_line() {
         "{msg}"
     );
 
+    for (name, what) in [
+        ("a-folder.obj", "an OBJ"),
+        ("a-folder.stl", "an STL"),
+        ("a-folder.ply", "a PLY"),
+    ] {
+        let folder = dir.join(name);
+        std::fs::create_dir_all(&folder).unwrap();
+        let msg = load(&folder).unwrap_err().to_string();
+        let expected = format!("{}: is a directory, not {what} file", folder.display());
+        assert_eq!(msg, expected);
+    }
     let folder = dir.join("a-folder.obj");
-    std::fs::create_dir_all(&folder).unwrap();
-    let msg = load_obj(&folder).unwrap_err().to_string();
-    assert!(
-        msg.starts_with(&format!("{}: ", folder.display())) && msg.contains("is a directory"),
-        "{msg}"
-    );
 
     for (path, what) in [(&missing, "No such file"), (&folder, "is a directory")] {
         let (ok, lines, stderr) = render_cli(path, "32x24");

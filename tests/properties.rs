@@ -1,6 +1,8 @@
 //! Property tests (proptest), bounded to a few seconds in debug builds:
 //! - random OBJ-ish text never panics the loader, and every mesh it accepts has finite
 //!   positions and normals and in-range indices;
+//! - random bytes, and random mutations of valid binary and ASCII STL and PLY files (ASCII,
+//!   little and big endian), never panic their loaders, and what they accept is as valid;
 //! - `edge_math::edge_eval` on random triangles seen by random valid cameras (vertices behind
 //!   the eye included) at random pixels never gives a NaN distance, and its barycentrics sum
 //!   to 1 whenever the triangle's screen area is not degenerate.
@@ -136,6 +138,193 @@ proptest! {
                 prop_assert!(msg.contains(&path.display().to_string()), "{}", msg);
             }
         }
+    }
+}
+
+/// Checks a mesh that a loader accepted: triangles, finite positions and normals, indices
+/// in range; or that an error names the file.
+fn check_loaded(path: &std::path::Path) -> Result<(), TestCaseError> {
+    let result = wirepass::mesh::load(path);
+    std::fs::remove_file(path).unwrap();
+    match result {
+        Ok(mesh) => {
+            let n = mesh.positions().len();
+            prop_assert!(mesh.triangle_count() > 0);
+            prop_assert!(mesh.positions().iter().all(|p| p.is_finite()));
+            prop_assert!(mesh.normals().iter().all(|p| p.is_finite()));
+            prop_assert_eq!(mesh.normals().len(), n);
+            for t in mesh.triangles() {
+                prop_assert!(t.iter().all(|&v| (v as usize) < n), "{:?} of {}", t, n);
+            }
+        }
+        Err(e) => {
+            let msg = e.to_string();
+            prop_assert!(msg.contains(&path.display().to_string()), "{}", msg);
+            prop_assert!(!msg.contains('\n'), "{}", msg);
+        }
+    }
+    Ok(())
+}
+
+fn temp_file(extension: &str, bytes: &[u8]) -> PathBuf {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    static NEXT: AtomicUsize = AtomicUsize::new(0);
+    let dir = std::env::temp_dir().join(format!("wirepass-prop-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let n = NEXT.fetch_add(1, Ordering::Relaxed);
+    let path = dir.join(format!("file-{n}.{extension}"));
+    std::fs::write(&path, bytes).unwrap();
+    path
+}
+
+/// Valid files to mutate, with their extensions: a small sphere (quads and triangles) as
+/// binary and ASCII STL, and as PLY in all three encodings with quads kept whole.
+fn valid_files() -> &'static [(&'static str, Vec<u8>)] {
+    static FILES: std::sync::OnceLock<Vec<(&str, Vec<u8>)>> = std::sync::OnceLock::new();
+    FILES.get_or_init(|| {
+        let mesh = wirepass::mesh::sphere(24).unwrap();
+        let p = mesh.positions();
+        let tris = mesh.triangles();
+        let mut binary = vec![0u8; 80];
+        binary.extend((tris.len() as u32).to_le_bytes());
+        let mut ascii = "solid sphere\n".to_owned();
+        for t in tris {
+            binary.extend([0u8; 12]);
+            ascii.push_str("facet normal 0 0 1\nouter loop\n");
+            for &v in t {
+                let q = p[v as usize];
+                for x in q.to_array() {
+                    binary.extend(x.to_le_bytes());
+                }
+                ascii.push_str(&format!("vertex {} {} {}\n", q.x, q.y, q.z));
+            }
+            binary.extend([0, 0]);
+            ascii.push_str("endloop\nendfacet\n");
+        }
+        ascii.push_str("endsolid sphere\n");
+        // Faces: the sphere's triangles, the first two joined into a quad.
+        let [a, b, c] = tris[0];
+        let d = tris[1]
+            .into_iter()
+            .find(|v| ![a, b, c].contains(v))
+            .unwrap();
+        let mut faces: Vec<Vec<u32>> = vec![vec![a, b, c, d]];
+        faces.extend(tris[2..].iter().map(|t| t.to_vec()));
+        let header = |format: &str| {
+            format!(
+                "ply\nformat {format} 1.0\nelement vertex {}\nproperty float x\n\
+                 property float y\nproperty float z\nelement face {}\n\
+                 property list uchar int vertex_indices\nend_header\n",
+                p.len(),
+                faces.len()
+            )
+        };
+        let mut ply_ascii = header("ascii");
+        for q in p {
+            ply_ascii.push_str(&format!("{} {} {}\n", q.x, q.y, q.z));
+        }
+        for f in &faces {
+            let f: Vec<String> = f.iter().map(u32::to_string).collect();
+            ply_ascii.push_str(&format!("{} {}\n", f.len(), f.join(" ")));
+        }
+        let binary_ply = |big: bool| {
+            let mut out = header(if big {
+                "binary_big_endian"
+            } else {
+                "binary_little_endian"
+            })
+            .into_bytes();
+            let word = |out: &mut Vec<u8>, w: [u8; 4]| {
+                out.extend(if big { [w[3], w[2], w[1], w[0]] } else { w })
+            };
+            for q in p {
+                for x in q.to_array() {
+                    word(&mut out, x.to_le_bytes());
+                }
+            }
+            for f in &faces {
+                out.push(f.len() as u8);
+                for &v in f {
+                    word(&mut out, (v as i32).to_le_bytes());
+                }
+            }
+            out
+        };
+        vec![
+            ("stl", binary),
+            ("stl", ascii.into_bytes()),
+            ("ply", ply_ascii.into_bytes()),
+            ("ply", binary_ply(false)),
+            ("ply", binary_ply(true)),
+        ]
+    })
+}
+
+/// One edit of a file: at a position (taken modulo the length), overwrite, insert or
+/// delete a byte, or cut the file there.
+fn edit() -> impl Strategy<Value = (usize, u8, u8)> {
+    (any::<usize>(), 0u8..10, any::<u8>())
+}
+
+/// Starts that send random bytes past each loader's first checks.
+fn start() -> impl Strategy<Value = &'static [u8]> {
+    prop::sample::select(vec![
+        &b""[..],
+        b"solid ",
+        b"solid x\nfacet normal 0 0 0\nouter loop\nvertex 0 0 0\n",
+        b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n",
+        b"ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n\
+          property float y\nproperty float z\nelement face 1\n\
+          property list uchar int vertex_indices\nend_header\n",
+        b"ply\nformat binary_big_endian 1.0\n",
+    ])
+}
+
+proptest! {
+    #![proptest_config(config())]
+
+    #[test]
+    fn random_bytes_never_panic_the_stl_and_ply_loaders(
+        extension in prop::sample::select(vec!["stl", "ply"]),
+        start in start(),
+        rest in prop::collection::vec(any::<u8>(), 0..600),
+    ) {
+        let mut bytes = start.to_vec();
+        bytes.extend(rest);
+        check_loaded(&temp_file(extension, &bytes))?;
+    }
+
+    #[test]
+    fn mutated_stl_and_ply_files_never_panic(
+        which in 0usize..5,
+        edits in prop::collection::vec(edit(), 1..8),
+    ) {
+        let (extension, valid) = &valid_files()[which];
+        let mut bytes = valid.clone();
+        for (at, op, byte) in edits {
+            let at = at % (bytes.len() + 1);
+            match op {
+                0..=4 if at < bytes.len() => bytes[at] = byte,
+                5 | 6 => bytes.insert(at, byte),
+                7 | 8 if at < bytes.len() => {
+                    bytes.remove(at);
+                }
+                9 => bytes.truncate(at),
+                _ => {}
+            }
+        }
+        check_loaded(&temp_file(extension, &bytes))?;
+    }
+}
+
+#[test]
+fn the_valid_files_load() {
+    for (k, (extension, bytes)) in valid_files().iter().enumerate() {
+        let path = temp_file(extension, bytes);
+        let mesh = wirepass::mesh::load(&path).unwrap_or_else(|e| panic!("file {k}: {e}"));
+        std::fs::remove_file(&path).unwrap();
+        let expected = wirepass::mesh::sphere(24).unwrap().triangle_count();
+        assert_eq!(mesh.triangle_count(), expected, "file {k}");
     }
 }
 

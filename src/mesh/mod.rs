@@ -4,14 +4,28 @@
 pub mod adjacency;
 pub mod clusters;
 #[cfg(feature = "formats")]
+mod load;
+#[cfg(feature = "formats")]
 mod obj;
+#[cfg(feature = "formats")]
+mod ply;
+#[cfg(feature = "formats")]
+mod polygon;
 mod procedural;
+#[cfg(feature = "formats")]
+mod stl;
 
 #[cfg(feature = "formats")]
+pub use load::{format_of, load, Format, FORMATS};
+#[cfg(feature = "formats")]
 pub use obj::load_obj;
+#[cfg(feature = "formats")]
+pub use ply::load_ply;
 pub use procedural::{
     default_parts, default_scene, grid, layers, sphere, torus, Procedural, LAYER_TRIANGLES,
 };
+#[cfg(feature = "formats")]
+pub use stl::load_stl;
 
 use crate::error::{Error, Result};
 use glam::Vec3;

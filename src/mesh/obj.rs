@@ -2,36 +2,23 @@
 //! polygons are triangulated here (not by tobj, whose fan breaks concave faces) so that the
 //! diagonals the triangulation adds can be left out of the polygon edge mask.
 
+use super::load::{build, file_error, io_error, open};
+use super::polygon::{polygon_edges, triangulate};
 use super::Mesh;
-use crate::error::{Error, Result};
-use glam::{DVec2, DVec3, Vec3};
+use crate::error::Result;
+use glam::Vec3;
+use std::io::Read;
 use std::path::Path;
 
 /// Loads an OBJ file as one mesh: all objects and groups merged in file order, polygons
 /// ear-clipped, normals taken from the file when every vertex has one (otherwise smooth
 /// normals are computed). Lines, points, materials and texture coordinates are ignored.
 pub fn load_obj(path: &Path) -> Result<Mesh> {
-    let io = |source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    if std::fs::metadata(path).map_err(io)?.is_dir() {
-        return Err(file_error(
-            path,
-            None,
-            "is a directory, not an OBJ file".into(),
-        ));
-    }
-    let bytes = std::fs::read(path).map_err(io)?;
+    let (mut file, len) = open(path, "an OBJ")?;
+    let mut bytes = Vec::with_capacity(usize::try_from(len).unwrap_or(0));
+    file.read_to_end(&mut bytes)
+        .map_err(|e| io_error(path, e))?;
     parse_obj(path, &bytes)
-}
-
-fn file_error(path: &Path, line: Option<usize>, message: String) -> Error {
-    Error::MeshFile {
-        path: path.to_path_buf(),
-        line,
-        message,
-    }
 }
 
 /// Parses the bytes of an OBJ file; `path` only names the file in errors.
@@ -117,10 +104,7 @@ fn parse_obj(path: &Path, bytes: &[u8]) -> Result<Mesh> {
             }
         }
     }
-    Mesh::new(positions, normals, triangles, Some(edges)).map_err(|e| match e {
-        Error::InvalidMesh(message) => fail(None, message),
-        e => e,
-    })
+    build(path, positions, normals, triangles, Some(edges))
 }
 
 /// The three kinds of face index, singular and plural, in the order of `v/vt/vn`.
@@ -291,120 +275,6 @@ fn face(args: &[&str], counts: [usize; 3]) -> std::result::Result<(), String> {
     Ok(())
 }
 
-/// Edge mask of a triangle whose corners are positions in an `n`-gon: edge `k` is a polygon
-/// edge when it joins consecutive corners (last to first included).
-fn polygon_edges(t: [usize; 3], n: usize) -> u8 {
-    (0..3)
-        .filter(|&k| t[(k + 1) % 3] == (t[k] + 1) % n)
-        .fold(0, |mask, k| mask | 1 << k)
-}
-
-/// Ear clipping of a polygon that may be concave. Appends triangles to `out` as indices into
-/// `points`, in the polygon's winding. O(n²): each vertex's ear status is cached and only
-/// the two neighbours of a clipped ear are re-tested, against the reflex vertices only.
-/// A degenerate remainder without ears (collinear or self-intersecting) becomes a fan.
-fn triangulate(points: &[Vec3], out: &mut Vec<[usize; 3]>) {
-    let n = points.len();
-    if n < 3 {
-        return;
-    }
-    if n == 3 {
-        out.push([0, 1, 2]);
-        return;
-    }
-    // Project onto the plane of the Newell normal by dropping its dominant axis; the cyclic
-    // choice of the other two axes keeps the winding as seen from the normal.
-    let origin = points[0].as_dvec3();
-    let p3 = |i: usize| points[i].as_dvec3() - origin;
-    let mut normal = DVec3::ZERO;
-    for i in 0..n {
-        let (a, b) = (p3(i), p3((i + 1) % n));
-        normal += DVec3::new(
-            (a.y - b.y) * (a.z + b.z),
-            (a.z - b.z) * (a.x + b.x),
-            (a.x - b.x) * (a.y + b.y),
-        );
-    }
-    let m = normal.abs();
-    let (u, v) = if m.x >= m.y && m.x >= m.z {
-        (1, 2)
-    } else if m.y >= m.z {
-        (2, 0)
-    } else {
-        (0, 1)
-    };
-    let pts: Vec<DVec2> = (0..n).map(|i| DVec2::new(p3(i)[u], p3(i)[v])).collect();
-    let area2: f64 = (0..n).map(|i| pts[i].perp_dot(pts[(i + 1) % n])).sum();
-    // `turn > 0` means a left turn in the polygon's own orientation.
-    let sign = if area2 < 0.0 { -1.0 } else { 1.0 };
-    let turn = |a: usize, b: usize, c: DVec2| sign * (pts[b] - pts[a]).perp_dot(c - pts[b]);
-
-    let mut prev: Vec<usize> = (0..n).map(|i| (i + n - 1) % n).collect();
-    let mut next: Vec<usize> = (0..n).map(|i| (i + 1) % n).collect();
-    // Collinear corners count as reflex: they are no ears, and they block ears they touch.
-    let mut reflex: Vec<bool> = (0..n)
-        .map(|i| turn(prev[i], i, pts[next[i]]) <= 0.0)
-        .collect();
-    let mut reflex_list: Vec<usize> = (0..n).filter(|&i| reflex[i]).collect();
-    let is_ear = |i: usize, prev: &[usize], next: &[usize], reflex: &[bool], list: &[usize]| {
-        let (a, c) = (prev[i], next[i]);
-        !reflex[i]
-            && list.iter().all(|&r| {
-                let p = pts[r];
-                r == a
-                    || r == i
-                    || r == c
-                    || p == pts[a]
-                    || p == pts[i]
-                    || p == pts[c]
-                    || turn(a, i, p) < 0.0
-                    || turn(i, c, p) < 0.0
-                    || turn(c, a, p) < 0.0
-            })
-    };
-    let mut ear: Vec<bool> = (0..n)
-        .map(|i| is_ear(i, &prev, &next, &reflex, &reflex_list))
-        .collect();
-
-    // Starting at corner 1 turns a convex polygon into the usual fan around corner 0.
-    let (mut i, mut left) = (1, n);
-    while left > 3 {
-        let mut steps = 0;
-        while !ear[i] && steps < left {
-            i = next[i];
-            steps += 1;
-        }
-        if !ear[i] {
-            break;
-        }
-        let (a, c) = (prev[i], next[i]);
-        out.push([a, i, c]);
-        next[a] = c;
-        prev[c] = a;
-        left -= 1;
-        for k in [a, c] {
-            let was = reflex[k];
-            reflex[k] = turn(prev[k], k, pts[next[k]]) <= 0.0;
-            if reflex[k] && !was {
-                reflex_list.push(k);
-            }
-        }
-        if !(reflex[a] && reflex[c]) {
-            reflex_list.retain(|&r| reflex[r]);
-        }
-        for k in [a, c] {
-            ear[k] = is_ear(k, &prev, &next, &reflex, &reflex_list);
-        }
-        i = c;
-    }
-    // The last triangle, or a fan over a remainder that has no ear.
-    let mut k = next[i];
-    while next[k] != i {
-        out.push([i, k, next[k]]);
-        k = next[k];
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -469,171 +339,6 @@ mod tests {
                 assert_eq!(m.positions().len(), 2930);
             }
         }
-    }
-
-    /// Checks a triangulation of the 2D polygon `poly` (in the XY plane).
-    fn check_triangulation(poly: &[[f64; 2]]) {
-        let n = poly.len();
-        let pts: Vec<Vec3> = poly
-            .iter()
-            .map(|p| Vec3::new(p[0] as f32, p[1] as f32, 0.0))
-            .collect();
-        let mut tris = Vec::new();
-        triangulate(&pts, &mut tris);
-        assert_eq!(tris.len(), n - 2);
-        let cross = |a: [f64; 2], b: [f64; 2], c: [f64; 2]| {
-            (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
-        };
-        let area: f64 = (0..n)
-            .map(|i| cross([0.0, 0.0], poly[i], poly[(i + 1) % n]))
-            .sum();
-        let mut sum = 0.0;
-        let mut boundary = vec![0; n];
-        for &t in &tris {
-            let a = cross(poly[t[0]], poly[t[1]], poly[t[2]]);
-            assert!(a * area >= 0.0, "triangle {t:?} flips the winding");
-            sum += a;
-            let mask = polygon_edges(t, n);
-            for k in 0..3 {
-                let (p, q) = (t[k], t[(k + 1) % 3]);
-                if q == (p + 1) % n {
-                    assert!(mask & 1 << k != 0);
-                    boundary[p] += 1;
-                } else {
-                    assert!(mask & 1 << k == 0, "diagonal {p}-{q} is marked");
-                }
-            }
-        }
-        assert!((sum - area).abs() < 1e-6 * area.abs(), "{sum} != {area}");
-        assert!(boundary.iter().all(|&c| c == 1), "{boundary:?}");
-    }
-
-    #[test]
-    fn ear_clipping_handles_concave_polygons_both_ways_round() {
-        let l_shape = [
-            [0.0, 0.0],
-            [2.0, 0.0],
-            [2.0, 1.0],
-            [1.0, 1.0],
-            [1.0, 2.0],
-            [0.0, 2.0],
-        ];
-        let star: Vec<[f64; 2]> = (0..10)
-            .map(|i| {
-                let r = if i % 2 == 0 { 1.0 } else { 0.4 };
-                let a = i as f64 * std::f64::consts::PI / 5.0;
-                [r * a.cos(), r * a.sin()]
-            })
-            .collect();
-        let comb: Vec<[f64; 2]> = (0..8)
-            .flat_map(|i| [[i as f64, 3.0], [i as f64 + 0.5, 0.5]])
-            .chain([[8.0, 3.0], [8.0, 0.0], [0.0, 0.0]])
-            .rev()
-            .collect();
-        for poly in [l_shape.to_vec(), star, comb] {
-            check_triangulation(&poly);
-            let reversed: Vec<_> = poly.iter().rev().copied().collect();
-            check_triangulation(&reversed);
-        }
-    }
-
-    #[test]
-    fn ear_clipping_handles_random_and_collinear_polygons() {
-        // Star-shaped polygons with random radii are simple, and mostly very concave.
-        let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut rand = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
-        for _ in 0..300 {
-            let n = 4 + (rand() * 60.0) as usize;
-            let poly: Vec<[f64; 2]> = (0..n)
-                .map(|i| {
-                    let a = i as f64 * std::f64::consts::TAU / n as f64;
-                    let r = 0.1 + rand();
-                    [r * a.cos(), r * a.sin()]
-                })
-                .collect();
-            check_triangulation(&poly);
-        }
-        // A square with extra corners along its sides.
-        let square = [
-            [0.0, 0.0],
-            [1.0, 0.0],
-            [2.0, 0.0],
-            [2.0, 1.0],
-            [2.0, 2.0],
-            [1.0, 2.0],
-        ]
-        .into_iter()
-        .chain([[0.0, 2.0], [0.0, 1.0]])
-        .collect::<Vec<_>>();
-        check_triangulation(&square);
-    }
-
-    #[test]
-    fn ear_clipping_works_in_any_plane() {
-        // The L shape (area 3) standing in the YZ plane and in a tilted plane.
-        let l_shape = [
-            [0.0, 0.0],
-            [2.0, 0.0],
-            [2.0, 1.0],
-            [1.0, 1.0],
-            [1.0, 2.0],
-            [0.0, 2.0],
-        ];
-        let tilt = glam::Quat::from_axis_angle(Vec3::new(1.0, 2.0, 0.5).normalize(), 1.2);
-        let upright: Vec<Vec3> = l_shape.iter().map(|p| Vec3::new(7.0, p[0], p[1])).collect();
-        let tilted: Vec<Vec3> = l_shape
-            .iter()
-            .map(|p| tilt * Vec3::new(p[0], p[1], 0.0))
-            .collect();
-        for pts in [upright, tilted] {
-            let mut tris = Vec::new();
-            triangulate(&pts, &mut tris);
-            let area: f32 = tris
-                .iter()
-                .map(|t| {
-                    (pts[t[1]] - pts[t[0]])
-                        .cross(pts[t[2]] - pts[t[0]])
-                        .length()
-                        / 2.0
-                })
-                .sum();
-            assert!((area - 3.0).abs() < 1e-4, "{area}");
-        }
-    }
-
-    #[test]
-    fn degenerate_polygons_do_not_panic() {
-        let line: Vec<Vec3> = (0..7).map(|i| Vec3::new(i as f32, 0.0, 0.0)).collect();
-        let same = vec![Vec3::ONE; 5];
-        let bowtie = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(1.0, 1.0, 0.0)].to_vec();
-        for poly in [line, same, bowtie] {
-            let mut tris = Vec::new();
-            triangulate(&poly, &mut tris);
-            assert_eq!(tris.len(), poly.len() - 2);
-        }
-    }
-
-    #[test]
-    fn ear_clipping_a_10k_gon_is_fast() {
-        let n = 10_000;
-        let pts: Vec<Vec3> = (0..n)
-            .map(|i| {
-                let a = i as f32 * std::f32::consts::TAU / n as f32;
-                Vec3::new(a.cos(), a.sin(), 0.0)
-            })
-            .collect();
-        let start = std::time::Instant::now();
-        let mut tris = Vec::new();
-        triangulate(&pts, &mut tris);
-        assert_eq!(tris.len(), 9_998);
-        let marked: u32 = tris.iter().map(|&t| polygon_edges(t, n).count_ones()).sum();
-        assert_eq!(marked, n as u32);
-        assert!(start.elapsed().as_secs_f64() < 2.0, "{:?}", start.elapsed());
     }
 
     #[test]
@@ -762,7 +467,7 @@ mod tests {
     fn missing_files_and_directories_are_io_errors() {
         let missing = std::env::temp_dir().join("wirepass-no-such-file-4711.obj");
         let e = load_obj(&missing).unwrap_err();
-        assert!(matches!(e, Error::Io { .. }), "{e:?}");
+        assert!(matches!(e, crate::Error::Io { .. }), "{e:?}");
         assert!(e.to_string().contains("wirepass-no-such-file-4711.obj"));
         let e = load_obj(&std::env::temp_dir()).unwrap_err();
         assert!(e.to_string().contains("is a directory"), "{e}");
