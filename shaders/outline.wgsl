@@ -378,16 +378,19 @@ fn draw_piece(seg: Segment, k0: f32, k1: f32, length_px: f32) {
 
 // True unless a triangle other than t and n of `inst` covers the screen point x nearer than
 // the point at near row `near` and w `w` on the edge. The candidates are the triangles the
-// rasterizer gave the four pixel centres around x, and those a walk across edges from them
-// reaches when they do not cover x themselves (x may lie in a small triangle that owns none
-// of those centres).
+// rasterizer gave the 3×3 pixel centres around x (a sliver of surface in front of the edge
+// may own no centre next to x, but one a pixel further on), and those a walk across edges
+// from them reaches when they do not cover x themselves (x may lie in a small triangle that
+// owns none of those centres).
 fn visible_at(x: vec2<f32>, near: f32, w: f32, inst: u32, t: u32, n: u32) -> bool {
-    let base = vec2<i32>(floor(x - frame.target_origin - 0.5));
-    for (var k = 0; k < 4; k++) {
-        let id = id_at(base + vec2<i32>(k & 1, k >> 1u));
-        if id.x >= HOST_ID || (id.x == inst && (id.y == t || id.y == n)) {
+    let centre = vec2<i32>(floor(x - frame.target_origin));
+    var last = vec2<u32>(BACKGROUND_ID, 0u);
+    for (var k = 0; k < 9; k++) {
+        let id = id_at(centre + vec2<i32>(k % 3 - 1, k / 3 - 1));
+        if id.x >= HOST_ID || (id.x == inst && (id.y == t || id.y == n)) || all(id == last) {
             continue;
         }
+        last = id;
         let s = locate(id.x, id.y, x, WALK_STEPS);
         if s.covers && !(s.inst == inst && (s.tri == t || s.tri == n)) && nearer(s.near, near, w) {
             return false;

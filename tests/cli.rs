@@ -201,3 +201,74 @@ fn feature_edges_from_the_command_line() {
     ]);
     assert!(!ok && err.contains("feature:DEGREES"), "{err}");
 }
+
+/// Reads a little-endian u32 `.npy` file (the dumps' id map).
+fn read_u32_npy(path: &std::path::Path) -> Vec<u32> {
+    let bytes = std::fs::read(path).unwrap();
+    let header = 10 + u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
+    bytes[header..]
+        .chunks_exact(4)
+        .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect()
+}
+
+#[test]
+fn renders_a_scene_file_with_global_ids_in_the_dump() {
+    let scene = temp("two.json");
+    std::fs::write(
+        &scene,
+        r#"{"objects": [
+            {"mesh": "sphere:200", "transform": {"translate": [-1.2, 0, 0]}},
+            {"mesh": "sphere:200", "transform": {"translate": [1.2, 0, 0], "scale": [1, 1.5, 1]},
+             "edges": "all", "line_width": 3}
+        ],
+        "camera": {"eye": [0, 0, 6], "orthographic": {"height": 4, "near": 0.1, "far": 20}}}"#,
+    )
+    .unwrap();
+    let png = temp("two.png");
+    let dump = temp("two-dump");
+    let (ok, err) = wirepass(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--size",
+        "96x64",
+        "-o",
+        png.to_str().unwrap(),
+        "--dump",
+        dump.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(err.contains("2 objects"), "{err}");
+    let ids = read_u32_npy(&dump.join("ids.npy"));
+    assert_eq!(ids.len(), 96 * 64);
+    // The sphere has 200 triangles: the second object's ids follow the first's.
+    let triangles = wirepass::mesh::sphere(200).unwrap().triangle_count() as u32;
+    let first = ids.iter().filter(|&&id| id < triangles).count();
+    let second = ids
+        .iter()
+        .filter(|&&id| (triangles..2 * triangles).contains(&id))
+        .count();
+    assert!(first > 100 && second > 100, "{first} and {second} pixels");
+    assert!(ids.iter().all(|&id| id < 2 * triangles || id == u32::MAX));
+    let camera: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dump.join("camera.json")).unwrap()).unwrap();
+    assert_eq!(camera["orthographic"], true);
+    // A bad field in the file is one line naming the file and the field.
+    let bad = temp("bad.json");
+    std::fs::write(
+        &bad,
+        r#"{"objects": [{"mesh": "sphere:200", "transform": [1, 0]}]}"#,
+    )
+    .unwrap();
+    let (ok, err) = wirepass(&["render", bad.to_str().unwrap(), "-o", png.to_str().unwrap()]);
+    assert!(!ok);
+    let lines: Vec<&str> = err
+        .lines()
+        .filter(|l| l.starts_with("wirepass: error:"))
+        .collect();
+    assert_eq!(lines.len(), 1, "{err}");
+    assert!(
+        lines[0].contains("bad.json") && lines[0].contains("objects[0].transform"),
+        "{err}"
+    );
+}

@@ -142,3 +142,29 @@ impl TestScene {
         render(gpu(), &self.shot(), method).unwrap_or_else(|e| panic!("{}: {e}", method.name()))
     }
 }
+
+/// The `n` pixels with the largest distance errors over `bound`, for failure messages.
+pub fn worst_pixels(truth: &Frame, frame: &Frame, bound: f64, n: usize) -> String {
+    let errors = wirepass::compare::distance_errors(truth, frame).unwrap_or_else(|e| panic!("{e}"));
+    let mut worst: Vec<(usize, f64)> = errors
+        .iter()
+        .enumerate()
+        .filter_map(|(i, e)| e.filter(|&e| e > bound).map(|e| (i, e)))
+        .collect();
+    worst.sort_by(|a, b| b.1.total_cmp(&a.1));
+    let width = truth.size.0 as usize;
+    worst
+        .iter()
+        .take(n)
+        .map(|&(i, _)| {
+            format!(
+                "\n    pixel ({}, {}) id {}: truth {} measured {}",
+                i % width,
+                i / width,
+                truth.ids[i] as i64,
+                truth.edge_distance[i],
+                frame.edge_distance[i]
+            )
+        })
+        .collect()
+}
