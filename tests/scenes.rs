@@ -257,12 +257,12 @@ fn moving_one_instance_changes_only_its_pixels() {
         }
     }
     let mut changed = 0;
-    for i in 0..a.ids.len() {
+    for (i, &near) in near_torus.iter().enumerate() {
         let differs = a.ids[i] != b.ids[i] || a.rgba[4 * i..4 * i + 4] != b.rgba[4 * i..4 * i + 4];
         if differs {
             changed += 1;
             assert!(
-                near_torus[i],
+                near,
                 "pixel ({}, {}) changed but the torus is nowhere near it",
                 i as i64 % w,
                 i as i64 / w
