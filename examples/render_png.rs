@@ -40,6 +40,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         &device,
         PassOptions {
             output_format: output.format(),
+            ..Default::default()
         },
     )?;
     let mut meshes = MeshStore::new(&device);

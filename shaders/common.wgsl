@@ -75,6 +75,14 @@ const INSTANCE_OUTLINES: u32 = 2u;
 const BACKGROUND_ID: u32 = 0xffffffffu;
 const HOST_ID: u32 = 0xfffffffeu;
 
+// Host geometry hides a point only when it is nearer by more than this margin (in reverse
+// depth, for a host depth of reverse value `r` and format step `quantum`), so a host that
+// draws the wireframed meshes itself too does not hide their lines with its own copy of
+// them: eight format steps and the f32 rounding of two transforms (src/edge_math.rs).
+fn host_margin(r: f32, quantum: f32) -> f32 {
+    return 1.0e-5 * r + 8.0 * max(quantum, 1.2e-7);
+}
+
 // Distance returned for an edge that is not drawn or not visible.
 const NO_EDGE: f32 = 3.0e38;
 
@@ -289,6 +297,11 @@ fn surface_color(f: Frame, inst: Instance, p: vec3<f32>, normal: vec3<f32>, face
 fn linear_to_srgb(c: vec3<f32>) -> vec3<f32> {
     let x = clamp(c, vec3<f32>(0.0), vec3<f32>(1.0));
     return select(1.055 * pow(x, vec3<f32>(1.0 / 2.4)) - 0.055, 12.92 * x, x <= vec3<f32>(0.0031308));
+}
+
+fn srgb_to_linear(c: vec3<f32>) -> vec3<f32> {
+    let x = clamp(c, vec3<f32>(0.0), vec3<f32>(1.0));
+    return select(pow((x + 0.055) / 1.055, vec3<f32>(2.4)), x / 12.92, x <= vec3<f32>(0.04045));
 }
 
 // Clip position for rasterising onto the targets with reverse depth (1 at near, 0 at far):

@@ -11,7 +11,8 @@
 // the neighbourhood's triangles and the walks across edges from them.
 //
 // Flags: OUTLINES (read what the outline pass left), COLORS (instances differ in line
-// colour: the outline pass also left which instance's line a pixel holds), and the output
+// colour: the outline pass also left which instance's line a pixel holds), HOST (the host's
+// depth seeded the targets: a triangle must also be nearer than it), and the output
 // mode: MODE_SHADE, MODE_OVERLAY, MODE_RESULT (with SHADED: surface and lines, else lines
 // only), MODE_DIAGNOSTIC.
 
@@ -93,6 +94,9 @@ fn finish(xy: vec2<u32>, s: Sample) -> Pixel {
     key = acc[k];
 #endif
 #endif
+    if s.inst == HOST_ID {
+        p.depth = host_at(vec2<i32>(xy));
+    }
     var own = NO_EDGE;
     var own_line = 0.0;
     var own_key = 0u;
@@ -142,7 +146,10 @@ fn store_pixel(xy: vec2<u32>, p: Pixel) {
     textureStore(out_color, out, encode_output(vec4<f32>(mix(base.rgb, p.wire.rgb, i), max(base.a, i))));
 #endif
 #if MODE_OVERLAY
-    let host = textureLoad(host_color, out, 0);
+    var host = textureLoad(host_color, out, 0);
+#if HOST_ENCODED
+    host = vec4<f32>(srgb_to_linear(host.rgb), host.a);
+#endif
     textureStore(out_color, out, encode_output(vec4<f32>(mix(host.rgb, p.wire.rgb, i), max(host.a, i))));
 #endif
 #if MODE_RESULT
@@ -207,9 +214,11 @@ fn edge_main(@builtin(global_invocation_id) gid: vec3<u32>) {
 // triangle, the 3×3 neighbourhood's, and those a walk from them reaches (the walk from the
 // neighbours only when the pixel itself is background). If none covers it, the pixel is
 // background where background is next to it, and keeps the rasterizer's triangle otherwise
-// (the true one is out of reach).
+// (the true one is out of reach). Where the host gave its depth, a triangle must also be
+// nearer than the host's surface at the centre.
 fn resolve(xy: vec2<u32>) -> Sample {
     let point = pixel_centre(xy);
+    let host = host_at(vec2<i32>(xy));
     let raster = textureLoad(ids, xy, 0).xy;
     let raster_empty = raster.x >= HOST_ID;
     var best = no_sample(raster.x);
@@ -233,7 +242,7 @@ fn resolve(xy: vec2<u32>) -> Sample {
             continue;
         }
         let s = locate(id.x, id.y, point, steps);
-        if s.covers && (!found || s.near < best.near) {
+        if s.covers && s.depth > host && (!found || s.near < best.near) {
             best = s;
             found = true;
         }

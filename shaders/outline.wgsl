@@ -363,6 +363,12 @@ fn draw_piece(seg: Segment, k0: f32, k1: f32, length_px: f32) {
                 continue;
             }
             let q = seg_at(seg, best_k);
+#if HOST
+            // The host's surface in this pixel is in front of the line's point.
+            if host_at(xy) > 1.0 - q.near_w {
+                continue;
+            }
+#endif
             let fade = depth_fade(q.fade_w / q.inv_w, frame.fade);
             let key = line_key(line_intensity(best, width) * fade, best);
             let index = u32(xy.y) * u32(frame.target_size.x) + u32(xy.x);
@@ -376,7 +382,8 @@ fn draw_piece(seg: Segment, k0: f32, k1: f32, length_px: f32) {
     }
 }
 
-// True unless a triangle other than t and n of `inst` covers the screen point x nearer than
+// True unless the host's geometry at the pixel containing x is nearer than the edge's point
+// there, or a triangle other than t and n of `inst` covers the screen point x nearer than
 // the point at near row `near` and w `w` on the edge. The candidates are the triangles the
 // rasterizer gave the 3×3 pixel centres around x (a sliver of surface in front of the edge
 // may own no centre next to x, but one a pixel further on), and those a walk across edges
@@ -384,6 +391,10 @@ fn draw_piece(seg: Segment, k0: f32, k1: f32, length_px: f32) {
 // owns none of those centres).
 fn visible_at(x: vec2<f32>, near: f32, w: f32, inst: u32, t: u32, n: u32) -> bool {
     let centre = vec2<i32>(floor(x - frame.target_origin));
+    // Reverse depth is 1 − near/w (the depth row is the w row minus the near row).
+    if host_at(centre) > 1.0 - near / w {
+        return false;
+    }
     var last = vec2<u32>(BACKGROUND_ID, 0u);
     for (var k = 0; k < 9; k++) {
         let id = id_at(centre + vec2<i32>(k % 3 - 1, k / 3 - 1));

@@ -27,6 +27,11 @@
 @group(0) @binding(8) var<storage, read> info: array<u32>;
 // (instance slot, triangle of its mesh) per target pixel; BACKGROUND_ID or HOST_ID in x.
 @group(0) @binding(10) var ids: texture_2d<u32>;
+#if HOST
+// The host's own reverse depth per target pixel, as bits; 0xffffffff where it has no
+// geometry (src/gpu/host.rs).
+@group(0) @binding(17) var host_depth: texture_2d<u32>;
+#endif
 
 fn vertex_at(v: u32) -> vec4<f32> {
 #if SPLIT
@@ -62,6 +67,19 @@ fn neighbour(t: u32, i: u32) -> u32 {
 fn id_at(q: vec2<i32>) -> vec2<u32> {
     let last = vec2<i32>(frame.target_size) - 1;
     return textureLoad(ids, vec2<u32>(clamp(q, vec2<i32>(0), last)), 0).xy;
+}
+
+// The host's reverse depth at target pixel q, or -1 where the host has no geometry there
+// (or gave no depth).
+fn host_at(q: vec2<i32>) -> f32 {
+#if HOST
+    let last = vec2<i32>(frame.target_size) - 1;
+    let v = textureLoad(host_depth, vec2<u32>(clamp(q, vec2<i32>(0), last)), 0).x;
+    if v != 0xffffffffu {
+        return bitcast<f32>(v);
+    }
+#endif
+    return -1.0;
 }
 
 // Full-image coordinates of a target pixel's centre.

@@ -178,6 +178,7 @@ pub fn bench_scene(
     };
     let forward_options = PassOptions {
         output_format: wgpu::TextureFormat::Rgba8UnormSrgb,
+        ..Default::default()
     };
     let attachment = || {
         let usage = wgpu::TextureUsages::RENDER_ATTACHMENT;

@@ -86,6 +86,16 @@ pub fn is_silhouette(a: DVec3, b: DVec3, c: DVec3, d: DVec3, eye: DVec4) -> bool
 /// edge or a vertex agree there only to rounding.
 pub const HIDDEN_MARGIN: f64 = 1e-4;
 
+/// Twin of `host_margin` in common.wgsl: the host's geometry hides a point only where it is
+/// nearer by more than this (in reverse depth, for a host depth of reverse value `r` and a
+/// depth format whose smallest step there is `quantum`): eight format steps and the f32
+/// rounding of two transforms, so a host that also draws the wireframed meshes itself does
+/// not hide their lines with its own copy of them. The host's depth is moved back by it
+/// once, where the pass reads it.
+pub fn host_margin(r: f64, quantum: f64) -> f64 {
+    1e-5 * r + 8.0 * quantum.max(1.2e-7)
+}
+
 /// Twin of `nearer` in scene.wgsl: true when the point with near row `a_near` is nearer than
 /// the one with near row `b_near` and clip w `b_w` at the same screen point, by more than
 /// [`HIDDEN_MARGIN`]. Along one pixel's ray the near row grows with depth, for perspective

@@ -35,6 +35,10 @@ pub mod scene_file;
 
 pub use camera::{Camera, DepthRange, View};
 pub use error::{Error, Result};
+pub use gpu::{
+    Canvas, Composite, DeferredPass, HostDepth, MeshId, MeshStore, OutputTarget, PassOptions,
+    PreparedFrame, RenderTarget,
+};
 pub use mesh::{EdgeSelection, Mesh};
 pub use scene::{Instance, InstanceStyle, Scene};
 pub use style::{Color, Style};

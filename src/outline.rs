@@ -74,6 +74,7 @@ struct Stretch {
     from: DVec2,
     to: DVec2,
     inv_w: [f64; 2],
+    near_w: [f64; 2],
     depth_w: [f64; 2],
     object: u32,
     width: f64,
@@ -85,6 +86,7 @@ pub(crate) fn outline_map(
     rays: &Rays,
     shot: &Shot<'_>,
     styles: &[ObjectStyle],
+    host: Option<&[f64]>,
 ) -> OutlineMap {
     let (width, height) = shot.size;
     let n = width as usize * height as usize;
@@ -96,6 +98,8 @@ pub(crate) fn outline_map(
         caster,
         rays,
         fade_row: shot.view.view_depth_row(),
+        host,
+        width,
     };
     let view = &view;
     let eye = shot.view.eye();
@@ -143,6 +147,11 @@ pub(crate) fn outline_map(
                     if !(d < reach) {
                         continue;
                     }
+                    let near_w = s.near_w[0] + (s.near_w[1] - s.near_w[0]) * at;
+                    // The host's surface in this pixel is in front of the line's point.
+                    if host.is_some_and(|h| h[y * width as usize + x] > 1.0 - near_w) {
+                        continue;
+                    }
                     let inv_w = s.inv_w[0] + (s.inv_w[1] - s.inv_w[0]) * at;
                     let depth = (s.depth_w[0] + (s.depth_w[1] - s.depth_w[0]) * at) / inv_w;
                     let intensity = line_intensity(d, s.width) * depth_fade(depth, fade);
@@ -178,6 +187,9 @@ struct Visibility<'a> {
     caster: &'a RayCaster<'a>,
     rays: &'a Rays,
     fade_row: DVec4,
+    /// The host's reverse depth per pixel (−1 where it has none), if the host gave it.
+    host: Option<&'a [f64]>,
+    width: u32,
 }
 
 impl Visibility<'_> {
@@ -262,6 +274,7 @@ impl Visibility<'_> {
                     from: q0.xy,
                     to: q1.xy,
                     inv_w: [q0.inv_w, q1.inv_w],
+                    near_w: [q0.near_w, q1.near_w],
                     depth_w: [q0.depth_w, q1.depth_w],
                     object,
                     width,
@@ -284,9 +297,18 @@ impl Visibility<'_> {
         }
     }
 
-    /// True unless a triangle other than `t` and `n` of the object (first id `first`)
-    /// covers screen point `x` nearer than the edge's point there (near row and w).
+    /// True unless the host's depth at the pixel containing screen point `x` is nearer than
+    /// the edge's point there (near row and w), or a triangle other than `t` and `n` of the
+    /// object (first id `first`) covers `x` nearer than that point.
     fn visible(&self, x: DVec2, (near, w): (f64, f64), first: u32, (t, n): (u32, u32)) -> bool {
+        if let Some(host) = self.host {
+            let size = self.rays.size();
+            let (px, py) = (x.x.floor(), x.y.floor());
+            let inside = px >= 0.0 && py >= 0.0 && px < size.x && py < size.y;
+            if inside && host[py as usize * self.width as usize + px as usize] > 1.0 - near / w {
+                return false;
+            }
+        }
         let (from, to) = self.rays.segment(x);
         match self.caster.cast(from, to) {
             None => true,
@@ -546,7 +568,7 @@ mod tests {
         };
         let rays = Rays::new(&shot.view, size, &world).unwrap();
         let styles = ObjectStyle::of(&world, style);
-        outline_map(&caster, &rays, &shot, &styles)
+        outline_map(&caster, &rays, &shot, &styles, None)
     }
 
     #[test]
@@ -610,6 +632,8 @@ mod tests {
             caster: &caster,
             rays: &rays,
             fade_row: view.view_depth_row(),
+            host: None,
+            width: 64,
         };
         // Triangle 0's edge 1 runs from (1, -1) to (1, 1): visible only above y = 0, i.e. on
         // screen from the middle row up, ending where the near quad's top edge crosses it.

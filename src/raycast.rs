@@ -24,7 +24,7 @@ use crate::camera::{ClipRows, View};
 use crate::edge_math;
 use crate::error::{Error, Result};
 use crate::gpu::light_world_dir;
-use crate::render::{Frame, Shot, World, BACKGROUND};
+use crate::render::{Frame, Shot, World, BACKGROUND, HOST};
 use crate::style::{self, Color};
 use glam::{DMat3, DMat4, DVec2, DVec3, DVec4, Vec3A};
 use obvhs::aabb::Aabb;
@@ -342,9 +342,97 @@ impl ObjectStyle {
     }
 }
 
+/// Geometry the host draws itself, not wireframed, as its depth buffer shows it to the pass:
+/// per pixel, the farthest of the host's samples (none where any sample misses), moved back
+/// by [`host_margin`](edge_math::host_margin).
+pub struct HostOccluders<'a> {
+    /// The host's own meshes, placed.
+    pub world: &'a World,
+    /// The sample positions within a pixel, (0, 0) its top left corner.
+    pub samples: Vec<DVec2>,
+    /// The smallest step of the host's depth format, in reverse depth
+    /// ([`depth_quantum`](crate::gpu::depth_quantum)).
+    pub quantum: f64,
+}
+
+impl<'a> HostOccluders<'a> {
+    /// One sample per pixel, at its centre, in a `Depth32Float` buffer.
+    pub fn single(world: &'a World) -> Self {
+        HostOccluders {
+            world,
+            samples: vec![DVec2::splat(0.5)],
+            quantum: crate::gpu::depth_quantum(
+                wgpu::TextureFormat::Depth32Float,
+                crate::camera::DepthRange::Standard,
+            ),
+        }
+    }
+
+    /// The standard 4× multisample pattern of Vulkan, D3D and Metal.
+    pub fn msaa4(world: &'a World) -> Self {
+        HostOccluders {
+            samples: [
+                (0.375, 0.125),
+                (0.875, 0.375),
+                (0.125, 0.625),
+                (0.625, 0.875),
+            ]
+            .map(|(x, y)| DVec2::new(x, y))
+            .to_vec(),
+            ..Self::single(world)
+        }
+    }
+
+    /// The same samples in a depth buffer of `format` holding depth in `depth`'s convention.
+    pub fn with_format(
+        self,
+        format: wgpu::TextureFormat,
+        depth: crate::camera::DepthRange,
+    ) -> Self {
+        HostOccluders {
+            quantum: crate::gpu::depth_quantum(format, depth),
+            ..self
+        }
+    }
+
+    /// Per pixel of `shot`, the host's reverse depth (moved back by the margin), or −1 where
+    /// the host has no geometry.
+    fn depth_map(&self, shot: &Shot<'_>) -> Result<Vec<f64>> {
+        let caster = RayCaster::new(self.world);
+        let rays = Rays::new(&shot.view, shot.size, self.world)?;
+        let (width, height) = shot.size;
+        Ok((0..height)
+            .into_par_iter()
+            .flat_map_iter(|y| {
+                let (caster, rays) = (&caster, &rays);
+                (0..width).map(move |x| {
+                    let corner = DVec2::new(f64::from(x), f64::from(y));
+                    let mut farthest = f64::INFINITY;
+                    for &s in &self.samples {
+                        let (from, to) = rays.segment(corner + s);
+                        let Some(hit) = caster.cast(from, to) else {
+                            return -1.0;
+                        };
+                        let c = rays.clip(hit.point);
+                        farthest = farthest.min(1.0 - c.z / c.w);
+                    }
+                    (farthest - edge_math::host_margin(farthest, self.quantum)).clamp(0.0, 1.0)
+                })
+            })
+            .collect())
+    }
+}
+
 /// Renders `shot` by ray casting on the CPU in f64: the reference every GPU method is
 /// measured against. Fills every map of the [`Frame`].
 pub fn render_raycast(shot: &Shot<'_>) -> Result<Frame> {
+    render_raycast_over(shot, None)
+}
+
+/// [`render_raycast`] over the host's own geometry: where the host is nearer, a pixel shows
+/// [`HOST`], its lines are hidden, and outlines are hidden where the host's depth at the
+/// pixel containing their point is nearer.
+pub fn render_raycast_over(shot: &Shot<'_>, host: Option<&HostOccluders<'_>>) -> Result<Frame> {
     let (width, height) = shot.size;
     if width == 0 || height == 0 {
         return Err(Error::InvalidSetting(format!(
@@ -368,7 +456,11 @@ pub fn render_raycast(shot: &Shot<'_>) -> Result<Frame> {
         .collect();
     let styles = ObjectStyle::of(world, shot.style);
     let shading = Shading::new(shot);
-    let outline = crate::outline::outline_map(&caster, &rays, shot, &styles);
+    let host = match host {
+        Some(h) => Some(h.depth_map(shot)?),
+        None => None,
+    };
+    let outline = crate::outline::outline_map(&caster, &rays, shot, &styles, host.as_deref());
 
     let pixels = u64::from(width) * u64::from(height);
     let bar = progress_bar(u64::from(height), pixels);
@@ -385,7 +477,9 @@ pub fn render_raycast(shot: &Shot<'_>) -> Result<Frame> {
             let row = (0..width)
                 .map(|x| {
                     let pixel = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
-                    gt.sample(pixel, outline.line[(y * width + x) as usize])
+                    let k = (y * width + x) as usize;
+                    let host = host.as_ref().map_or(-1.0, |h| h[k]);
+                    gt.sample(pixel, outline.line[k], host)
                 })
                 .collect();
             bar.inc(1);
@@ -477,12 +571,16 @@ struct Truth<'a> {
 
 impl Truth<'_> {
     /// The ground truth at one pixel centre; `outline` is the pixel's line from the outline
-    /// map.
-    fn sample(&self, pixel: DVec2, outline: Option<Line>) -> Sample {
+    /// map, `host` the host's reverse depth there (−1 for none).
+    fn sample(&self, pixel: DVec2, outline: Option<Line>, host: f64) -> Sample {
         let sh = self.shading;
         let world = self.caster.world();
         let (from, to) = self.rays.segment(pixel);
-        let Some(hit) = self.caster.cast(from, to) else {
+        let hit = self.caster.cast(from, to).filter(|h| {
+            let c = self.rays.clip(h.point);
+            1.0 - c.z / c.w >= host
+        });
+        let Some(hit) = hit else {
             let bg = sh.background.0.map(f64::from);
             let (i, wire) = outline.map_or((0.0, [0.0; 4]), |l| {
                 let w = self.styles[l.object as usize].wire;
@@ -490,8 +588,12 @@ impl Truth<'_> {
             });
             let mix = |k: usize| (bg[k] + (wire[k] - bg[k]) * i) as f32;
             return Sample {
-                id: BACKGROUND,
-                depth: 1.0,
+                id: if host >= 0.0 { HOST } else { BACKGROUND },
+                depth: if host >= 0.0 {
+                    (1.0 - host) as f32
+                } else {
+                    1.0
+                },
                 distance: outline.map_or(f64::INFINITY, |l| l.distance) as f32,
                 rgba: Color([mix(0), mix(1), mix(2), bg[3].max(i) as f32]).to_srgb8(),
             };

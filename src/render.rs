@@ -427,6 +427,7 @@ pub fn render_forward(ctx: &GpuContext, shot: &Shot<'_>) -> Result<Frame> {
     let up = Uploaded::new(ctx, shot.world)?;
     let options = PassOptions {
         output_format: FORWARD_OUTPUT,
+        ..Default::default()
     };
     let mut pass = ForwardPass::new(device, options)?;
     let scene = up.scene(shot.world, shot.view);
@@ -449,6 +450,7 @@ pub fn render_two_pass(ctx: &GpuContext, shot: &Shot<'_>) -> Result<Frame> {
     let lines = up.edge_lines(ctx, shot.world)?;
     let options = PassOptions {
         output_format: FORWARD_OUTPUT,
+        ..Default::default()
     };
     let mut pass = TwoPass::new(device, options)?;
     let scene = up.scene(shot.world, shot.view);

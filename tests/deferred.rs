@@ -237,6 +237,7 @@ fn overlay_blends_lines_over_the_host_image_and_resizes() {
         device,
         PassOptions {
             output_format: wgpu::TextureFormat::Rgba16Float,
+            ..Default::default()
         },
     )
     .unwrap()

@@ -29,6 +29,8 @@ pub(crate) enum Res {
     Cull = 14,
     WorkRw = 15,
     Work = 16,
+    /// The host's depth (reverse depth bits per target pixel).
+    HostDepth = 17,
     /// The output colour (a storage texture of the pass's format, or the frame's result).
     OutColor = 20,
     /// The host's colour image, for overlay.
@@ -64,7 +66,7 @@ impl Res {
         let ty = match self {
             Frame => buffer(wgpu::BufferBindingType::Uniform),
             AccRw | CullRw | WorkRw => write,
-            Ids => texture(wgpu::TextureSampleType::Uint),
+            Ids | HostDepth => texture(wgpu::TextureSampleType::Uint),
             HostColor => texture(wgpu::TextureSampleType::Float { filterable: false }),
             OutColor => storage_texture(color),
             OutDiagnostic => storage_texture(super::targets::DIAGNOSTIC_FORMAT),
@@ -87,7 +89,7 @@ impl Res {
             .filter(|r| {
                 !matches!(
                     r,
-                    Frame | Ids | HostColor | OutColor | OutDiagnostic | OutIds
+                    Frame | Ids | HostDepth | HostColor | OutColor | OutDiagnostic | OutIds
                 )
             })
             .count() as u32
@@ -200,6 +202,7 @@ impl Compute {
 pub(crate) struct Sources<'a> {
     pub frame: &'a FrameData,
     pub ids: Option<&'a wgpu::TextureView>,
+    pub host_depth: Option<&'a wgpu::TextureView>,
     pub acc: Option<&'a wgpu::Buffer>,
     pub cull: Option<&'a wgpu::Buffer>,
     pub work: Option<&'a wgpu::Buffer>,
@@ -215,6 +218,7 @@ impl<'a> Sources<'a> {
         Sources {
             frame,
             ids: None,
+            host_depth: None,
             acc: None,
             cull: None,
             work: None,
@@ -280,6 +284,9 @@ pub(crate) fn bind_group(
             Info => store.info.as_entire_binding(),
             Clusters => store.clusters.as_entire_binding(),
             Ids => wgpu::BindingResource::TextureView(sources.ids.ok_or_else(|| missing(r))?),
+            HostDepth => {
+                wgpu::BindingResource::TextureView(sources.host_depth.ok_or_else(|| missing(r))?)
+            }
             AccRw | Acc => sources.acc.ok_or_else(|| missing(r))?.as_entire_binding(),
             CullRw | Cull => sources.cull.ok_or_else(|| missing(r))?.as_entire_binding(),
             WorkRw | Work => sources.work.ok_or_else(|| missing(r))?.as_entire_binding(),

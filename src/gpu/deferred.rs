@@ -2,16 +2,18 @@
 //! the edge pass, for a whole scene of instances at once.
 
 use super::bindings::{store_resources, Compute, Res, Sources};
-use super::frame::{FrameData, Window};
+use super::composite::{Composite, CompositePipeline, RenderTarget};
+use super::frame::{Canvas, FrameData};
+use super::host::{HostFrame, HostImport};
 use super::mesh_store::MeshStore;
-use super::targets::{TargetSpec, Targets, LIST_HEADER};
+use super::targets::{TargetSpec, Targets, LIST_HEADER, RESULT_FORMAT};
 use super::visibility::Visibility;
 use super::{shaders, GpuTimer};
 use crate::error::{Error, Result};
 use crate::scene::Scene;
 use crate::style::Style;
 use std::collections::HashMap;
-use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 use wgpu::util::DeviceExt;
 
@@ -27,12 +29,15 @@ pub struct PassOptions {
     /// [`OutputTarget::Overlay`] write: `Rgba8Unorm` (written sRGB-encoded), `Rgba16Float`
     /// or `Rgba32Float` (linear). It needs `STORAGE_BINDING` usage.
     pub output_format: wgpu::TextureFormat,
+    /// The host's render pass that [`DeferredPass::render`] draws into, if it is used.
+    pub render_target: Option<RenderTarget>,
 }
 
 impl Default for PassOptions {
     fn default() -> Self {
         Self {
             output_format: wgpu::TextureFormat::Rgba8Unorm,
+            render_target: None,
         }
     }
 }
@@ -43,8 +48,9 @@ pub enum OutputTarget<'a> {
     /// output format and the frame's size.
     Shaded(&'a wgpu::TextureView),
     /// Post-process: blend the lines over the host's colour image `host` (a sampled
-    /// texture of the frame's size, holding linear values, or sRGB-encoded ones in an sRGB
-    /// format) into `output`. Background pixels copy `host`.
+    /// texture of the frame's size) into `output`; pixels without a line copy `host`. A
+    /// float or sRGB host format holds what it says; an 8-bit host format without sRGB is
+    /// taken to hold sRGB-encoded values, like the pass's own `Rgba8Unorm` output.
     Overlay {
         /// The host's rendered colour, read as a float texture.
         host: &'a wgpu::TextureView,
@@ -59,13 +65,17 @@ pub enum OutputTarget<'a> {
     /// The benchmark floor: reads each pixel's id and writes the fill or background colour
     /// into the output, doing none of the edge work. What a deferred pass cannot go below.
     Floor(&'a wgpu::TextureView),
+    /// The frame's own result, which [`DeferredPass::render`] then draws into the host's
+    /// render pass (needs [`PassOptions::render_target`]).
+    RenderPass,
 }
 
 /// What the edge pass writes, which selects its pipeline.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 enum Mode {
     Shade,
-    Overlay,
+    Overlay { encoded: bool },
+    Result { shaded: bool },
     Diagnostic,
 }
 
@@ -75,6 +85,7 @@ struct Variant {
     split: bool,
     outlines: bool,
     colors: bool,
+    host: bool,
 }
 
 struct EdgePipelines {
@@ -95,6 +106,11 @@ pub struct PreparedFrame {
     pub(crate) data: FrameData,
     pub(crate) targets: Targets,
     cull: wgpu::Buffer,
+    host: Option<HostFrame>,
+    /// The composite's bind group over this frame's result, with a render target.
+    composite: Option<wgpu::BindGroup>,
+    /// Which of the pass's encodes last wrote this frame's result (0: none yet).
+    encoded: AtomicU64,
 }
 
 impl PreparedFrame {
@@ -143,9 +159,13 @@ pub struct DeferredPass {
     id: u32,
     format: wgpu::TextureFormat,
     visibility: Visibility,
+    host: HostImport,
     edge: Mutex<HashMap<(Mode, Variant), Arc<EdgePipelines>>>,
     outline: Mutex<HashMap<Variant, Arc<OutlinePipelines>>>,
     floor: Compute,
+    composite: Option<(CompositePipeline, Composite)>,
+    /// Counts the encodes that write a result for [`render`](Self::render).
+    results: AtomicU64,
     /// Header every list starts a frame with: no work, one workgroup row.
     reset: wgpu::Buffer,
     diagnostics: bool,
@@ -186,6 +206,10 @@ impl DeferredPass {
             vec![Res::Frame, Res::Ids, Res::OutColor],
             format,
         )?;
+        let composite = match &options.render_target {
+            Some(t) => Some((CompositePipeline::new(device, t)?, t.content)),
+            None => None,
+        };
         let reset = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("wirepass list reset"),
             contents: bytemuck::cast_slice(&[0u32, 1, 1, 0]),
@@ -198,9 +222,12 @@ impl DeferredPass {
             id: NEXT.fetch_add(1, Ordering::Relaxed),
             format,
             visibility,
+            host: HostImport::new(),
             edge: Mutex::default(),
             outline: Mutex::default(),
             floor,
+            composite,
+            results: AtomicU64::new(0),
             reset,
             diagnostics: false,
             targets: None,
@@ -226,36 +253,31 @@ impl DeferredPass {
         self.targets.as_ref().map_or(0, Targets::bytes)
     }
 
-    /// Prepares `scene` for an image of `size` pixels: checks it, writes its uniforms and
-    /// instance records, and makes the targets (rebuilt only when the size changes).
-    pub fn prepare(
+    /// Prepares `scene` for `canvas` (an image size, a window of a larger image, and
+    /// optionally the host's depth): checks it, writes its uniforms and instance records,
+    /// and makes the targets (rebuilt only when the size changes).
+    pub fn prepare<'c>(
         &mut self,
         device: &wgpu::Device,
         store: &MeshStore,
         scene: &Scene<'_>,
         style: &Style,
-        size: (u32, u32),
+        canvas: impl Into<Canvas<'c>>,
     ) -> Result<PreparedFrame> {
-        self.prepare_window(device, store, scene, style, Window::whole(size))
-    }
-
-    /// [`prepare`](Self::prepare) for a window of a larger image (a tile): the frame draws
-    /// exactly the pixels the whole image has there.
-    pub fn prepare_window(
-        &mut self,
-        device: &wgpu::Device,
-        store: &MeshStore,
-        scene: &Scene<'_>,
-        style: &Style,
-        window: Window,
-    ) -> Result<PreparedFrame> {
+        let canvas = canvas.into();
+        let window = canvas.window;
         let data = FrameData::new(device, store, scene, style, window, 0)?;
+        let host = match &canvas.host_depth {
+            Some(h) => Some(self.host.prepare(device, h, &scene.view, window.image)?),
+            None => None,
+        };
         let spec = TargetSpec {
             size: data.target_size(),
             output: window.size,
             acc_colors: data.mixed_colors,
-            result: false,
+            result: self.composite.is_some(),
             diagnostic: self.diagnostics,
+            host: host.is_some(),
         };
         if self.targets.as_ref().map(Targets::spec) != Some(spec) {
             self.targets = Some(Targets::new(device, spec)?);
@@ -290,11 +312,18 @@ impl DeferredPass {
             .cull
             .clone()
             .ok_or_else(|| Error::Device("no cluster list".into()))?;
+        let composite = match (&self.composite, &targets.result) {
+            (Some((pipeline, _)), Some(result)) => Some(pipeline.bind(device, result)),
+            _ => None,
+        };
         Ok(PreparedFrame {
             pass: self.id,
             data,
             targets,
             cull,
+            host,
+            composite,
+            encoded: AtomicU64::new(0),
         })
     }
 
@@ -303,6 +332,7 @@ impl DeferredPass {
             split: frame.data.split(),
             outlines: frame.data.outlines,
             colors: frame.data.outlines && frame.data.mixed_colors,
+            host: frame.host.is_some(),
         }
     }
 
@@ -325,9 +355,19 @@ impl DeferredPass {
                 flags.push("MODE_SHADE");
                 (vec![Res::OutColor], self.format)
             }
-            Mode::Overlay => {
+            Mode::Overlay { encoded } => {
                 flags.push("MODE_OVERLAY");
+                if encoded {
+                    flags.push("HOST_ENCODED");
+                }
                 (vec![Res::OutColor, Res::HostColor], self.format)
+            }
+            Mode::Result { shaded } => {
+                flags.push("MODE_RESULT");
+                if shaded {
+                    flags.push("SHADED");
+                }
+                (vec![Res::OutColor], RESULT_FORMAT)
             }
             Mode::Diagnostic => {
                 flags.push("MODE_DIAGNOSTIC");
@@ -338,6 +378,9 @@ impl DeferredPass {
         let module = edge_module(device, self.format, &flags);
         let mut common = store_resources(v.split, false);
         common.push(Res::Ids);
+        if v.host {
+            common.push(Res::HostDepth);
+        }
         if v.outlines {
             common.push(Res::Acc);
         }
@@ -388,6 +431,9 @@ impl DeferredPass {
         )?;
         let mut draw_res = store_resources(v.split, true);
         draw_res.extend([Res::Ids, Res::Cull, Res::AccRw]);
+        if v.host {
+            draw_res.push(Res::HostDepth);
+        }
         let draw = Compute::new(device, &module, "outline_main", draw_res, self.format)?;
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(Error::Device(format!("building the outline pass: {e}")));
@@ -457,6 +503,7 @@ impl DeferredPass {
         }
         frame.data.check_store(store)?;
         let t = &frame.targets;
+        let result_view;
         let (mode, out_color, host_color) = match &target {
             OutputTarget::Shaded(v) => {
                 check_storage_output(v, self.format, t.output, "the output texture")?;
@@ -465,7 +512,19 @@ impl DeferredPass {
             OutputTarget::Overlay { host, output } => {
                 check_storage_output(output, self.format, t.output, "the output texture")?;
                 check_sampled(host, t.output, "the host colour texture")?;
-                (Some(Mode::Overlay), Some(*output), Some(*host))
+                let f = host.texture().format();
+                let encoded = !f.is_srgb() && f.target_component_alignment() == Some(1);
+                (Some(Mode::Overlay { encoded }), Some(*output), Some(*host))
+            }
+            OutputTarget::RenderPass => {
+                let (Some((_, content)), Some(result)) = (&self.composite, &t.result) else {
+                    return Err(Error::Misuse(
+                        "OutputTarget::RenderPass needs PassOptions::render_target".into(),
+                    ));
+                };
+                result_view = result.create_view(&Default::default());
+                let shaded = *content == Composite::Shaded;
+                (Some(Mode::Result { shaded }), Some(&result_view), None)
             }
             OutputTarget::Floor(v) => {
                 check_storage_output(v, self.format, t.output, "the output texture")?;
@@ -481,10 +540,22 @@ impl DeferredPass {
             }
         };
         if visibility {
-            self.visibility
-                .encode(device, encoder, &frame.data, t, timer.as_deref_mut())?;
+            if let Some(host) = &frame.host {
+                self.host
+                    .encode(device, encoder, &frame.data, host, t, timer.as_deref_mut())?;
+            }
+            let seeded = frame.host.is_some();
+            self.visibility.encode(
+                device,
+                encoder,
+                &frame.data,
+                t,
+                seeded,
+                timer.as_deref_mut(),
+            )?;
         }
         let ids = t.ids.create_view(&Default::default());
+        let host_depth = t.host.as_ref().map(|h| h.create_view(&Default::default()));
         let (diag, resolved) = match &t.diagnostic {
             Some((d, r)) => (
                 Some(d.create_view(&Default::default())),
@@ -494,6 +565,7 @@ impl DeferredPass {
         };
         let sources = Sources {
             ids: Some(&ids),
+            host_depth: host_depth.as_ref(),
             acc: Some(&t.acc),
             cull: Some(&frame.cull),
             work: Some(&t.work),
@@ -527,6 +599,10 @@ impl DeferredPass {
             )?;
         }
         let edge = self.edge_pipelines(device, mode, variant)?;
+        if let Mode::Result { .. } = mode {
+            let n = self.results.fetch_add(1, Ordering::Relaxed) + 1;
+            frame.encoded.store(n, Ordering::Relaxed);
+        }
         let main = edge.main.bind(device, &sources)?;
         let refine = edge.refine.bind(device, &sources)?;
         encoder.copy_buffer_to_buffer(&self.reset, 0, &t.work, 0, LIST_HEADER);
@@ -548,6 +624,41 @@ impl DeferredPass {
         pass.set_pipeline(&edge.refine.pipeline);
         pass.set_bind_group(0, &refine, &[]);
         pass.dispatch_workgroups_indirect(&t.work, 0);
+        Ok(())
+    }
+
+    /// Draws `frame`'s result into the host's render pass, whose attachments match
+    /// [`PassOptions::render_target`]: the lines over the host's image, or the shaded surface
+    /// and its lines. The frame must have been encoded with [`OutputTarget::RenderPass`],
+    /// and no other frame of this pass encoded since (each frame's result lives in the
+    /// pass's one result texture until the next encode).
+    pub fn render(&self, pass: &mut wgpu::RenderPass<'_>, frame: &PreparedFrame) -> Result<()> {
+        if frame.pass != self.id {
+            return Err(Error::Misuse(
+                "the frame was prepared by another DeferredPass".into(),
+            ));
+        }
+        let (Some((pipeline, _)), Some(group)) = (&self.composite, &frame.composite) else {
+            return Err(Error::Misuse(
+                "DeferredPass::render needs PassOptions::render_target".into(),
+            ));
+        };
+        let encoded = frame.encoded.load(Ordering::Relaxed);
+        if encoded == 0 {
+            return Err(Error::Misuse(
+                "the frame was not encoded with OutputTarget::RenderPass before render".into(),
+            ));
+        }
+        if encoded != self.results.load(Ordering::Relaxed) {
+            return Err(Error::Misuse(
+                "another frame was encoded after this one and overwrote its result: render \
+                 each frame before encoding the next"
+                    .into(),
+            ));
+        }
+        pass.set_pipeline(&pipeline.pipeline);
+        pass.set_bind_group(0, group, &[]);
+        pass.draw(0..3, 0..1);
         Ok(())
     }
 
@@ -604,6 +715,9 @@ fn variant_flags(v: Variant) -> Vec<&'static str> {
     }
     if v.colors {
         flags.push("COLORS");
+    }
+    if v.host {
+        flags.push("HOST");
     }
     flags
 }

@@ -124,6 +124,46 @@ impl Window {
     }
 }
 
+/// What a frame draws onto: an image, or a window of a larger one, and optionally the
+/// host's depth buffer. An image size converts into one: `pass.prepare(.., (800, 600))`.
+#[derive(Clone, Copy, Debug)]
+pub struct Canvas<'a> {
+    /// The image, or the part of it the frame draws.
+    pub window: Window,
+    /// The host's depth: host geometry nearer than a wireframed surface hides its lines.
+    pub host_depth: Option<super::HostDepth<'a>>,
+}
+
+impl<'a> Canvas<'a> {
+    /// A whole image of `size` pixels.
+    pub fn new(size: (u32, u32)) -> Canvas<'a> {
+        Window::whole(size).into()
+    }
+
+    /// This canvas over the host's depth buffer.
+    pub fn with_host_depth(self, host_depth: super::HostDepth<'a>) -> Canvas<'a> {
+        Canvas {
+            host_depth: Some(host_depth),
+            ..self
+        }
+    }
+}
+
+impl From<Window> for Canvas<'_> {
+    fn from(window: Window) -> Self {
+        Canvas {
+            window,
+            host_depth: None,
+        }
+    }
+}
+
+impl From<(u32, u32)> for Canvas<'_> {
+    fn from(size: (u32, u32)) -> Self {
+        Canvas::new(size)
+    }
+}
+
 /// One instanced draw: a mesh's triangles, for a run of consecutive instance slots.
 #[derive(Clone, Debug)]
 pub(crate) struct DrawGroup {

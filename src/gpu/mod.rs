@@ -1,10 +1,12 @@
 //! GPU side: device creation, the mesh store, the per-frame scene data and the passes.
 
 mod bindings;
+mod composite;
 mod context;
 mod deferred;
 mod forward;
 mod frame;
+mod host;
 mod mesh_store;
 mod raster;
 mod readback;
@@ -14,14 +16,18 @@ mod timing;
 mod two_pass;
 mod visibility;
 
+pub use composite::{Composite, RenderTarget};
 pub use context::{GpuContext, OPTIONAL_FEATURES};
 pub use deferred::{DeferredPass, OutputTarget, PassOptions, PreparedFrame};
 pub use forward::{forward_source, ForwardPass};
-pub use frame::{light_world_dir, FrameUniforms, InstanceRecord, Window, MAX_INSTANCES};
+pub use frame::{light_world_dir, Canvas, FrameUniforms, InstanceRecord, Window, MAX_INSTANCES};
+pub use host::{depth_quantum, HostDepth};
 pub use mesh_store::{pack_normal, unpack_normal, MeshId, MeshStore};
 pub use raster::{RasterFrame, MAPS_DIAGNOSTIC_FORMAT};
 pub use readback::read_texture;
-pub use targets::{DEPTH_FORMAT, DIAGNOSTIC_FORMAT, ID_FORMAT, RESOLVED_ID_FORMAT, RESULT_FORMAT};
+pub use targets::{
+    DEPTH_FORMAT, DIAGNOSTIC_FORMAT, HOST_FORMAT, ID_FORMAT, RESOLVED_ID_FORMAT, RESULT_FORMAT,
+};
 pub use timing::GpuTimer;
 pub use two_pass::{drawn_edges, two_pass_source, EdgeLines, TwoPass, FILL_DEPTH_BIAS};
 

@@ -26,6 +26,11 @@ pub const FORWARD: &str = include_str!("../../shaders/forward.wgsl");
 /// The two-pass baseline (fill + edge lines), assembled after [`FORWARD`]; see `gpu::TwoPass`.
 pub const TWO_PASS: &str = include_str!("../../shaders/two_pass.wgsl");
 
+/// Drawing a frame's result into the host's render pass (self-contained).
+pub const COMPOSITE: &str = include_str!("../../shaders/composite.wgsl");
+/// Seeding the targets from the host's depth buffer.
+pub const HOST_DEPTH: &str = include_str!("../../shaders/host_depth.wgsl");
+
 /// Storage-texture formats the edge pass can write, with the WGSL name of each.
 pub fn storage_format_name(format: wgpu::TextureFormat) -> Option<&'static str> {
     match format {
@@ -127,11 +132,23 @@ pub fn outline_source(flags: &[&str]) -> String {
     assemble(&[SCENE, OUTLINE], flags)
 }
 
+/// The host-depth seeding module, for a single- or multisampled host depth texture.
+pub fn host_depth_source(multisampled: bool) -> String {
+    let flags: &[&str] = if multisampled { &["MULTISAMPLED"] } else { &[] };
+    assemble(&[HOST_DEPTH], flags)
+}
+
 /// Every module the crate builds, named by its settings: each pass in each of its
 /// specialisations, for validation without a GPU.
 pub fn variants() -> Vec<(String, String)> {
     use wgpu::TextureFormat as F;
-    let mut out = Vec::new();
+    let mut out = vec![("composite".to_string(), COMPOSITE.to_string())];
+    for multisampled in [false, true] {
+        out.push((
+            format!("host depth multisampled={multisampled}"),
+            host_depth_source(multisampled),
+        ));
+    }
     for pulled in [false, true] {
         for split in [false, true] {
             out.push((
@@ -144,6 +161,7 @@ pub fn variants() -> Vec<(String, String)> {
     let modes: &[&[&str]] = &[
         &["MODE_SHADE"],
         &["MODE_OVERLAY"],
+        &["MODE_OVERLAY", "HOST_ENCODED"],
         &["MODE_RESULT"],
         &["MODE_RESULT", "SHADED"],
         &["MODE_DIAGNOSTIC"],
@@ -152,10 +170,19 @@ pub fn variants() -> Vec<(String, String)> {
     for format in storage {
         for mode in modes {
             for split in [false, true] {
-                for (outlines, colors) in [(false, false), (true, false), (true, true)] {
+                for (outlines, colors, host) in [
+                    (false, false, false),
+                    (true, false, false),
+                    (true, true, false),
+                    (true, false, true),
+                    (false, false, true),
+                ] {
                     let mut flags = mode.to_vec();
                     if split {
                         flags.push("SPLIT");
+                    }
+                    if host {
+                        flags.push("HOST");
                     }
                     if outlines {
                         flags.push("OUTLINES");
@@ -172,10 +199,13 @@ pub fn variants() -> Vec<(String, String)> {
         }
     }
     for split in [false, true] {
-        for colors in [false, true] {
+        for (colors, host) in [(false, false), (true, false), (false, true), (true, true)] {
             let mut flags = vec![];
             if split {
                 flags.push("SPLIT");
+            }
+            if host {
+                flags.push("HOST");
             }
             if colors {
                 flags.push("COLORS");

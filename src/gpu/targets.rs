@@ -13,6 +13,10 @@ pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// Format of the resolved ids the diagnostic output writes: (instance slot, triangle) in the
 /// first two channels (a storage format every backend can write, which `Rg32Uint` is not).
 pub const RESOLVED_ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Uint;
+/// Format of the host's own depth as the compute passes read it: the bits of the reverse
+/// depth, `u32::MAX` where the host has no geometry (a 32-bit integer target renders on
+/// every backend, a float one not).
+pub const HOST_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 /// Format of the diagnostic map: distance in pixels (r) and reverse depth (g).
 pub const DIAGNOSTIC_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 /// Format of the result a frame composites into the host's render pass: premultiplied
@@ -38,6 +42,8 @@ pub(crate) struct Targets {
     pub work: wgpu::Buffer,
     pub result: Option<wgpu::Texture>,
     pub diagnostic: Option<(wgpu::Texture, wgpu::Texture)>,
+    /// The host's depth, where the frame has one.
+    pub host: Option<wgpu::Texture>,
 }
 
 /// What a set of targets must hold.
@@ -48,6 +54,7 @@ pub(crate) struct TargetSpec {
     pub acc_colors: bool,
     pub result: bool,
     pub diagnostic: bool,
+    pub host: bool,
 }
 
 impl Targets {
@@ -58,6 +65,7 @@ impl Targets {
             acc_colors: self.acc_colors,
             result: self.result.is_some(),
             diagnostic: self.diagnostic.is_some(),
+            host: self.host.is_some(),
         }
     }
 
@@ -148,6 +156,14 @@ impl Targets {
                     ),
                 )
             }),
+            host: spec.host.then(|| {
+                texture(
+                    "wirepass host depth",
+                    spec.size,
+                    HOST_FORMAT,
+                    U::RENDER_ATTACHMENT | U::TEXTURE_BINDING,
+                )
+            }),
         })
     }
 
@@ -164,6 +180,9 @@ impl Targets {
         }
         if let Some((d, i)) = &self.diagnostic {
             n += tex(d) + tex(i);
+        }
+        if let Some(h) = &self.host {
+            n += tex(h);
         }
         n
     }

@@ -157,13 +157,14 @@ impl Visibility {
     }
 
     /// Records the visibility pass: clears the targets (ids to background, depth to the far
-    /// plane) and draws every instance.
+    /// plane), unless the host's depth `seeded` them, and draws every instance.
     pub fn encode(
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
         frame: &FrameData,
         targets: &Targets,
+        seeded: bool,
         timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
         let split = frame.split() && self.pulled;
@@ -185,19 +186,27 @@ impl Visibility {
                 depth_slice: None,
                 resolve_target: None,
                 ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color {
-                        r: f64::from(BACKGROUND),
-                        g: 0.0,
-                        b: 0.0,
-                        a: 0.0,
-                    }),
+                    load: if seeded {
+                        wgpu::LoadOp::Load
+                    } else {
+                        wgpu::LoadOp::Clear(wgpu::Color {
+                            r: f64::from(BACKGROUND),
+                            g: 0.0,
+                            b: 0.0,
+                            a: 0.0,
+                        })
+                    },
                     store: wgpu::StoreOp::Store,
                 },
             })],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: &depth,
                 depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(0.0),
+                    load: if seeded {
+                        wgpu::LoadOp::Load
+                    } else {
+                        wgpu::LoadOp::Clear(0.0)
+                    },
                     store: wgpu::StoreOp::Store,
                 }),
                 stencil_ops: None,

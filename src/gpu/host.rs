@@ -1,0 +1,305 @@
+//! The host's depth buffer as the deferred pass sees it: geometry the host drew itself, which
+//! hides the wireframed surfaces' lines and outlines where it is nearer, and lets outlines
+//! draw over it where it is farther.
+//!
+//! Before the visibility pass, a full-screen draw seeds the pass's depth and id targets from
+//! the host's depth (each pixel's farthest sample, in the pass's reverse depth, moved back by
+//! [`host_margin`](crate::edge_math::host_margin); id `HOST` where the host has geometry)
+//! and keeps the host's depth alone in a target of its own for the compute passes. The rules
+//! the ground truth shares: a pixel shows the host where the host's depth there is nearer
+//! than the instance's surface at its centre; a point of an outline is hidden where the
+//! host's depth at the pixel containing it is nearer than the point; and no line is drawn
+//! into a pixel whose host depth is nearer than the line's point.
+
+use super::frame::FrameData;
+use super::targets::{Targets, DEPTH_FORMAT, HOST_FORMAT, ID_FORMAT};
+use super::{shaders, GpuTimer};
+use crate::camera::{DepthRange, View};
+use crate::error::{Error, Result};
+use glam::{DMat4, DVec4};
+use wgpu::util::DeviceExt;
+
+/// The host's depth buffer, with the view it was rendered with.
+///
+/// Any depth format works (`Depth16Unorm`, `Depth24Plus`, `Depth24PlusStencil8`,
+/// `Depth32Float`, `Depth32FloatStencil8`), single- or multisampled; the texture needs
+/// `TEXTURE_BINDING` usage, and its size is the image's.
+#[derive(Clone, Copy, Debug)]
+pub struct HostDepth<'a> {
+    /// The host's depth texture.
+    pub texture: &'a wgpu::Texture,
+    /// The matrices and depth convention the host rendered it with (usually the scene's).
+    pub view: View,
+}
+
+/// Mirror of WGSL `HostParams` (host_depth.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+struct HostParams {
+    a: [f32; 4],
+    b: [f32; 4],
+    mode: u32,
+    reversed: u32,
+    samples: u32,
+    quantum: f32,
+}
+
+/// The seeding draw's pipelines: for single- and multisampled host depth.
+pub(crate) struct HostImport {
+    pipelines: [Option<(wgpu::RenderPipeline, wgpu::BindGroupLayout)>; 2],
+}
+
+/// A frame's host depth, ready to seed its targets.
+pub(crate) struct HostFrame {
+    view: wgpu::TextureView,
+    params: wgpu::Buffer,
+    multisampled: bool,
+}
+
+impl HostImport {
+    pub fn new() -> Self {
+        HostImport {
+            pipelines: [None, None],
+        }
+    }
+
+    /// Checks the host's depth against the frame and builds what seeding it needs.
+    pub fn prepare(
+        &mut self,
+        device: &wgpu::Device,
+        host: &HostDepth<'_>,
+        scene_view: &View,
+        image: (u32, u32),
+    ) -> Result<HostFrame> {
+        let t = host.texture;
+        if !t.format().is_depth_stencil_format() || !t.format().has_depth_aspect() {
+            return Err(Error::Misuse(format!(
+                "the host depth texture is {:?}, not a depth format",
+                t.format()
+            )));
+        }
+        if !t.usage().contains(wgpu::TextureUsages::TEXTURE_BINDING) {
+            return Err(Error::Misuse(format!(
+                "the host depth texture lacks the usage TEXTURE_BINDING (it has {:?})",
+                t.usage()
+            )));
+        }
+        if (t.width(), t.height()) != image {
+            return Err(Error::Misuse(format!(
+                "the host depth texture is {}x{}, but the image is {}x{}",
+                t.width(),
+                t.height(),
+                image.0,
+                image.1
+            )));
+        }
+        if t.dimension() != wgpu::TextureDimension::D2 || t.depth_or_array_layers() != 1 {
+            return Err(Error::Misuse(
+                "the host depth texture is not a single 2D texture".into(),
+            ));
+        }
+        host.view.validate()?;
+        let multisampled = t.sample_count() > 1;
+        let slot = usize::from(multisampled);
+        if self.pipelines[slot].is_none() {
+            self.pipelines[slot] = Some(build(device, multisampled)?);
+        }
+        let same =
+            host.view.view == scene_view.view && host.view.projection == scene_view.projection;
+        let reversed = host.view.depth == DepthRange::Reversed;
+        let (mode, a, b) = if same {
+            (u32::from(reversed), DVec4::ZERO, DVec4::ZERO)
+        } else {
+            // Host NDC (u, v, d, 1) → world → the scene's reverse depth and w.
+            let inverse = (host.view.projection * host.view.view).inverse();
+            let rows = scene_view.clip_rows(DMat4::IDENTITY);
+            (
+                2,
+                inverse.transpose() * rows.depth,
+                inverse.transpose() * rows.clip.row(3),
+            )
+        };
+        let params = HostParams {
+            a: a.as_vec4().to_array(),
+            b: b.as_vec4().to_array(),
+            mode,
+            reversed: u32::from(reversed),
+            samples: t.sample_count(),
+            quantum: depth_quantum(t.format(), host.view.depth) as f32,
+        };
+        let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("wirepass host depth"),
+            contents: bytemuck::bytes_of(&params),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let view = t.create_view(&wgpu::TextureViewDescriptor {
+            label: Some("wirepass host depth"),
+            aspect: wgpu::TextureAspect::DepthOnly,
+            ..Default::default()
+        });
+        Ok(HostFrame {
+            view,
+            params,
+            multisampled,
+        })
+    }
+
+    /// Records the seeding draw: clears nothing, writes every target pixel.
+    pub fn encode(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        frame: &FrameData,
+        host: &HostFrame,
+        targets: &Targets,
+        timer: Option<&mut GpuTimer>,
+    ) -> Result<()> {
+        let (pipeline, layout) = self.pipelines[usize::from(host.multisampled)]
+            .as_ref()
+            .ok_or_else(|| Error::Device("the host depth pipeline was not prepared".into()))?;
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("wirepass host depth"),
+            layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: frame.frame.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 30,
+                    resource: wgpu::BindingResource::TextureView(&host.view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 31,
+                    resource: host.params.as_entire_binding(),
+                },
+            ],
+        });
+        let host_target = targets
+            .host
+            .as_ref()
+            .ok_or_else(|| Error::Device("the targets have no host depth".into()))?;
+        let (ids, depth, host_view) = (
+            targets.ids.create_view(&Default::default()),
+            targets.depth.create_view(&Default::default()),
+            host_target.create_view(&Default::default()),
+        );
+        let attach = |view| {
+            Some(wgpu::RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                    store: wgpu::StoreOp::Store,
+                },
+            })
+        };
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("wirepass host depth"),
+            color_attachments: &[attach(&ids), attach(&host_view)],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &depth,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(0.0),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: timer.and_then(|t| t.render_span("host_depth")),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, &group, &[]);
+        pass.draw(0..3, 0..1);
+        Ok(())
+    }
+}
+
+/// The smallest step of a depth format near its far end, in reverse depth (see
+/// `host_margin`): 2^-bits for unorm formats; for float ones the f32 step at 1 for a standard
+/// convention (its far end is 1) and a relative step, taken at its largest, for a reversed one.
+pub fn depth_quantum(format: wgpu::TextureFormat, depth: DepthRange) -> f64 {
+    use wgpu::TextureFormat as F;
+    match (format, depth) {
+        (F::Depth16Unorm, _) => 2f64.powi(-16),
+        (F::Depth24Plus | F::Depth24PlusStencil8, _) => 2f64.powi(-24),
+        (_, DepthRange::Standard) => 2f64.powi(-24),
+        (_, DepthRange::Reversed) => 2f64.powi(-23),
+    }
+}
+
+fn build(
+    device: &wgpu::Device,
+    multisampled: bool,
+) -> Result<(wgpu::RenderPipeline, wgpu::BindGroupLayout)> {
+    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let fs = wgpu::ShaderStages::FRAGMENT;
+    let uniform = wgpu::BindingType::Buffer {
+        ty: wgpu::BufferBindingType::Uniform,
+        has_dynamic_offset: false,
+        min_binding_size: None,
+    };
+    let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: fs,
+        ty,
+        count: None,
+    };
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("wirepass host depth"),
+        entries: &[
+            entry(0, uniform),
+            entry(
+                30,
+                wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Depth,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled,
+                },
+            ),
+            entry(31, uniform),
+        ],
+    });
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("wirepass host depth"),
+        bind_group_layouts: &[Some(&layout)],
+        immediate_size: 0,
+    });
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("wirepass host depth"),
+        source: wgpu::ShaderSource::Wgsl(shaders::host_depth_source(multisampled).into()),
+    });
+    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("wirepass host depth"),
+        layout: Some(&pipeline_layout),
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        primitive: wgpu::PrimitiveState::default(),
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: DEPTH_FORMAT,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Always),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module: &module,
+            entry_point: Some("fs_main"),
+            compilation_options: Default::default(),
+            targets: &[Some(ID_FORMAT.into()), Some(HOST_FORMAT.into())],
+        }),
+        multiview_mask: None,
+        cache: None,
+    });
+    if let Some(e) = pollster::block_on(scope.pop()) {
+        return Err(Error::Device(format!("building the host depth pass: {e}")));
+    }
+    Ok((pipeline, layout))
+}
