@@ -78,9 +78,39 @@ const HOST_ID: u32 = 0xfffffffeu;
 // Host geometry hides a point only when it is nearer by more than this margin (in reverse
 // depth, for a host depth of reverse value `r` and format step `quantum`), so a host that
 // draws the wireframed meshes itself too does not hide their lines with its own copy of
-// them: eight format steps and the f32 rounding of two transforms (src/edge_math.rs).
+// them: two format steps (the host stores its depth rounded) and the f32 rounding of two
+// transforms (src/edge_math.rs).
 fn host_margin(r: f32, quantum: f32) -> f32 {
-    return 1.0e-5 * r + 8.0 * max(quantum, 1.2e-7);
+    return 1.0e-5 * r + 2.0 * quantum + 1.0e-6;
+}
+
+// Twin of `host_slope` in src/edge_math.rs: how much the host's reverse depth `h` changes per
+// pixel, from its values at the left, right, upper and lower neighbours (negative where the
+// host has no geometry there): per axis the smaller change to a neighbour with geometry (the
+// surface's own slope, not the jump at its edge), summed over both axes.
+fn host_slope(h: f32, left: f32, right: f32, up: f32, down: f32) -> f32 {
+    return host_axis_slope(h, left, right) + host_axis_slope(h, up, down);
+}
+
+fn host_axis_slope(h: f32, a: f32, b: f32) -> f32 {
+    var m = 3.0e38;
+    if a >= 0.0 {
+        m = abs(h - a);
+    }
+    if b >= 0.0 {
+        m = min(m, abs(b - h));
+    }
+    return select(0.0, m, m < 3.0e38);
+}
+
+// Twin of `host_hides` in src/edge_math.rs: whether the host's surface at a pixel (reverse
+// depth `host`, changing by `slope` per pixel) hides a line point of reverse depth `point`
+// that lies `distance` pixels from the pixel's centre. The host must be nearer by twice its
+// own depth change over that distance and one pixel more: a point on or in front of the
+// host's surface where it lies (an outline where an object meets the ground) is never
+// hidden by the host's depth sampled a pixel or two away.
+fn host_hides(host: f32, point: f32, distance: f32, slope: f32) -> bool {
+    return host - point > 2.0 * (distance + 1.0) * slope;
 }
 
 // Distance returned for an edge that is not drawn or not visible.

@@ -1,17 +1,22 @@
 // Seeds the targets from the host's depth buffer, before the visibility pass draws the
-// instances over it: per target pixel, the host's nearest depth sample in the pass's reverse
-// depth (moved back by HOST_MARGIN), the id HOST_ID where the host has geometry
-// (BACKGROUND_ID where it has none), and
-// the host depth alone in `host_out` for the compute passes. Assembled after common.wgsl.
+// instances over it. `resolve_main` (compute) writes, per target pixel, the host's farthest
+// depth sample in the pass's reverse depth, moved back by host_margin, into `host_out` (its
+// bits; 0xffffffff where the host has no geometry) for the compute passes; the draw
+// `vs_main`/`fs_main` then writes that depth and the id HOST_ID (BACKGROUND_ID where the
+// host has no geometry) into the depth and id targets. Reading a multisampled texture in a
+// compute pass rather than a fragment shader keeps lavapipe from growing its memory with
+// every frame. Assembled after common.wgsl.
 //
-// Flags: MULTISAMPLED (the host's depth texture has several samples per pixel; the nearest
-// counts, so a line is hidden in every pixel a nearer host surface touches).
+// Flags: MULTISAMPLED (the host's depth texture has several samples per pixel; the farthest
+// counts, so a line is hidden only where the host covers the whole pixel).
 
 @group(0) @binding(0) var<uniform> frame: Frame;
+// Bound as unfilterable float (its depth in x), which every backend can load from; GLSL
+// has no texel fetch from depth textures.
 #if MULTISAMPLED
-@group(0) @binding(30) var host_depth: texture_depth_multisampled_2d;
+@group(0) @binding(30) var host_depth: texture_multisampled_2d<f32>;
 #else
-@group(0) @binding(30) var host_depth: texture_depth_2d;
+@group(0) @binding(30) var host_depth: texture_2d<f32>;
 #endif
 
 // How host depth maps to the pass's reverse depth (src/gpu/host.rs, HostParams).
@@ -33,46 +38,37 @@ struct HostParams {
 }
 @group(0) @binding(31) var<uniform> host: HostParams;
 
-@vertex
-fn vs_main(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
-    // One triangle over the whole target.
-    let uv = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));
-    return vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
+@group(0) @binding(32) var host_out: texture_storage_2d<r32uint, write>;
+
+@compute @workgroup_size(8, 8)
+fn resolve_main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if !all(vec2<f32>(gid.xy) < frame.target_size) {
+        return;
+    }
+    textureStore(host_out, gid.xy, vec4<u32>(host_value(gid.xy), 0u, 0u, 0u));
 }
 
-struct Seed {
-    @builtin(frag_depth) depth: f32,
-    @location(0) id: vec2<u32>,
-    // The bits of the host's reverse depth; 0xffffffff where the host has no geometry.
-    @location(1) host: u32,
-}
-
-@fragment
-fn fs_main(@builtin(position) position: vec4<f32>) -> Seed {
-    var out: Seed;
-    out.depth = 0.0;
-    out.id = vec2<u32>(BACKGROUND_ID, 0u);
-    out.host = 0xffffffffu;
+// The bits of the host's reverse depth at target pixel xy, or 0xffffffff.
+fn host_value(xy: vec2<u32>) -> u32 {
     // The image pixel this target pixel is; the host's depth covers the image only.
-    let image = vec2<i32>(floor(position.xy + frame.target_origin));
+    let image = vec2<i32>(xy) + vec2<i32>(frame.target_origin);
     let size = vec2<i32>(textureDimensions(host_depth));
     if any(image < vec2<i32>(0)) || any(image >= size) {
-        return out;
+        return 0xffffffffu;
     }
     let far = select(1.0, 0.0, host.reversed == 1u);
     // The farthest sample: towards `far`.
-    let near_end = 1.0 - far;
-    var d = near_end;
+    var d = 1.0 - far;
 #if MULTISAMPLED
     for (var s = 0u; s < host.samples; s++) {
-        let x = textureLoad(host_depth, image, i32(s));
+        let x = textureLoad(host_depth, image, i32(s)).x;
         d = select(max(d, x), min(d, x), host.reversed == 1u);
     }
 #else
-    d = textureLoad(host_depth, image, 0);
+    d = textureLoad(host_depth, image, 0).x;
 #endif
     if d == far {
-        return out;
+        return 0xffffffffu;
     }
     var reverse = 1.0 - d;
     if host.mode == 1u {
@@ -84,8 +80,28 @@ fn fs_main(@builtin(position) position: vec4<f32>) -> Seed {
         reverse = dot(host.a, q) / dot(host.b, q);
     }
     // Moved back by the margin, so the pass's own surfaces win ties with the host's copy.
-    out.depth = clamp(reverse - host_margin(reverse, host.quantum), 0.0, 1.0);
-    out.id = vec2<u32>(HOST_ID, 0u);
-    out.host = bitcast<u32>(out.depth);
-    return out;
+    return bitcast<u32>(clamp(reverse - host_margin(reverse, host.quantum), 0.0, 1.0));
+}
+
+@group(0) @binding(33) var host_in: texture_2d<u32>;
+
+@vertex
+fn vs_main(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
+    // One triangle over the whole target.
+    let uv = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));
+    return vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
+}
+
+struct Seed {
+    @builtin(frag_depth) depth: f32,
+    @location(0) id: vec2<u32>,
+}
+
+@fragment
+fn fs_main(@builtin(position) position: vec4<f32>) -> Seed {
+    let v = textureLoad(host_in, vec2<u32>(position.xy), 0).x;
+    if v == 0xffffffffu {
+        return Seed(0.0, vec2<u32>(BACKGROUND_ID, 0u));
+    }
+    return Seed(bitcast<f32>(v), vec2<u32>(HOST_ID, 0u));
 }

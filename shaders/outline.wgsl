@@ -180,23 +180,25 @@ fn keep_between(range: vec2<f32>, p0: f32, d: f32, lo: f32, hi: f32) -> vec2<f32
     return vec2<f32>(max(range.x, min(u0, u1)), min(range.y, max(u0, u1)));
 }
 
-// Where a clip-space point lands: full-image pixel coordinates, and 1/w, near/w and view
-// depth/w, which are affine along a screen segment.
+// Where a clip-space point lands: full-image pixel coordinates, and 1/w, near/w, reverse
+// depth (depth row / w, exact where it is small, unlike 1 − near/w) and view depth/w, which
+// are affine along a screen segment.
 struct Projected {
     xy: vec2<f32>,
     inv_w: f32,
     near_w: f32,
+    reverse: f32,
     fade_w: f32,
 }
 
-fn project(c: vec4<f32>, fade: f32) -> Projected {
+fn project(c: vec4<f32>, depth: f32, fade: f32) -> Projected {
     let inv_w = 1.0 / c.w;
     let ndc = c.xy * inv_w;
-    return Projected(vec2<f32>(0.5 * (ndc.x + 1.0), 0.5 * (1.0 - ndc.y)) * frame.image_size, inv_w, c.z * inv_w, fade * inv_w);
+    return Projected(vec2<f32>(0.5 * (ndc.x + 1.0), 0.5 * (1.0 - ndc.y)) * frame.image_size, inv_w, c.z * inv_w, depth * inv_w, fade * inv_w);
 }
 
 fn lerp_projected(a: Projected, b: Projected, k: f32) -> Projected {
-    return Projected(mix(a.xy, b.xy, k), mix(a.inv_w, b.inv_w, k), mix(a.near_w, b.near_w, k), mix(a.fade_w, b.fade_w, k));
+    return Projected(mix(a.xy, b.xy, k), mix(a.inv_w, b.inv_w, k), mix(a.near_w, b.near_w, k), mix(a.reverse, b.reverse, k), mix(a.fade_w, b.fade_w, k));
 }
 
 // Visibility samples per pixel of edge length; each change between two is then bisected.
@@ -223,7 +225,7 @@ fn seg_at(s: Segment, k: f32) -> Projected {
 fn seg_visible(s: Segment, k: f32) -> bool {
     let q = seg_at(s, k);
     let w = 1.0 / q.inv_w;
-    return visible_at(q.xy, q.near_w * w, w, s.inst, s.t, s.n);
+    return visible_at(q.xy, q.near_w * w, w, q.reverse, s.inst, s.t, s.n);
 }
 
 // Writes edge a -> b (of triangle t of `inst`, with neighbour n) into every pixel within reach
@@ -242,8 +244,12 @@ fn draw_outline(inst: u32, t: u32, n: u32, a: vec3<f32>, b: vec3<f32>) {
     if !(s.x <= s.y) {
         return;
     }
-    let p0 = project(mix(ca, cb, s.x), mix(dot(fade_row, ha), dot(fade_row, hb), s.x));
-    let p1 = project(mix(ca, cb, s.y), mix(dot(fade_row, ha), dot(fade_row, hb), s.y));
+    let da = dot(depth_row, ha);
+    let db = dot(depth_row, hb);
+    let fa = dot(fade_row, ha);
+    let fb = dot(fade_row, hb);
+    let p0 = project(mix(ca, cb, s.x), mix(da, db, s.x), mix(fa, fb, s.x));
+    let p1 = project(mix(ca, cb, s.y), mix(da, db, s.y), mix(fa, fb, s.y));
     // Inside the targets.
     let d = p1.xy - p0.xy;
     let lo = frame.target_origin;
@@ -364,8 +370,8 @@ fn draw_piece(seg: Segment, k0: f32, k1: f32, length_px: f32) {
             }
             let q = seg_at(seg, best_k);
 #if HOST
-            // The host's surface in this pixel is in front of the line's point.
-            if host_at(xy) > 1.0 - q.near_w {
+            // The pixel shows the host, and its surface is in front of the line's point.
+            if host_hides_line(xy, q.reverse, best) {
                 continue;
             }
 #endif
@@ -382,17 +388,16 @@ fn draw_piece(seg: Segment, k0: f32, k1: f32, length_px: f32) {
     }
 }
 
-// True unless the host's geometry at the pixel containing x is nearer than the edge's point
-// there, or a triangle other than t and n of `inst` covers the screen point x nearer than
-// the point at near row `near` and w `w` on the edge. The candidates are the triangles the
+// Whether the edge's point at screen point x (near row `near`, w `w`, reverse depth `reverse`)
+// is visible: unless the host hides it (host_hides_point), or a triangle other than t and n of
+// `inst` covers x nearer than the point. The candidates are the triangles the
 // rasterizer gave the 3×3 pixel centres around x (a sliver of surface in front of the edge
 // may own no centre next to x, but one a pixel further on), and those a walk across edges
 // from them reaches when they do not cover x themselves (x may lie in a small triangle that
 // owns none of those centres).
-fn visible_at(x: vec2<f32>, near: f32, w: f32, inst: u32, t: u32, n: u32) -> bool {
+fn visible_at(x: vec2<f32>, near: f32, w: f32, reverse: f32, inst: u32, t: u32, n: u32) -> bool {
     let centre = vec2<i32>(floor(x - frame.target_origin));
-    // Reverse depth is 1 − near/w (the depth row is the w row minus the near row).
-    if host_at(centre) > 1.0 - near / w {
+    if host_hides_point(x - frame.target_origin, reverse) {
         return false;
     }
     var last = vec2<u32>(BACKGROUND_ID, 0u);

@@ -82,6 +82,46 @@ fn host_at(q: vec2<i32>) -> f32 {
     return -1.0;
 }
 
+// The host's reverse depth at target pixel q and its slope there (host_slope); x < 0 where the
+// host has no geometry.
+fn host_pixel(q: vec2<i32>) -> vec2<f32> {
+    let h = host_at(q);
+    let x = vec2<i32>(1, 0);
+    let y = vec2<i32>(0, 1);
+    return vec2<f32>(h, host_slope(h, host_at(q - x), host_at(q + x), host_at(q - y), host_at(q + y)));
+}
+
+// host_pixel where q shows the host (its surface nearer there than every instance's); x < 0
+// elsewhere. Where an instance shows, the host hides nothing drawn there: not even the host's
+// own copy of that instance, just behind its surface.
+fn host_shown(q: vec2<i32>) -> vec2<f32> {
+#if HOST
+    if id_at(q).x == HOST_ID {
+        return host_pixel(q);
+    }
+#endif
+    return vec2<f32>(-1.0, 0.0);
+}
+
+// Whether the host hides a point of an edge at target-space point x, of reverse depth
+// `point`: the pixel containing x shows the host, and the host there is clearly nearer
+// (host_hides).
+fn host_hides_point(x: vec2<f32>, point: f32) -> bool {
+    return host_hides_line(vec2<i32>(floor(x)), point, 0.0);
+}
+
+// Whether the host hides, in target pixel q, the line of a point of reverse depth `point`
+// that lies `distance` pixels from q's centre: q shows the host, and the host there is
+// clearly nearer than the point (host_hides).
+fn host_hides_line(q: vec2<i32>, point: f32, distance: f32) -> bool {
+#if HOST
+    let shown = host_shown(q);
+    return shown.x >= 0.0 && host_hides(shown.x, point, distance, shown.y);
+#else
+    return false;
+#endif
+}
+
 // Full-image coordinates of a target pixel's centre.
 fn pixel_centre(xy: vec2<u32>) -> vec2<f32> {
     return vec2<f32>(xy) + frame.target_origin + 0.5;

@@ -88,12 +88,37 @@ pub const HIDDEN_MARGIN: f64 = 1e-4;
 
 /// Twin of `host_margin` in common.wgsl: the host's geometry hides a point only where it is
 /// nearer by more than this (in reverse depth, for a host depth of reverse value `r` and a
-/// depth format whose smallest step there is `quantum`): eight format steps and the f32
-/// rounding of two transforms, so a host that also draws the wireframed meshes itself does
+/// depth format whose smallest step there is `quantum`): two format steps (the host stores
+/// its depth rounded) and the f32 rounding of two transforms, so a host that also draws the wireframed meshes itself does
 /// not hide their lines with its own copy of them. The host's depth is moved back by it
 /// once, where the pass reads it.
 pub fn host_margin(r: f64, quantum: f64) -> f64 {
-    1e-5 * r + 8.0 * quantum.max(1.2e-7)
+    1e-5 * r + 2.0 * quantum + 1e-6
+}
+
+/// Twin of `host_slope` in common.wgsl: how much the host's reverse depth `h` changes per
+/// pixel, from its values at the left, right, upper and lower neighbours (negative where the
+/// host has no geometry): per axis the smaller change to a neighbour with geometry (the
+/// surface's own slope, not the jump at its edge), summed over both axes.
+pub fn host_slope(h: f64, [left, right, up, down]: [f64; 4]) -> f64 {
+    let axis = |a: f64, b: f64| {
+        let sides = [
+            (a >= 0.0).then(|| (h - a).abs()),
+            (b >= 0.0).then(|| (b - h).abs()),
+        ];
+        sides.into_iter().flatten().reduce(f64::min).unwrap_or(0.0)
+    };
+    axis(left, right) + axis(up, down)
+}
+
+/// Twin of `host_hides` in common.wgsl: whether the host's surface at a pixel (reverse depth
+/// `host`, changing by `slope` per pixel) hides a line point of reverse depth `point` that
+/// lies `distance` pixels from the pixel's centre. The host must be nearer by twice its own
+/// depth change over that distance and one pixel more, so a point on or in front of the
+/// host's surface where it lies (an outline where an object meets the ground) is never
+/// hidden by the host's depth sampled a pixel or two away.
+pub fn host_hides(host: f64, point: f64, distance: f64, slope: f64) -> bool {
+    host - point > 2.0 * (distance + 1.0) * slope
 }
 
 /// Twin of `nearer` in scene.wgsl: true when the point with near row `a_near` is nearer than

@@ -19,7 +19,7 @@
 
 use crate::edge_math;
 use crate::mesh::adjacency::NO_NEIGHBOUR;
-use crate::raycast::{Line, ObjectStyle, RayCaster, Rays};
+use crate::raycast::{HostMap, Line, ObjectStyle, RayCaster, Rays};
 use crate::render::Shot;
 use crate::style::{depth_fade, line_intensity, line_key, line_reach};
 use glam::{DVec2, DVec4};
@@ -86,7 +86,7 @@ pub(crate) fn outline_map(
     rays: &Rays,
     shot: &Shot<'_>,
     styles: &[ObjectStyle],
-    host: Option<&[f64]>,
+    host: Option<&HostMap>,
 ) -> OutlineMap {
     let (width, height) = shot.size;
     let n = width as usize * height as usize;
@@ -99,7 +99,6 @@ pub(crate) fn outline_map(
         rays,
         fade_row: shot.view.view_depth_row(),
         host,
-        width,
     };
     let view = &view;
     let eye = shot.view.eye();
@@ -148,8 +147,8 @@ pub(crate) fn outline_map(
                         continue;
                     }
                     let near_w = s.near_w[0] + (s.near_w[1] - s.near_w[0]) * at;
-                    // The host's surface in this pixel is in front of the line's point.
-                    if host.is_some_and(|h| h[y * width as usize + x] > 1.0 - near_w) {
+                    // The pixel shows the host, and its surface is in front of the line's point.
+                    if host.is_some_and(|h| h.hides_line((x, y), 1.0 - near_w, d)) {
                         continue;
                     }
                     let inv_w = s.inv_w[0] + (s.inv_w[1] - s.inv_w[0]) * at;
@@ -187,9 +186,8 @@ struct Visibility<'a> {
     caster: &'a RayCaster<'a>,
     rays: &'a Rays,
     fade_row: DVec4,
-    /// The host's reverse depth per pixel (−1 where it has none), if the host gave it.
-    host: Option<&'a [f64]>,
-    width: u32,
+    /// The host's depth, if the host gave it.
+    host: Option<&'a HostMap>,
 }
 
 impl Visibility<'_> {
@@ -297,24 +295,20 @@ impl Visibility<'_> {
         }
     }
 
-    /// True unless the host's depth at the pixel containing screen point `x` is nearer than
-    /// the edge's point there (near row and w), or a triangle other than `t` and `n` of the
+    /// Whether the edge's point at screen point `x` (near row and w) is visible: unless the
+    /// host hides it ([`HostMap::hides_point`]), or a triangle other than `t` and `n` of the
     /// object (first id `first`) covers `x` nearer than that point.
     fn visible(&self, x: DVec2, (near, w): (f64, f64), first: u32, (t, n): (u32, u32)) -> bool {
-        if let Some(host) = self.host {
-            let size = self.rays.size();
-            let (px, py) = (x.x.floor(), x.y.floor());
-            let inside = px >= 0.0 && py >= 0.0 && px < size.x && py < size.y;
-            if inside && host[py as usize * self.width as usize + px as usize] > 1.0 - near / w {
-                return false;
-            }
+        if self.host.is_some_and(|h| h.hides_point(x, 1.0 - near / w)) {
+            return false;
         }
         let (from, to) = self.rays.segment(x);
         match self.caster.cast(from, to) {
             None => true,
             Some(hit) => {
                 let own = hit.id == first + t || (n != NO_NEIGHBOUR && hit.id == first + n);
-                own || !edge_math::nearer(self.rays.clip(hit.point).z, near, w)
+                let c = self.rays.clip(hit.point);
+                own || !edge_math::nearer(c.z, near, w)
             }
         }
     }
@@ -633,7 +627,6 @@ mod tests {
             rays: &rays,
             fade_row: view.view_depth_row(),
             host: None,
-            width: 64,
         };
         // Triangle 0's edge 1 runs from (1, -1) to (1, 1): visible only above y = 0, i.e. on
         // screen from the middle row up, ending where the near quad's top edge crosses it.

@@ -20,7 +20,7 @@
 // `!(a > b)` is deliberate throughout: NaN must take the rejecting branch.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-use crate::camera::{ClipRows, View};
+use crate::camera::{ClipRows, DepthRange, View};
 use crate::edge_math;
 use crate::error::{Error, Result};
 use crate::gpu::light_world_dir;
@@ -343,28 +343,29 @@ impl ObjectStyle {
 }
 
 /// Geometry the host draws itself, not wireframed, as its depth buffer shows it to the pass:
-/// per pixel, the farthest of the host's samples (none where any sample misses), moved back
-/// by [`host_margin`](edge_math::host_margin).
+/// per pixel, the farthest of the host's samples (none where any sample misses), as the
+/// depth format stores it, then moved back by [`host_margin`](edge_math::host_margin).
 pub struct HostOccluders<'a> {
     /// The host's own meshes, placed.
     pub world: &'a World,
     /// The sample positions within a pixel, (0, 0) its top left corner.
     pub samples: Vec<DVec2>,
-    /// The smallest step of the host's depth format, in reverse depth
-    /// ([`depth_quantum`](crate::gpu::depth_quantum)).
-    pub quantum: f64,
+    /// The host's depth format.
+    pub format: wgpu::TextureFormat,
+    /// The matrices and depth convention the host rendered with, where they are not the
+    /// shot's.
+    pub view: Option<View>,
 }
 
 impl<'a> HostOccluders<'a> {
-    /// One sample per pixel, at its centre, in a `Depth32Float` buffer.
+    /// One sample per pixel, at its centre, in a `Depth32Float` buffer, through the shot's
+    /// own view.
     pub fn single(world: &'a World) -> Self {
         HostOccluders {
             world,
             samples: vec![DVec2::splat(0.5)],
-            quantum: crate::gpu::depth_quantum(
-                wgpu::TextureFormat::Depth32Float,
-                crate::camera::DepthRange::Standard,
-            ),
+            format: wgpu::TextureFormat::Depth32Float,
+            view: None,
         }
     }
 
@@ -383,23 +384,49 @@ impl<'a> HostOccluders<'a> {
         }
     }
 
-    /// The same samples in a depth buffer of `format` holding depth in `depth`'s convention.
-    pub fn with_format(
-        self,
-        format: wgpu::TextureFormat,
-        depth: crate::camera::DepthRange,
-    ) -> Self {
+    /// The same samples in a depth buffer of `format`.
+    pub fn with_format(self, format: wgpu::TextureFormat) -> Self {
+        HostOccluders { format, ..self }
+    }
+
+    /// The same samples rendered through `view` (its matrices and depth convention).
+    pub fn with_view(self, view: View) -> Self {
         HostOccluders {
-            quantum: crate::gpu::depth_quantum(format, depth),
+            view: Some(view),
             ..self
         }
     }
 
+    /// A depth value of the host's convention as `format` stores it.
+    fn stored(&self, d: f64) -> f64 {
+        use wgpu::TextureFormat as F;
+        let unorm = |bits: i32| {
+            let steps = 2f64.powi(bits) - 1.0;
+            (d.clamp(0.0, 1.0) * steps).round() / steps
+        };
+        match self.format {
+            F::Depth16Unorm => unorm(16),
+            F::Depth24Plus | F::Depth24PlusStencil8 => unorm(24),
+            _ => f64::from(d as f32),
+        }
+    }
+
     /// Per pixel of `shot`, the host's reverse depth (moved back by the margin), or −1 where
-    /// the host has no geometry.
+    /// the host has no geometry. Mirrors host_depth.wgsl: the farthest sample of the host's
+    /// convention, mapped to the shot's reverse depth (through the pixel's centre where the
+    /// host's matrices differ from the shot's).
     fn depth_map(&self, shot: &Shot<'_>) -> Result<Vec<f64>> {
         let caster = RayCaster::new(self.world);
         let rays = Rays::new(&shot.view, shot.size, self.world)?;
+        let host = self.view.unwrap_or(shot.view);
+        host.validate()?;
+        let same = host.view == shot.view.view && host.projection == shot.view.projection;
+        let reversed = host.depth == DepthRange::Reversed;
+        let host_clip = host.projection * host.view;
+        let unproject = host_clip.inverse();
+        let scene = shot.view.clip_rows(DMat4::IDENTITY);
+        let quantum = crate::gpu::depth_quantum(self.format, host.depth);
+        let size = DVec2::new(f64::from(shot.size.0), f64::from(shot.size.1));
         let (width, height) = shot.size;
         Ok((0..height)
             .into_par_iter()
@@ -407,19 +434,119 @@ impl<'a> HostOccluders<'a> {
                 let (caster, rays) = (&caster, &rays);
                 (0..width).map(move |x| {
                     let corner = DVec2::new(f64::from(x), f64::from(y));
-                    let mut farthest = f64::INFINITY;
+                    let mut farthest: Option<f64> = None;
                     for &s in &self.samples {
                         let (from, to) = rays.segment(corner + s);
                         let Some(hit) = caster.cast(from, to) else {
                             return -1.0;
                         };
-                        let c = rays.clip(hit.point);
-                        farthest = farthest.min(1.0 - c.z / c.w);
+                        let c = host_clip * hit.point.extend(1.0);
+                        let d = self.stored(c.z / c.w);
+                        farthest = Some(match farthest {
+                            None => d,
+                            Some(f) if reversed => f.min(d),
+                            Some(f) => f.max(d),
+                        });
                     }
-                    (farthest - edge_math::host_margin(farthest, self.quantum)).clamp(0.0, 1.0)
+                    let Some(d) = farthest else { return -1.0 };
+                    let reverse = if same {
+                        if reversed {
+                            d
+                        } else {
+                            1.0 - d
+                        }
+                    } else {
+                        let pixel = corner + 0.5;
+                        let ndc =
+                            DVec2::new(pixel.x / size.x * 2.0 - 1.0, 1.0 - pixel.y / size.y * 2.0);
+                        let p = unproject * DVec4::new(ndc.x, ndc.y, d, 1.0);
+                        scene.depth.dot(p) / scene.clip.row(3).dot(p)
+                    };
+                    (reverse - edge_math::host_margin(reverse, quantum)).clamp(0.0, 1.0)
                 })
             })
             .collect())
+    }
+}
+
+/// The host's depth as the outline rules read it: per pixel its reverse depth (−1 where it
+/// has no geometry) and whether the pixel shows the host (its surface at the centre nearer
+/// than every object's, as [`Truth::sample`] decides).
+pub(crate) struct HostMap {
+    depth: Vec<f64>,
+    shows_host: Vec<bool>,
+    width: usize,
+    height: usize,
+}
+
+impl HostMap {
+    fn new(caster: &RayCaster<'_>, rays: &Rays, depth: Vec<f64>) -> HostMap {
+        let width = rays.size().x as usize;
+        let shows_host = depth
+            .par_iter()
+            .enumerate()
+            .map(|(k, &h)| {
+                if h < 0.0 {
+                    return false;
+                }
+                let pixel = DVec2::new((k % width) as f64 + 0.5, (k / width) as f64 + 0.5);
+                let (from, to) = rays.segment(pixel);
+                !caster.cast(from, to).is_some_and(|hit| {
+                    let c = rays.clip(hit.point);
+                    1.0 - c.z / c.w >= h
+                })
+            })
+            .collect();
+        HostMap {
+            height: depth.len() / width.max(1),
+            depth,
+            shows_host,
+            width,
+        }
+    }
+
+    /// The host's depth at pixel `(x, y)`, the image's edge pixels standing in for those
+    /// past it (as the GPU's clamped loads have it).
+    fn at(&self, x: i64, y: i64) -> f64 {
+        let x = x.clamp(0, self.width as i64 - 1) as usize;
+        let y = y.clamp(0, self.height as i64 - 1) as usize;
+        self.depth[y * self.width + x]
+    }
+
+    /// Twin of `host_pixel` in scene.wgsl: the host's depth and slope at a pixel.
+    fn pixel(&self, x: i64, y: i64) -> (f64, f64) {
+        let h = self.at(x, y);
+        let n = [
+            self.at(x - 1, y),
+            self.at(x + 1, y),
+            self.at(x, y - 1),
+            self.at(x, y + 1),
+        ];
+        (h, edge_math::host_slope(h, n))
+    }
+
+    /// Twin of `host_shown` in scene.wgsl: [`pixel`](Self::pixel) where the pixel shows the
+    /// host; `None` where an object shows (the host hides nothing drawn there, not even its
+    /// own copy of that object) or the host has nothing.
+    fn shown(&self, x: i64, y: i64) -> Option<(f64, f64)> {
+        let k = y.clamp(0, self.height as i64 - 1) as usize * self.width
+            + x.clamp(0, self.width as i64 - 1) as usize;
+        self.shows_host[k].then(|| self.pixel(x, y))
+    }
+
+    /// Twin of `host_hides_point` in scene.wgsl: whether the host hides an edge's point at
+    /// screen point `x`, of reverse depth `point`.
+    pub fn hides_point(&self, x: DVec2, point: f64) -> bool {
+        let (px, py) = (x.x.floor(), x.y.floor());
+        px >= 0.0 && py >= 0.0 && self.hides_line((px as usize, py as usize), point, 0.0)
+    }
+
+    /// Twin of `host_hides_line` in scene.wgsl: whether the host hides, in pixel `(x, y)`,
+    /// the line of a point of reverse depth `point` that lies `distance` pixels from its
+    /// centre.
+    pub fn hides_line(&self, (x, y): (usize, usize), point: f64, distance: f64) -> bool {
+        self.shown(x as i64, y as i64)
+            .is_some_and(|(h, slope)| edge_math::host_hides(h, point, distance, slope))
     }
 }
 
@@ -430,8 +557,9 @@ pub fn render_raycast(shot: &Shot<'_>) -> Result<Frame> {
 }
 
 /// [`render_raycast`] over the host's own geometry: where the host is nearer, a pixel shows
-/// [`HOST`], its lines are hidden, and outlines are hidden where the host's depth at the
-/// pixel containing their point is nearer.
+/// [`HOST`] and its lines are hidden; an outline point is hidden where the pixel containing
+/// it shows the host and the host's depth there is nearer, and no outline is drawn into a
+/// pixel that shows the host where the host is nearer than the outline's point.
 pub fn render_raycast_over(shot: &Shot<'_>, host: Option<&HostOccluders<'_>>) -> Result<Frame> {
     let (width, height) = shot.size;
     if width == 0 || height == 0 {
@@ -460,7 +588,8 @@ pub fn render_raycast_over(shot: &Shot<'_>, host: Option<&HostOccluders<'_>>) ->
         Some(h) => Some(h.depth_map(shot)?),
         None => None,
     };
-    let outline = crate::outline::outline_map(&caster, &rays, shot, &styles, host.as_deref());
+    let host_map = host.clone().map(|h| HostMap::new(&caster, &rays, h));
+    let outline = crate::outline::outline_map(&caster, &rays, shot, &styles, host_map.as_ref());
 
     let pixels = u64::from(width) * u64::from(height);
     let bar = progress_bar(u64::from(height), pixels);

@@ -7,8 +7,8 @@
 use crate::camera::View;
 use crate::error::{Error, Result};
 use crate::gpu::{
-    read_texture, texture_2d, DeferredPass, EdgeLines, ForwardPass, GpuContext, MeshId, MeshStore,
-    OutputTarget, PassOptions, TwoPass,
+    read_texture, texture_2d, Canvas, DeferredPass, EdgeLines, ForwardPass, GpuContext, MeshId,
+    MeshStore, OutputTarget, PassOptions, TwoPass, Window,
 };
 use crate::mesh::{EdgeSelection, Mesh};
 use crate::scene::{Instance, InstanceStyle, Scene};
@@ -329,11 +329,29 @@ pub fn render_deferred_with(
     ctx: &GpuContext,
     shot: &Shot<'_>,
     up: &Uploaded,
+    pass: DeferredPass,
+) -> Result<Frame> {
+    render_deferred_on(ctx, shot, up, pass, Canvas::new(shot.size))
+}
+
+/// [`render_deferred_with`] onto a canvas of the caller's: over the host's depth buffer, say
+/// (its pixels where the host is in front get the id [`HOST`]).
+pub fn render_deferred_on(
+    ctx: &GpuContext,
+    shot: &Shot<'_>,
+    up: &Uploaded,
     mut pass: DeferredPass,
+    canvas: Canvas<'_>,
 ) -> Result<Frame> {
     let device = &ctx.device;
+    if canvas.window != Window::whole(shot.size) {
+        return Err(Error::Misuse(format!(
+            "the canvas is {:?}, not the whole {}x{} image of the shot",
+            canvas.window, shot.size.0, shot.size.1
+        )));
+    }
     let scene = up.scene(shot.world, shot.view);
-    let frame = pass.prepare(device, &up.store, &scene, shot.style, shot.size)?;
+    let frame = pass.prepare(device, &up.store, &scene, shot.style, canvas)?;
     let usage = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC;
     let output = texture_2d(
         device,

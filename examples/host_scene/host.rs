@@ -6,10 +6,23 @@ use wirepass::glam::{DMat4, Mat4, Vec3};
 use wirepass::wgpu::util::DeviceExt;
 use wirepass::{wgpu, DepthRange, Mesh};
 
-/// The host's colour format: sRGB, as most surfaces and images are.
-pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
-/// The host's depth-stencil format.
-pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth24PlusStencil8;
+/// The host's target formats and sample count.
+#[derive(Clone, Copy, Debug)]
+pub struct HostFormats {
+    pub color: wgpu::TextureFormat,
+    pub depth: wgpu::TextureFormat,
+    pub samples: u32,
+}
+
+impl HostFormats {
+    /// What the example draws into: sRGB colour, as most surfaces and images are, a
+    /// depth-stencil buffer, 4× multisampling.
+    pub const EXAMPLE: HostFormats = HostFormats {
+        color: wgpu::TextureFormat::Rgba8UnormSrgb,
+        depth: wgpu::TextureFormat::Depth24PlusStencil8,
+        samples: 4,
+    };
+}
 
 const SHADER: &str = r#"
 struct Draw {
@@ -74,11 +87,12 @@ pub struct HostDraw<'a> {
 pub struct HostRenderer {
     pipeline: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
+    formats: HostFormats,
     pub depth: DepthRange,
 }
 
 impl HostRenderer {
-    pub fn new(device: &wgpu::Device, samples: u32, depth: DepthRange) -> HostRenderer {
+    pub fn new(device: &wgpu::Device, formats: HostFormats, depth: DepthRange) -> HostRenderer {
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("host"),
             source: wgpu::ShaderSource::Wgsl(SHADER.into()),
@@ -120,21 +134,21 @@ impl HostRenderer {
             },
             primitive: wgpu::PrimitiveState::default(),
             depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
+                format: formats.depth,
                 depth_write_enabled: Some(true),
                 depth_compare: Some(compare),
                 stencil: Default::default(),
                 bias: Default::default(),
             }),
             multisample: wgpu::MultisampleState {
-                count: samples,
+                count: formats.samples,
                 ..Default::default()
             },
             fragment: Some(wgpu::FragmentState {
                 module: &module,
                 entry_point: Some("fs"),
                 compilation_options: Default::default(),
-                targets: &[Some(COLOR_FORMAT.into())],
+                targets: &[Some(formats.color.into())],
             }),
             multiview_mask: None,
             cache: None,
@@ -142,6 +156,7 @@ impl HostRenderer {
         HostRenderer {
             pipeline,
             layout,
+            formats,
             depth,
         }
     }
@@ -160,7 +175,7 @@ impl HostRenderer {
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
-        (color, depth): (&wgpu::TextureView, &wgpu::TextureView),
+        targets: &HostTargets,
         clear: Vec3,
         view_projection: DMat4,
         draws: &[HostDraw<'_>],
@@ -189,37 +204,41 @@ impl HostRenderer {
                 })
             })
             .collect();
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("host scene"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: color,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color {
-                        r: f64::from(clear.x),
-                        g: f64::from(clear.y),
-                        b: f64::from(clear.z),
-                        a: 1.0,
+        let (color, depth, resolved) = targets.views();
+        let mut pass =
+            encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("host scene"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &color,
+                    depth_slice: None,
+                    resolve_target: resolved.as_ref(),
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color {
+                            r: f64::from(clear.x),
+                            g: f64::from(clear.y),
+                            b: f64::from(clear.z),
+                            a: 1.0,
+                        }),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &depth,
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(self.far()),
+                        store: wgpu::StoreOp::Store,
                     }),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: depth,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(self.far()),
-                    store: wgpu::StoreOp::Store,
+                    stencil_ops: self.formats.depth.has_stencil_aspect().then_some(
+                        wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(0),
+                            store: wgpu::StoreOp::Store,
+                        },
+                    ),
                 }),
-                stencil_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(0),
-                    store: wgpu::StoreOp::Store,
-                }),
-            }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
         pass.set_pipeline(&self.pipeline);
         for (d, group) in draws.iter().zip(&groups) {
             pass.set_bind_group(0, group, &[]);
@@ -229,16 +248,16 @@ impl HostRenderer {
     }
 }
 
-/// The host's targets at one size: multisampled colour and depth, and the single-sampled
-/// colour they resolve to.
+/// The host's targets at one size: colour and depth (multisampled or not), and with
+/// multisampling the single-sampled colour they resolve to.
 pub struct HostTargets {
     pub color: wgpu::Texture,
     pub depth: wgpu::Texture,
-    pub resolved: wgpu::Texture,
+    pub resolved: Option<wgpu::Texture>,
 }
 
 impl HostTargets {
-    pub fn new(device: &wgpu::Device, size: (u32, u32), samples: u32) -> HostTargets {
+    pub fn new(device: &wgpu::Device, size: (u32, u32), formats: HostFormats) -> HostTargets {
         let texture = |label, format, samples, usage| {
             device.create_texture(&wgpu::TextureDescriptor {
                 label: Some(label),
@@ -256,21 +275,84 @@ impl HostTargets {
             })
         };
         use wgpu::TextureUsages as U;
+        let image = U::RENDER_ATTACHMENT | U::COPY_SRC | U::TEXTURE_BINDING;
+        let samples = formats.samples;
+        let multisampled = samples > 1;
         HostTargets {
-            color: texture("host colour", COLOR_FORMAT, samples, U::RENDER_ATTACHMENT),
+            color: texture(
+                "host colour",
+                formats.color,
+                samples,
+                if multisampled {
+                    U::RENDER_ATTACHMENT
+                } else {
+                    image
+                },
+            ),
             depth: texture(
                 "host depth",
-                DEPTH_FORMAT,
+                formats.depth,
                 samples,
                 U::RENDER_ATTACHMENT | U::TEXTURE_BINDING,
             ),
-            resolved: texture(
-                "host resolved",
-                COLOR_FORMAT,
-                1,
-                U::RENDER_ATTACHMENT | U::COPY_SRC | U::TEXTURE_BINDING,
-            ),
+            resolved: multisampled.then(|| texture("host resolved", formats.color, 1, image)),
         }
+    }
+
+    /// The finished single-sampled image.
+    pub fn image(&self) -> &wgpu::Texture {
+        self.resolved.as_ref().unwrap_or(&self.color)
+    }
+
+    /// Views of the colour and depth attachments and of the resolve target.
+    pub fn views(
+        &self,
+    ) -> (
+        wgpu::TextureView,
+        wgpu::TextureView,
+        Option<wgpu::TextureView>,
+    ) {
+        (
+            self.color.create_view(&Default::default()),
+            self.depth.create_view(&Default::default()),
+            self.resolved
+                .as_ref()
+                .map(|r| r.create_view(&Default::default())),
+        )
+    }
+
+    /// A render pass over the host's finished colour and depth, as a host opens one to draw
+    /// overlays (text, gizmos, wirepass's lines) after its scene; it resolves again at its end.
+    pub fn overlay_pass<'e>(&self, encoder: &'e mut wgpu::CommandEncoder) -> wgpu::RenderPass<'e> {
+        let (color, depth, resolved) = self.views();
+        let load = wgpu::Operations {
+            load: wgpu::LoadOp::Load,
+            store: wgpu::StoreOp::Store,
+        };
+        let stencil = self.depth.format().has_stencil_aspect();
+        encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("host overlay"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &color,
+                depth_slice: None,
+                resolve_target: resolved.as_ref(),
+                ops: load,
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &depth,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Load,
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: stencil.then_some(wgpu::Operations {
+                    load: wgpu::LoadOp::Load,
+                    store: wgpu::StoreOp::Store,
+                }),
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        })
     }
 }
 
@@ -312,6 +394,48 @@ impl HostScene {
             pillar: box_mesh(),
             pillar_at: DMat4::from_translation(DVec3::new(-0.55, 0.8, 1.3))
                 * DMat4::from_scale(DVec3::new(0.18, 0.8, 0.18)),
+        }
+    }
+
+    /// The host's meshes on the GPU, in the order of [`draws`](Self::draws).
+    pub fn upload(&self, device: &wgpu::Device) -> [HostMesh; 4] {
+        [&self.ground, &self.pillar, &self.cow, &self.monkey].map(|m| HostMesh::new(device, m))
+    }
+
+    /// Everything the host draws: the ground, the pillar, and its own shaded copies of the
+    /// cow and the monkey.
+    pub fn draws<'a>(&self, meshes: &'a [HostMesh; 4]) -> [HostDraw<'a>; 4] {
+        let placed = [
+            (DMat4::IDENTITY, Vec3::new(0.35, 0.42, 0.3)),
+            (self.pillar_at, Vec3::new(0.6, 0.45, 0.35)),
+            (self.cow_at, Vec3::new(0.8, 0.75, 0.7)),
+            (self.monkey_at, Vec3::new(0.75, 0.6, 0.45)),
+        ];
+        std::array::from_fn(|i| HostDraw {
+            mesh: &meshes[i],
+            transform: placed[i].0,
+            color: placed[i].1,
+        })
+    }
+
+    /// The sky colour the host clears to (linear RGB).
+    pub const SKY: Vec3 = Vec3::new(0.55, 0.65, 0.8);
+
+    /// The host's view for an image of `aspect`, in depth convention `depth`.
+    pub fn view(&self, aspect: f64, depth: DepthRange) -> wirepass::View {
+        let camera = self.camera();
+        match depth {
+            DepthRange::Standard => camera.to_view(aspect),
+            DepthRange::Reversed => wirepass::View::new(
+                camera.view(),
+                wirepass::glam::dcamera::rh::proj::directx::perspective(
+                    f64::from(camera.fov_y_deg).to_radians(),
+                    aspect,
+                    f64::from(camera.far),
+                    f64::from(camera.near),
+                ),
+                DepthRange::Reversed,
+            ),
         }
     }
 

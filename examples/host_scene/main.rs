@@ -9,8 +9,7 @@
 
 mod host;
 
-use host::{HostDraw, HostMesh, HostRenderer, HostScene, HostTargets};
-use wirepass::glam::{DMat4, Vec3};
+use host::{HostFormats, HostRenderer, HostScene, HostTargets};
 use wirepass::gpu::{Composite, HostDepth, MeshStore, OutputTarget, PassOptions, RenderTarget};
 use wirepass::{wgpu, DeferredPass, DepthRange, EdgeSelection, Instance, Scene, Style};
 
@@ -48,26 +47,11 @@ fn render(
     depth: DepthRange,
 ) -> Result<Vec<u8>, Box<dyn std::error::Error>> {
     // The host's renderer, targets and meshes.
-    let samples = 4;
-    let host = HostRenderer::new(device, samples, depth);
-    let targets = HostTargets::new(device, size, samples);
-    let meshes =
-        [&scene.ground, &scene.pillar, &scene.cow, &scene.monkey].map(|m| HostMesh::new(device, m));
-    let camera = scene.camera();
-    let aspect = f64::from(size.0) / f64::from(size.1);
-    let view = match depth {
-        DepthRange::Standard => camera.to_view(aspect),
-        DepthRange::Reversed => wirepass::View::new(
-            camera.view(),
-            wirepass::glam::dcamera::rh::proj::directx::perspective(
-                f64::from(camera.fov_y_deg).to_radians(),
-                aspect,
-                f64::from(camera.far),
-                f64::from(camera.near),
-            ),
-            DepthRange::Reversed,
-        ),
-    };
+    let formats = HostFormats::EXAMPLE;
+    let host = HostRenderer::new(device, formats, depth);
+    let targets = HostTargets::new(device, size, formats);
+    let meshes = scene.upload(device);
+    let view = scene.view(f64::from(size.0) / f64::from(size.1), depth);
 
     // wirepass: the meshes to wireframe, and a pass that draws into the host's render pass.
     let mut store = MeshStore::new(device);
@@ -77,9 +61,9 @@ fn render(
         device,
         PassOptions {
             render_target: Some(RenderTarget {
-                format: host::COLOR_FORMAT,
-                sample_count: samples,
-                depth_stencil: Some(host::DEPTH_FORMAT),
+                format: formats.color,
+                sample_count: formats.samples,
+                depth_stencil: Some(formats.depth),
                 content: Composite::Lines,
             }),
             ..Default::default()
@@ -97,28 +81,14 @@ fn render(
 
     // Each frame: the host draws its scene, wirepass reads its depth and draws the lines
     // into the host's own render pass.
-    let color = targets.color.create_view(&Default::default());
-    let depth_view = targets.depth.create_view(&Default::default());
-    let resolved = targets.resolved.create_view(&Default::default());
     let mut encoder = device.create_command_encoder(&Default::default());
-    let draws = [
-        (0, DMat4::IDENTITY, Vec3::new(0.35, 0.42, 0.3)),
-        (1, scene.pillar_at, Vec3::new(0.6, 0.45, 0.35)),
-        (2, scene.cow_at, Vec3::new(0.8, 0.75, 0.7)),
-        (3, scene.monkey_at, Vec3::new(0.75, 0.6, 0.45)),
-    ]
-    .map(|(m, transform, color)| HostDraw {
-        mesh: &meshes[m],
-        transform,
-        color,
-    });
     host.draw(
         device,
         &mut encoder,
-        (&color, &depth_view),
-        Vec3::new(0.55, 0.65, 0.8),
+        &targets,
+        HostScene::SKY,
         view.view_projection(),
-        &draws,
+        &scene.draws(&meshes),
     );
     let canvas = wirepass::gpu::Canvas::new(size).with_host_depth(HostDepth {
         texture: &targets.depth,
@@ -132,34 +102,9 @@ fn render(
         &frame,
         OutputTarget::RenderPass,
     )?;
-    {
-        let mut rp = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("host overlay"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &color,
-                depth_slice: None,
-                resolve_target: Some(&resolved),
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Load,
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &depth_view,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Load,
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.render(&mut rp, &frame)?;
-    }
+    pass.render(&mut targets.overlay_pass(&mut encoder), &frame)?;
     queue.submit([encoder.finish()]);
     let rgba =
-        wirepass::gpu::read_texture(device, queue, &targets.resolved, wgpu::TextureAspect::All)?;
+        wirepass::gpu::read_texture(device, queue, targets.image(), wgpu::TextureAspect::All)?;
     Ok(rgba)
 }

@@ -308,9 +308,12 @@ pub(crate) fn bind_group(
             resource,
         });
     }
-    Ok(device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("wirepass"),
-        layout,
-        entries: &entries,
-    }))
+    super::bind_host_resources(
+        device,
+        &wgpu::BindGroupDescriptor {
+            label: Some("wirepass"),
+            layout,
+            entries: &entries,
+        },
+    )
 }

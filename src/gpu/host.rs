@@ -7,9 +7,13 @@
 //! [`host_margin`](crate::edge_math::host_margin); id `HOST` where the host has geometry)
 //! and keeps the host's depth alone in a target of its own for the compute passes. The rules
 //! the ground truth shares: a pixel shows the host where the host's depth there is nearer
-//! than the instance's surface at its centre; a point of an outline is hidden where the
-//! host's depth at the pixel containing it is nearer than the point; and no line is drawn
-//! into a pixel whose host depth is nearer than the line's point.
+//! than every instance's surface at its centre; a point of an outline is hidden where the
+//! pixel containing it shows the host and the host there is clearly nearer than the point;
+//! and no line is drawn into a pixel that shows the host where the host is clearly nearer
+//! than the line's point ("clearly": by twice the host's own depth change over the distance
+//! and a pixel more, `edge_math::host_hides`, so outlines stay whole where an object meets
+//! the ground). Where an instance shows, the host hides nothing drawn there, so a host that
+//! draws its own copy of a wireframed mesh keeps that mesh's outlines whole.
 
 use super::frame::FrameData;
 use super::targets::{Targets, DEPTH_FORMAT, HOST_FORMAT, ID_FORMAT};
@@ -44,9 +48,11 @@ struct HostParams {
     quantum: f32,
 }
 
-/// The seeding draw's pipelines: for single- and multisampled host depth.
+/// The seeding passes' pipelines: the resolve for single- and multisampled host depth, and
+/// the draw that writes the depth and id targets.
 pub(crate) struct HostImport {
-    pipelines: [Option<(wgpu::RenderPipeline, wgpu::BindGroupLayout)>; 2],
+    resolve: [Option<(wgpu::ComputePipeline, wgpu::BindGroupLayout)>; 2],
+    seed: Option<(wgpu::RenderPipeline, wgpu::BindGroupLayout)>,
 }
 
 /// A frame's host depth, ready to seed its targets.
@@ -59,7 +65,8 @@ pub(crate) struct HostFrame {
 impl HostImport {
     pub fn new() -> Self {
         HostImport {
-            pipelines: [None, None],
+            resolve: [None, None],
+            seed: None,
         }
     }
 
@@ -100,9 +107,24 @@ impl HostImport {
         }
         host.view.validate()?;
         let multisampled = t.sample_count() > 1;
+        let info = device.adapter_info();
+        if multisampled && info.backend == wgpu::Backend::Gl {
+            // wgpu's GL backend cannot render into a multisampled texture that can also be
+            // bound (gfx-rs/wgpu#6084): such a depth holds nothing, and the host's own pass
+            // with it draws nothing either.
+            return Err(Error::MissingFeature {
+                adapter: info.name,
+                what: "a multisampled depth texture that can be both rendered and bound \
+                       (wgpu's GL backend cannot; give a single-sampled depth)"
+                    .into(),
+            });
+        }
         let slot = usize::from(multisampled);
-        if self.pipelines[slot].is_none() {
-            self.pipelines[slot] = Some(build(device, multisampled)?);
+        if self.resolve[slot].is_none() {
+            self.resolve[slot] = Some(build_resolve(device, multisampled)?);
+        }
+        if self.seed.is_none() {
+            self.seed = Some(build_seed(device)?);
         }
         let same =
             host.view.view == scene_view.view && host.view.projection == scene_view.projection;
@@ -144,7 +166,8 @@ impl HostImport {
         })
     }
 
-    /// Records the seeding draw: clears nothing, writes every target pixel.
+    /// Records the seeding passes: the resolve into the host target, then the draw that
+    /// writes every pixel of the depth and id targets.
     pub fn encode(
         &self,
         device: &wgpu::Device,
@@ -152,52 +175,78 @@ impl HostImport {
         frame: &FrameData,
         host: &HostFrame,
         targets: &Targets,
-        timer: Option<&mut GpuTimer>,
+        mut timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
-        let (pipeline, layout) = self.pipelines[usize::from(host.multisampled)]
+        let unprepared = || Error::Device("the host depth pipelines were not prepared".into());
+        let (resolve, resolve_layout) = self.resolve[usize::from(host.multisampled)]
             .as_ref()
-            .ok_or_else(|| Error::Device("the host depth pipeline was not prepared".into()))?;
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("wirepass host depth"),
-            layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: frame.frame.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 30,
-                    resource: wgpu::BindingResource::TextureView(&host.view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 31,
-                    resource: host.params.as_entire_binding(),
-                },
-            ],
-        });
+            .ok_or_else(unprepared)?;
+        let (seed, seed_layout) = self.seed.as_ref().ok_or_else(unprepared)?;
         let host_target = targets
             .host
             .as_ref()
             .ok_or_else(|| Error::Device("the targets have no host depth".into()))?;
-        let (ids, depth, host_view) = (
+        let host_view = host_target.create_view(&Default::default());
+        let resolve_group = super::bind_host_resources(
+            device,
+            &wgpu::BindGroupDescriptor {
+                label: Some("wirepass host depth"),
+                layout: resolve_layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: frame.frame.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 30,
+                        resource: wgpu::BindingResource::TextureView(&host.view),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 31,
+                        resource: host.params.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 32,
+                        resource: wgpu::BindingResource::TextureView(&host_view),
+                    },
+                ],
+            },
+        )?;
+        let seed_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("wirepass host seed"),
+            layout: seed_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 33,
+                resource: wgpu::BindingResource::TextureView(&host_view),
+            }],
+        });
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("wirepass host depth"),
+                timestamp_writes: timer
+                    .as_deref_mut()
+                    .and_then(|t| t.compute_span("host_depth.resolve")),
+            });
+            pass.set_pipeline(resolve);
+            pass.set_bind_group(0, &resolve_group, &[]);
+            let (w, h) = (host_target.width(), host_target.height());
+            pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
+        }
+        let (ids, depth) = (
             targets.ids.create_view(&Default::default()),
             targets.depth.create_view(&Default::default()),
-            host_target.create_view(&Default::default()),
         );
-        let attach = |view| {
-            Some(wgpu::RenderPassColorAttachment {
-                view,
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("wirepass host seed"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &ids,
                 depth_slice: None,
                 resolve_target: None,
                 ops: wgpu::Operations {
                     load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
                     store: wgpu::StoreOp::Store,
                 },
-            })
-        };
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("wirepass host depth"),
-            color_attachments: &[attach(&ids), attach(&host_view)],
+            })],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: &depth,
                 depth_ops: Some(wgpu::Operations {
@@ -206,12 +255,12 @@ impl HostImport {
                 }),
                 stencil_ops: None,
             }),
-            timestamp_writes: timer.and_then(|t| t.render_span("host_depth")),
+            timestamp_writes: timer.and_then(|t| t.render_span("host_depth.seed")),
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_pipeline(pipeline);
-        pass.set_bind_group(0, &group, &[]);
+        pass.set_pipeline(seed);
+        pass.set_bind_group(0, &seed_group, &[]);
         pass.draw(0..3, 0..1);
         Ok(())
     }
@@ -230,36 +279,51 @@ pub fn depth_quantum(format: wgpu::TextureFormat, depth: DepthRange) -> f64 {
     }
 }
 
-fn build(
+fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+fn build_resolve(
     device: &wgpu::Device,
     multisampled: bool,
-) -> Result<(wgpu::RenderPipeline, wgpu::BindGroupLayout)> {
+) -> Result<(wgpu::ComputePipeline, wgpu::BindGroupLayout)> {
     let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-    let fs = wgpu::ShaderStages::FRAGMENT;
-    let uniform = wgpu::BindingType::Buffer {
-        ty: wgpu::BufferBindingType::Uniform,
-        has_dynamic_offset: false,
-        min_binding_size: None,
-    };
-    let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: fs,
-        ty,
-        count: None,
-    };
+    let cs = wgpu::ShaderStages::COMPUTE;
     let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("wirepass host depth"),
         entries: &[
-            entry(0, uniform),
-            entry(
-                30,
-                wgpu::BindingType::Texture {
-                    sample_type: wgpu::TextureSampleType::Depth,
+            uniform_entry(0, cs),
+            wgpu::BindGroupLayoutEntry {
+                binding: 30,
+                visibility: cs,
+                // Unfilterable float: what every backend can load a depth texture as.
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
                     view_dimension: wgpu::TextureViewDimension::D2,
                     multisampled,
                 },
-            ),
-            entry(31, uniform),
+                count: None,
+            },
+            uniform_entry(31, cs),
+            wgpu::BindGroupLayoutEntry {
+                binding: 32,
+                visibility: cs,
+                ty: wgpu::BindingType::StorageTexture {
+                    access: wgpu::StorageTextureAccess::WriteOnly,
+                    format: HOST_FORMAT,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                },
+                count: None,
+            },
         ],
     });
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -271,8 +335,46 @@ fn build(
         label: Some("wirepass host depth"),
         source: wgpu::ShaderSource::Wgsl(shaders::host_depth_source(multisampled).into()),
     });
-    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
         label: Some("wirepass host depth"),
+        layout: Some(&pipeline_layout),
+        module: &module,
+        entry_point: Some("resolve_main"),
+        compilation_options: Default::default(),
+        cache: None,
+    });
+    if let Some(e) = pollster::block_on(scope.pop()) {
+        return Err(Error::Device(format!("building the host depth pass: {e}")));
+    }
+    Ok((pipeline, layout))
+}
+
+fn build_seed(device: &wgpu::Device) -> Result<(wgpu::RenderPipeline, wgpu::BindGroupLayout)> {
+    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("wirepass host seed"),
+        entries: &[wgpu::BindGroupLayoutEntry {
+            binding: 33,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Uint,
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: false,
+            },
+            count: None,
+        }],
+    });
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("wirepass host seed"),
+        bind_group_layouts: &[Some(&layout)],
+        immediate_size: 0,
+    });
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("wirepass host seed"),
+        source: wgpu::ShaderSource::Wgsl(shaders::host_depth_source(false).into()),
+    });
+    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("wirepass host seed"),
         layout: Some(&pipeline_layout),
         vertex: wgpu::VertexState {
             module: &module,
@@ -293,13 +395,13 @@ fn build(
             module: &module,
             entry_point: Some("fs_main"),
             compilation_options: Default::default(),
-            targets: &[Some(ID_FORMAT.into()), Some(HOST_FORMAT.into())],
+            targets: &[Some(ID_FORMAT.into())],
         }),
         multiview_mask: None,
         cache: None,
     });
     if let Some(e) = pollster::block_on(scope.pop()) {
-        return Err(Error::Device(format!("building the host depth pass: {e}")));
+        return Err(Error::Device(format!("building the host seed pass: {e}")));
     }
     Ok((pipeline, layout))
 }

@@ -667,7 +667,7 @@ pub(crate) fn triangle_info(mesh: &Mesh, edges: EdgeSelection, order: &[u32]) ->
 }
 
 /// A unit normal packed octahedrally into two 16-bit snorms (`unpack_normal` in
-/// common.wgsl is the inverse); a zero normal packs to [`NO_NORMAL`].
+/// common.wgsl is the inverse); a zero normal packs to `NO_NORMAL`.
 pub fn pack_normal(n: Vec3) -> u32 {
     let sum = n.x.abs() + n.y.abs() + n.z.abs();
     if !(sum > 0.0) {
@@ -683,7 +683,7 @@ pub fn pack_normal(n: Vec3) -> u32 {
 }
 
 /// Twin of `unpack_normal` in common.wgsl: the unit normal of a packed one (zero for
-/// [`NO_NORMAL`]).
+/// `NO_NORMAL`).
 pub fn unpack_normal(packed: u32) -> Vec3 {
     if packed == NO_NORMAL {
         return Vec3::ZERO;

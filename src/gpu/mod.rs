@@ -33,6 +33,23 @@ pub use two_pass::{drawn_edges, two_pass_source, EdgeLines, TwoPass, FILL_DEPTH_
 
 use crate::error::{Error, Result};
 
+/// Creates a bind group that may hold the host's resources, turning wgpu's validation of
+/// them (a view from another device, say) into an [`Error::Misuse`] before anything uses
+/// the group.
+pub(crate) fn bind_host_resources(
+    device: &wgpu::Device,
+    desc: &wgpu::BindGroupDescriptor<'_>,
+) -> Result<wgpu::BindGroup> {
+    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let group = device.create_bind_group(desc);
+    match pollster::block_on(scope.pop()) {
+        None => Ok(group),
+        Some(e) => Err(Error::Misuse(format!(
+            "a texture given to the pass cannot be bound (from another device?): {e}"
+        ))),
+    }
+}
+
 /// A single-level 2D texture of `width × height`: the shape of every target and output here.
 pub fn texture_2d(
     device: &wgpu::Device,

@@ -161,7 +161,7 @@ impl Targets {
                     "wirepass host depth",
                     spec.size,
                     HOST_FORMAT,
-                    U::RENDER_ATTACHMENT | U::TEXTURE_BINDING,
+                    U::STORAGE_BINDING | U::TEXTURE_BINDING,
                 )
             }),
         })
