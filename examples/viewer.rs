@@ -1,0 +1,718 @@
+//! A mesh viewer in a window: wirepass draws the shaded mesh and its lines straight into the
+//! surface's render pass (the deferred method), or the forward baseline draws into a texture
+//! that is blitted to the surface, for comparison. The device has the WebGPU default limits.
+//!
+//! Mouse: left drag orbits, right or middle drag pans, the wheel zooms.
+//! Keys: `E` cycles the edges (polygon, all, feature), `O` toggles outlines, `M` switches the
+//! method, `+`/`-` change the line width, `Esc` quits.
+//!
+//! `cargo run --release --example viewer -- [MESH] [--method deferred|forward]
+//! [--edges polygon|all|feature] [--frames N] [--screenshot OUT.png]`
+//!
+//! With `--frames N` the viewer orbits a little each frame and closes after N frames; with
+//! `--screenshot` it reads the last frame back from the surface, checks that it shows the
+//! background, the shaded mesh and its lines, and writes it as a PNG (CI runs it so under
+//! Xvfb).
+
+use std::sync::Arc;
+use winit::application::ApplicationHandler;
+use winit::dpi::PhysicalSize;
+use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
+use winit::event_loop::{ActiveEventLoop, EventLoop, OwnedDisplayHandle};
+use winit::keyboard::{Key, NamedKey};
+use winit::window::{Window, WindowId};
+use wirepass::glam::{DMat4, DVec3, Vec3};
+use wirepass::gpu::{
+    Composite, DeferredPass, ForwardPass, MeshId, MeshStore, OutputTarget, PassOptions,
+    RenderTarget,
+};
+use wirepass::{wgpu, Camera, EdgeSelection, Instance, Mesh, Scene, Style};
+
+type AnyError = Box<dyn std::error::Error>;
+
+const EDGES: [(&str, EdgeSelection); 3] = [
+    ("polygon", EdgeSelection::Polygon),
+    ("all", EdgeSelection::All),
+    (
+        "feature",
+        EdgeSelection::Feature(wirepass::mesh::DEFAULT_FEATURE_ANGLE),
+    ),
+];
+
+#[derive(Clone, Copy, PartialEq, Debug)]
+enum Method {
+    Deferred,
+    Forward,
+}
+
+/// What the command line asks for.
+struct Options {
+    mesh: std::path::PathBuf,
+    method: Method,
+    edges: usize,
+    frames: Option<u64>,
+    screenshot: Option<std::path::PathBuf>,
+}
+
+fn options() -> Result<Options, AnyError> {
+    let mut o = Options {
+        mesh: std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/meshes/spot.obj"),
+        method: Method::Deferred,
+        edges: 0,
+        frames: None,
+        screenshot: None,
+    };
+    let mut args = std::env::args().skip(1);
+    while let Some(a) = args.next() {
+        let mut value = || args.next().ok_or(format!("{a} needs a value"));
+        match a.as_str() {
+            "--method" => {
+                o.method = match value()?.as_str() {
+                    "deferred" => Method::Deferred,
+                    "forward" => Method::Forward,
+                    m => return Err(format!("--method {m:?} is not deferred or forward").into()),
+                }
+            }
+            "--edges" => {
+                let e = value()?;
+                o.edges = EDGES
+                    .iter()
+                    .position(|(name, _)| *name == e)
+                    .ok_or(format!("--edges {e:?} is not polygon, all or feature"))?;
+            }
+            "--frames" => o.frames = Some(value()?.parse()?),
+            "--screenshot" => o.screenshot = Some(value()?.into()),
+            flag if flag.starts_with("--") => return Err(format!("unknown flag {flag}").into()),
+            path => o.mesh = path.into(),
+        }
+    }
+    Ok(o)
+}
+
+/// An orbit camera around the mesh's bounding sphere.
+struct Orbit {
+    target: DVec3,
+    radius: f64,
+    distance: f64,
+    yaw: f64,
+    pitch: f64,
+}
+
+impl Orbit {
+    fn new(mesh: &Mesh) -> Orbit {
+        let (lo, hi) = mesh.bounds_f64();
+        let radius = ((hi - lo).length() * 0.5).max(f64::MIN_POSITIVE);
+        Orbit {
+            target: (lo + hi) * 0.5,
+            radius,
+            distance: 2.8 * radius,
+            yaw: 0.5,
+            pitch: 0.35,
+        }
+    }
+
+    fn forward(&self) -> DVec3 {
+        -DVec3::new(
+            self.pitch.cos() * self.yaw.sin(),
+            self.pitch.sin(),
+            self.pitch.cos() * self.yaw.cos(),
+        )
+    }
+
+    /// A perspective camera with an infinite far plane and a near plane just before the
+    /// mesh (or close to the eye once inside it).
+    fn camera(&self) -> Camera {
+        let eye = self.target - self.forward() * self.distance;
+        let near = ((self.distance - self.radius) * 0.5).max(self.distance * 1e-3);
+        Camera {
+            eye: eye.as_vec3(),
+            target: self.target.as_vec3(),
+            up: Vec3::Y,
+            fov_y_deg: 40.0,
+            near: near as f32,
+            far: f32::INFINITY,
+        }
+    }
+
+    fn rotate(&mut self, dx: f64, dy: f64) {
+        self.yaw -= dx * 0.01;
+        self.pitch = (self.pitch + dy * 0.01).clamp(-1.5, 1.5);
+    }
+
+    /// Moves the target in the view plane by a drag of `(dx, dy)` pixels of a window
+    /// `height` pixels tall, so the point under the cursor follows it.
+    fn pan(&mut self, dx: f64, dy: f64, height: f64) {
+        let forward = self.forward();
+        let right = forward.cross(DVec3::Y).normalize();
+        let up = right.cross(forward);
+        let per_pixel = 2.0 * self.distance * (20f64.to_radians()).tan() / height;
+        self.target += (-right * dx + up * dy) * per_pixel;
+    }
+
+    fn zoom(&mut self, steps: f64) {
+        self.distance = (self.distance * 0.9f64.powf(steps)).max(self.radius * 1e-3);
+    }
+}
+
+/// The window's GPU side: the surface, the passes and the mesh in each edge selection.
+struct Viewer {
+    window: Arc<Window>,
+    surface: wgpu::Surface<'static>,
+    config: wgpu::SurfaceConfiguration,
+    /// The sRGB view of the surface's format, the one every pass draws into.
+    view_format: wgpu::TextureFormat,
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    store: MeshStore,
+    meshes: [MeshId; 3],
+    deferred: DeferredPass,
+    /// The forward baseline, if the device can run it, and its blit to the surface.
+    forward: Option<(ForwardPass, Blit)>,
+    orbit: Orbit,
+    style: Style,
+    method: Method,
+    edges: usize,
+    drag: Option<MouseButton>,
+    cursor: (f64, f64),
+}
+
+impl Viewer {
+    fn new(
+        window: Arc<Window>,
+        display: OwnedDisplayHandle,
+        mesh: &Mesh,
+        o: &Options,
+    ) -> Result<Viewer, AnyError> {
+        let instance = wgpu::Instance::new(
+            wgpu::InstanceDescriptor::new_with_display_handle_from_env(Box::new(display)),
+        );
+        let surface = instance.create_surface(window.clone())?;
+        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+            compatible_surface: Some(&surface),
+            ..Default::default()
+        }))?;
+        let (device, queue) =
+            pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+                required_features: adapter.features() & wgpu::Features::PRIMITIVE_INDEX,
+                required_limits: wgpu::Limits::default(),
+                ..Default::default()
+            }))?;
+        let size = window.inner_size();
+        let mut config = surface
+            .get_default_config(&adapter, size.width.max(1), size.height.max(1))
+            .ok_or("the surface cannot be presented to by this adapter")?;
+        let caps = surface.get_capabilities(&adapter);
+        // Draw through an sRGB view whatever the surface's own format, so that the colours
+        // are the same as in the PNGs the tools write.
+        config.format = caps
+            .formats
+            .iter()
+            .copied()
+            .find(|f| f.is_srgb())
+            .unwrap_or(config.format);
+        let view_format = config.format.add_srgb_suffix();
+        if view_format != config.format {
+            config.view_formats.push(view_format);
+        }
+        if o.screenshot.is_some() {
+            if !caps.usages.contains(wgpu::TextureUsages::COPY_SRC) {
+                return Err("--screenshot: the surface cannot be copied from".into());
+            }
+            config.usage |= wgpu::TextureUsages::COPY_SRC;
+        }
+        surface.configure(&device, &config);
+
+        let mut store = MeshStore::new(&device);
+        let mut meshes = Vec::new();
+        for (_, edges) in EDGES {
+            meshes.push(store.insert(&device, &queue, mesh, edges)?);
+        }
+        let deferred = DeferredPass::new(
+            &device,
+            PassOptions {
+                render_target: Some(RenderTarget {
+                    format: view_format,
+                    sample_count: 1,
+                    depth_stencil: None,
+                    content: Composite::Shaded,
+                }),
+                ..Default::default()
+            },
+        )?;
+        let forward = match ForwardPass::new(
+            &device,
+            PassOptions {
+                output_format: wgpu::TextureFormat::Rgba8UnormSrgb,
+                ..Default::default()
+            },
+        ) {
+            Ok(pass) => Some((pass, Blit::new(&device, view_format))),
+            Err(e) => {
+                eprintln!("viewer: the forward method is unavailable: {e}");
+                None
+            }
+        };
+        if o.method == Method::Forward && forward.is_none() {
+            return Err("--method forward: this device cannot run the forward pass".into());
+        }
+        let viewer = Viewer {
+            window,
+            surface,
+            config,
+            view_format,
+            device,
+            queue,
+            store,
+            meshes: meshes.try_into().expect("one mesh per edge selection"),
+            deferred,
+            forward,
+            orbit: Orbit::new(mesh),
+            style: Style::default(),
+            method: o.method,
+            edges: o.edges,
+            drag: None,
+            cursor: (0.0, 0.0),
+        };
+        viewer.title();
+        Ok(viewer)
+    }
+
+    fn title(&self) {
+        self.window.set_title(&format!(
+            "wirepass viewer: {:?}, {} edges, outlines {}, width {:.1} (E, O, M, +/-)",
+            self.method,
+            EDGES[self.edges].0,
+            if self.style.silhouettes { "on" } else { "off" },
+            self.style.line_width
+        ));
+    }
+
+    fn resize(&mut self, size: PhysicalSize<u32>) {
+        if size.width > 0 && size.height > 0 {
+            self.config.width = size.width;
+            self.config.height = size.height;
+            self.surface.configure(&self.device, &self.config);
+        }
+    }
+
+    fn key(&mut self, key: &Key) {
+        match key.as_ref() {
+            Key::Character("e" | "E") => self.edges = (self.edges + 1) % EDGES.len(),
+            Key::Character("o" | "O") => self.style.silhouettes = !self.style.silhouettes,
+            Key::Character("m" | "M") if self.forward.is_some() => {
+                self.method = match self.method {
+                    Method::Deferred => Method::Forward,
+                    Method::Forward => Method::Deferred,
+                }
+            }
+            Key::Character("+" | "=") => {
+                self.style.line_width = (self.style.line_width + 0.5).min(16.0)
+            }
+            Key::Character("-") => self.style.line_width = (self.style.line_width - 0.5).max(0.5),
+            _ => return,
+        }
+        self.title();
+        self.window.request_redraw();
+    }
+
+    fn mouse_moved(&mut self, x: f64, y: f64) {
+        let (dx, dy) = (x - self.cursor.0, y - self.cursor.1);
+        self.cursor = (x, y);
+        match self.drag {
+            Some(MouseButton::Left) => self.orbit.rotate(dx, dy),
+            Some(MouseButton::Right | MouseButton::Middle) => {
+                self.orbit.pan(dx, dy, f64::from(self.config.height))
+            }
+            _ => return,
+        }
+        self.window.request_redraw();
+    }
+
+    /// Draws one frame and presents it, read back as RGBA8 (sRGB) when `read_back`.
+    fn draw(&mut self, read_back: bool) -> Result<Drawn, AnyError> {
+        let surface = match self.surface.get_current_texture() {
+            wgpu::CurrentSurfaceTexture::Success(t)
+            | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
+            wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
+                self.surface.configure(&self.device, &self.config);
+                return Ok(Drawn::Skipped);
+            }
+            other => return Err(format!("the surface gave no frame: {other:?}").into()),
+        };
+        self.record(&surface.texture)?;
+        let rgba = if read_back {
+            Some(self.read(&surface.texture)?)
+        } else {
+            None
+        };
+        self.window.pre_present_notify();
+        self.queue.present(surface);
+        Ok(Drawn::Presented(rgba))
+    }
+
+    /// The frame [`draw`](Self::draw) presents, drawn into a texture of the surface's
+    /// format instead, and read back.
+    fn draw_offscreen(&mut self) -> Result<Vec<u8>, AnyError> {
+        let texture = self.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("viewer offscreen"),
+            size: wgpu::Extent3d {
+                width: self.config.width,
+                height: self.config.height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: self.config.format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[self.view_format],
+        });
+        self.record(&texture)?;
+        self.read(&texture)
+    }
+
+    /// Draws the scene into `texture` (of the surface's size and format) and submits.
+    fn record(&mut self, texture: &wgpu::Texture) -> Result<(), AnyError> {
+        let target = texture.create_view(&wgpu::TextureViewDescriptor {
+            format: Some(self.view_format),
+            ..Default::default()
+        });
+        let size = (self.config.width, self.config.height);
+        let aspect = f64::from(size.0) / f64::from(size.1);
+        let instances = [Instance::new(self.meshes[self.edges], DMat4::IDENTITY)];
+        let scene = Scene::borrowed(self.orbit.camera().to_view(aspect), &instances);
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        let clear = {
+            let [r, g, b, a] = self.style.background.0.map(f64::from);
+            wgpu::Color { r, g, b, a }
+        };
+        match (self.method, &mut self.forward) {
+            (Method::Forward, Some((forward, blit))) => {
+                let frame =
+                    forward.prepare(&self.device, &self.store, &scene, &self.style, size)?;
+                let output = wirepass::gpu::texture_2d(
+                    &self.device,
+                    "viewer forward",
+                    size,
+                    forward.output_format(),
+                    wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+                );
+                let output = output.create_view(&Default::default());
+                forward.encode(&self.device, &mut encoder, &self.store, &frame, &output)?;
+                blit.draw(&self.device, &mut encoder, &output, &target);
+            }
+            _ => {
+                let frame =
+                    self.deferred
+                        .prepare(&self.device, &self.store, &scene, &self.style, size)?;
+                self.deferred.encode(
+                    &self.device,
+                    &mut encoder,
+                    &self.store,
+                    &frame,
+                    OutputTarget::RenderPass,
+                )?;
+                // The host's own render pass on the surface; wirepass draws into it.
+                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("viewer"),
+                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                        view: &target,
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(clear),
+                            store: wgpu::StoreOp::Store,
+                        },
+                    })],
+                    ..Default::default()
+                });
+                self.deferred.render(&mut pass, &frame)?;
+            }
+        }
+        self.queue.submit([encoder.finish()]);
+        Ok(())
+    }
+
+    /// Reads `texture` back as RGBA8.
+    fn read(&self, texture: &wgpu::Texture) -> Result<Vec<u8>, AnyError> {
+        let mut bytes = wirepass::gpu::read_texture(
+            &self.device,
+            &self.queue,
+            texture,
+            wgpu::TextureAspect::All,
+        )?;
+        if texture.format().remove_srgb_suffix() == wgpu::TextureFormat::Bgra8Unorm {
+            bytes.chunks_exact_mut(4).for_each(|p| p.swap(0, 2));
+        }
+        Ok(bytes)
+    }
+}
+
+/// What became of a frame.
+enum Drawn {
+    /// The surface had to be configured again; draw again.
+    Skipped,
+    /// Presented, with its pixels if they were asked for.
+    Presented(Option<Vec<u8>>),
+}
+
+/// Copies a texture onto the surface: a full-screen triangle that loads each texel.
+struct Blit {
+    pipeline: wgpu::RenderPipeline,
+}
+
+impl Blit {
+    const SHADER: &str = "
+        @group(0) @binding(0) var source: texture_2d<f32>;
+        @vertex fn vs(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
+            let p = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));
+            return vec4<f32>(p * 2.0 - 1.0, 0.0, 1.0);
+        }
+        @fragment fn fs(@builtin(position) p: vec4<f32>) -> @location(0) vec4<f32> {
+            return textureLoad(source, vec2<i32>(p.xy), 0);
+        }";
+
+    fn new(device: &wgpu::Device, format: wgpu::TextureFormat) -> Blit {
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("viewer blit"),
+            source: wgpu::ShaderSource::Wgsl(Self::SHADER.into()),
+        });
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("viewer blit"),
+            layout: None,
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: Default::default(),
+            depth_stencil: None,
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs"),
+                compilation_options: Default::default(),
+                targets: &[Some(format.into())],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        Blit { pipeline }
+    }
+
+    fn draw(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        source: &wgpu::TextureView,
+        target: &wgpu::TextureView,
+    ) {
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("viewer blit"),
+            layout: &self.pipeline.get_bind_group_layout(0),
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::TextureView(source),
+            }],
+        });
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("viewer blit"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: target,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            ..Default::default()
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &group, &[]);
+        pass.draw(0..3, 0..1);
+    }
+}
+
+/// Checks a frame read back from the surface: it is the frame the same passes draw into a
+/// texture of the surface's format, and it shows the background around the mesh, the shaded
+/// surface, and lines.
+fn check_frame(presented: &[u8], offscreen: &[u8], style: &Style) -> Result<(), String> {
+    let differing = presented
+        .chunks_exact(4)
+        .zip(offscreen.chunks_exact(4))
+        .filter(|(a, b)| (0..3).any(|k| a[k].abs_diff(b[k]) > 1))
+        .count();
+    if differing > 0 {
+        return Err(format!(
+            "{differing} pixels of the presented frame differ from the same frame drawn offscreen"
+        ));
+    }
+    let pixels = presented.len() / 4;
+    let share = |f: &dyn Fn(&[u8]) -> bool| {
+        presented.chunks_exact(4).filter(|p| f(p)).count() as f64 / pixels as f64
+    };
+    let sky = style.background.to_srgb8();
+    let background = share(&|p| (0..3).all(|k| p[k].abs_diff(sky[k]) <= 2));
+    // The fill is never darker than its ambient share; the line cores are.
+    let dark = style.fill_color.0.map(|c| c * style.ambient * 0.5);
+    let dark = wirepass::Color(dark).to_srgb8();
+    let lines = share(&|p| (0..3).all(|k| p[k] < dark[k]));
+    let surface = 1.0 - background - lines;
+    println!(
+        "frame: the same as offscreen; {:.1} % background, {:.1} % surface, {:.1} % lines",
+        100.0 * background,
+        100.0 * surface,
+        100.0 * lines
+    );
+    if background < 0.05 || surface < 0.05 || lines < 0.002 {
+        return Err(format!(
+            "the frame does not show background, surface and lines \
+             ({background:.3}, {surface:.3}, {lines:.4} of its pixels)"
+        ));
+    }
+    Ok(())
+}
+
+struct App {
+    options: Options,
+    mesh: Mesh,
+    display: OwnedDisplayHandle,
+    viewer: Option<Viewer>,
+    frames: u64,
+    error: Option<AnyError>,
+}
+
+impl App {
+    fn redraw(&mut self, event_loop: &ActiveEventLoop) -> Result<(), AnyError> {
+        let Some(viewer) = self.viewer.as_mut() else {
+            return Ok(());
+        };
+        let Some(limit) = self.options.frames else {
+            viewer.draw(false)?;
+            return Ok(());
+        };
+        let last = self.frames + 1 >= limit;
+        let read_back = last && self.options.screenshot.is_some();
+        let Drawn::Presented(rgba) = viewer.draw(read_back)? else {
+            viewer.window.request_redraw();
+            return Ok(());
+        };
+        self.frames += 1;
+        if !last {
+            viewer.orbit.rotate(4.0, 0.0);
+            viewer.window.request_redraw();
+            return Ok(());
+        }
+        if let (Some(path), Some(rgba)) = (&self.options.screenshot, rgba) {
+            let (w, h) = (viewer.config.width, viewer.config.height);
+            image::save_buffer(path, &rgba, w, h, image::ColorType::Rgba8)?;
+            println!("wrote {} ({w}x{h}, {} frames)", path.display(), self.frames);
+            let offscreen = viewer.draw_offscreen()?;
+            check_frame(&rgba, &offscreen, &viewer.style)?;
+        }
+        event_loop.exit();
+        Ok(())
+    }
+}
+
+impl ApplicationHandler for App {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.viewer.is_some() {
+            return;
+        }
+        let attributes = Window::default_attributes()
+            .with_title("wirepass viewer")
+            .with_inner_size(PhysicalSize::new(960, 640));
+        let made = event_loop
+            .create_window(attributes)
+            .map_err(AnyError::from)
+            .and_then(|w| {
+                Viewer::new(Arc::new(w), self.display.clone(), &self.mesh, &self.options)
+            });
+        match made {
+            Ok(v) => {
+                v.window.request_redraw();
+                self.viewer = Some(v);
+            }
+            Err(e) => {
+                self.error = Some(e);
+                event_loop.exit();
+            }
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _: WindowId, event: WindowEvent) {
+        let result = match event {
+            WindowEvent::RedrawRequested => self.redraw(event_loop),
+            WindowEvent::CloseRequested => {
+                event_loop.exit();
+                Ok(())
+            }
+            event => {
+                if let Some(v) = self.viewer.as_mut() {
+                    match event {
+                        WindowEvent::Resized(size) => {
+                            v.resize(size);
+                            v.window.request_redraw();
+                        }
+                        WindowEvent::KeyboardInput { event, .. }
+                            if event.state == ElementState::Pressed =>
+                        {
+                            if event.logical_key == Key::Named(NamedKey::Escape) {
+                                event_loop.exit();
+                            }
+                            v.key(&event.logical_key);
+                        }
+                        WindowEvent::MouseInput { state, button, .. } => {
+                            v.drag = (state == ElementState::Pressed).then_some(button);
+                        }
+                        WindowEvent::CursorMoved { position, .. } => {
+                            v.mouse_moved(position.x, position.y)
+                        }
+                        WindowEvent::MouseWheel { delta, .. } => {
+                            v.orbit.zoom(match delta {
+                                MouseScrollDelta::LineDelta(_, y) => f64::from(y),
+                                MouseScrollDelta::PixelDelta(p) => p.y / 40.0,
+                            });
+                            v.window.request_redraw();
+                        }
+                        _ => {}
+                    }
+                }
+                Ok(())
+            }
+        };
+        if let Err(e) = result {
+            self.error = Some(e);
+            event_loop.exit();
+        }
+    }
+}
+
+fn main() {
+    if let Err(e) = run() {
+        eprintln!("viewer: {e}");
+        std::process::exit(1);
+    }
+}
+
+fn run() -> Result<(), AnyError> {
+    let options = options()?;
+    let mesh = wirepass::mesh::load(&options.mesh)?;
+    let event_loop = EventLoop::new()?;
+    let mut app = App {
+        display: event_loop.owned_display_handle(),
+        options,
+        mesh,
+        viewer: None,
+        frames: 0,
+        error: None,
+    };
+    event_loop.run_app(&mut app)?;
+    match app.error {
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
+}
