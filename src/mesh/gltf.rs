@@ -335,6 +335,22 @@ fn parse(path: &Path, bytes: &[u8]) -> Res<Document> {
         ));
     }
     root.extensions_required.clear();
+    // The crate's own validation indexes the accessors by POSITION before it checks the
+    // index (and panics on a bad one): every attribute's accessor is checked first.
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (k, p) in mesh.primitives.iter().enumerate() {
+            if let Some(a) = p
+                .attributes
+                .values()
+                .find(|a| a.value() >= root.accessors.len())
+            {
+                return Err(format!(
+                    "invalid glTF: meshes[{m}].primitives[{k}].attributes: accessor {} does not exist",
+                    a.value()
+                ));
+            }
+        }
+    }
     let doc = gltf::Document::from_json(root).map_err(|e| e.to_string())?;
     let raw: RawRoot = serde_json::from_slice(&json).map_err(|e| format!("not glTF JSON: {e}"))?;
     let buffers = Buffers::load(path, &doc, blob)?;
