@@ -543,7 +543,8 @@ fn cli(file: &Path, args: &[&str], dump: Option<&Path>) -> (bool, String) {
 /// Strips alternate their winding and fans turn about their first vertex, as §3.7.2.1
 /// lists them; unsigned byte and short indices, non-indexed primitives, quantized
 /// positions (KHR_mesh_quantization, required) and sparse accessors all load, primitives
-/// concatenated in order; a LINES primitive is skipped with a note.
+/// concatenated in order, normals where one primitive has them and smooth ones elsewhere;
+/// a LINES primitive is skipped with a note.
 #[test]
 fn primitive_layouts_give_the_triangles_the_specification_lists() {
     let mut file = GltfFile::new();
@@ -563,6 +564,7 @@ fn primitive_layouts_give_the_triangles_the_specification_lists() {
     ];
     let fan_p = file.positions(&fan);
     let fan_i = file.indices(&[0, 1, 2, 3], UNSIGNED_SHORT);
+    let fan_n = file.normals(&[[0.0, 0.0, 2.0]; 4]);
     // Shorts, not normalized: the values themselves.
     let quant: Vec<i16> = vec![0, 0, 2, 3, 0, 2, 0, 3, 2];
     let bytes: Vec<u8> = quant.iter().flat_map(|v| v.to_le_bytes()).collect();
@@ -589,7 +591,8 @@ fn primitive_layouts_give_the_triangles_the_specification_lists() {
         &mut file,
         vec![
             json!({"attributes": {"POSITION": strip_p}, "indices": strip_i, "mode": TRIANGLE_STRIP}),
-            json!({"attributes": {"POSITION": fan_p}, "indices": fan_i, "mode": TRIANGLE_FAN}),
+            json!({"attributes": {"POSITION": fan_p, "NORMAL": fan_n}, "indices": fan_i,
+                "mode": TRIANGLE_FAN}),
             json!({"attributes": {"POSITION": strip_p}, "indices": lines_i, "mode": LINES}),
             json!({"attributes": {"POSITION": quant_p}}),
             json!({"attributes": {"POSITION": sparse}, "indices": strip_i, "mode": TRIANGLE_STRIP}),
@@ -617,6 +620,12 @@ fn primitive_layouts_give_the_triangles_the_specification_lists() {
         [v(sq[1]), Vec3::new(1.0, 2.0, 0.0), v(sq[2])],
     ];
     assert_eq!(corners(&doc.meshes[0].mesh), expected);
+    // The fan's normals, made unit; smooth ones for the vertices of the others.
+    let normals = doc.meshes[0].mesh.normals();
+    assert_eq!(normals[4..8], [Vec3::Z; 4]);
+    assert!(normals
+        .iter()
+        .all(|n| n.is_finite() && (n.length() - 1.0).abs() < 1e-6));
     assert_eq!(doc.notes.len(), 1, "{:?}", doc.notes);
     assert!(doc.notes[0].contains("primitive 2") && doc.notes[0].contains("Lines"));
 

@@ -876,16 +876,21 @@ fn build_mesh(
                                 positions.len()
                             ));
                         }
-                        b.any_normals = true;
                         Some(normals)
                     }
                     None => None,
                 };
                 b.positions.extend_from_slice(&positions);
+                // Vertices without normals get NaN ones, filled with smooth normals once the
+                // triangles are known; none are kept until some primitive has normals.
                 match normals {
-                    Some(n) => b.normals.extend(n),
-                    // Filled with smooth normals once the triangles are known.
-                    None => b.normals.resize(b.positions.len(), Vec3::NAN),
+                    Some(n) => {
+                        b.normals.resize(base, Vec3::NAN);
+                        b.normals.extend(n);
+                        b.any_normals = true;
+                    }
+                    None if b.any_normals => b.normals.resize(b.positions.len(), Vec3::NAN),
+                    None => {}
                 }
                 let base = u32::try_from(base)
                     .ok()
@@ -895,6 +900,8 @@ fn build_mesh(
                 base
             }
         };
+        // The index list lives only until it is cut into triangles: on large meshes it is
+        // as big as they are.
         let indices = match p.indices() {
             Some(acc) => {
                 let indices = buffers
@@ -914,10 +921,10 @@ fn build_mesh(
             None => (0..u32::try_from(vertices).map_err(|_| format!("{at}: too many vertices"))?)
                 .collect(),
         };
-        let first = b.triangles.len();
         let tris = triangles(mode, &indices, &at, notes);
-        b.triangles.extend(tris.iter().map(|t| t.map(|v| v + base)));
-        let count = b.triangles.len() - first;
+        drop(indices);
+        let first = b.triangles.len();
+        let count = tris.len();
 
         // Edge data of this primitive: levels per triangle edge, or none.
         let mut levels: Option<Vec<[u8; 3]>> = None;
@@ -936,7 +943,12 @@ fn build_mesh(
             let all = b.levels.get_or_insert_with(|| vec![[UNAUTHORED; 3]; first]);
             all.extend(l);
         } else if let Some(all) = &mut b.levels {
-            all.resize(b.triangles.len(), [UNAUTHORED; 3]);
+            all.resize(first + count, [UNAUTHORED; 3]);
+        }
+        if first == 0 && base == 0 {
+            b.triangles = tris;
+        } else {
+            b.triangles.extend(tris.iter().map(|t| t.map(|v| v + base)));
         }
         if let Some(w) = line_width(doc, &p, notes, &at) {
             widths.push(w);
