@@ -339,8 +339,9 @@ fn plain_gltf_matches_an_obj_of_triangles() {
 
 /// A parent node scaled, rotated and moved, with three children: the cube twice (once
 /// mirrored by a negative scale) and a torus placed by a matrix. The cube is loaded once and
-/// instanced; each instance's transform is the parent's times the child's; and the scene,
-/// outlines on, renders within the ground truth's bounds.
+/// instanced; each instance's transform is the parent's times the child's; loaded as one
+/// mesh, the instances are moved into place; and the scene, outlines on, renders within the
+/// ground truth's bounds.
 #[test]
 fn node_hierarchy_instances_meshes_against_the_ground_truth() {
     let (p, n, t) = cube();
@@ -407,8 +408,21 @@ fn node_hierarchy_instances_meshes_against_the_ground_truth() {
     }
     assert!(doc.instances[1].1.determinant() < 0.0, "mirrored");
 
+    // As one mesh (`mesh::load`, scene files): every instance moved into place, in order.
+    let path = write("hierarchy-baked.glb", &file.glb());
+    let baked = wirepass::mesh::load(&path).unwrap();
+    assert_eq!(baked.triangle_count(), 2 * 12 + torus.triangle_count());
+    let p0 = doc.instances[1]
+        .1
+        .transform_point3(DVec3::from(p[0].map(f64::from)));
+    assert!((baked.positions()[24].as_dvec3() - p0).length() < 1e-6);
+
     let world = World::from_gltf(doc, None);
     assert_eq!(world.objects.len(), 3);
+    let (lo, hi) = world.bounds();
+    let (blo, bhi) = baked.bounds_f64();
+    // The world's bounds are its objects' boxes transformed: they hold the baked mesh.
+    assert!(blo.cmpge(lo - 1e-5).all() && bhi.cmple(hi + 1e-5).all());
     let (lo, hi) = world.bounds();
     let view = Camera::framing(lo, hi, aspect()).to_view(aspect());
     against_truth("hierarchy", &world, view, &Style::default());
@@ -627,7 +641,26 @@ fn primitive_layouts_give_the_triangles_the_specification_lists() {
         .iter()
         .all(|n| n.is_finite() && (n.length() - 1.0).abs() < 1e-6));
     assert_eq!(doc.notes.len(), 1, "{:?}", doc.notes);
-    assert!(doc.notes[0].contains("primitive 2") && doc.notes[0].contains("Lines"));
+    assert!(
+        doc.notes[0].contains("primitive 2: mode LINES"),
+        "{}",
+        doc.notes[0]
+    );
+
+    // The command line draws it, printing the note.
+    let path = write("layouts-cli.glb", &file.glb());
+    let (ok, stderr) = cli(&path, &[], None);
+    assert!(ok, "{stderr}");
+    let notes: Vec<&str> = stderr
+        .lines()
+        .filter(|l| l.starts_with("wirepass: note:"))
+        .collect();
+    assert_eq!(notes.len(), 1, "{stderr}");
+    assert!(
+        notes[0].contains("mode LINES is not triangles"),
+        "{}",
+        notes[0]
+    );
 
     // A file requiring an extension wirepass cannot read is an error.
     file.json["extensionsRequired"] = json!(["KHR_draco_mesh_compression"]);
@@ -896,4 +929,34 @@ fn repeated_codes_line_strings_and_line_style() {
     assert_eq!(loaded.world.meshes[0].edges, EdgeSelection::Authored);
     let loaded = wirepass::cli::load_world(path.to_str(), &Default::default()).unwrap();
     assert_eq!(loaded.world.objects[0].style.line_width, Some(4.0));
+}
+
+/// A scene file may name a glTF file as an object's mesh: without `edges` it draws the
+/// file's own edges with their outline mask; with `edges` it draws those, every edge
+/// allowed as an outline.
+#[test]
+fn scene_files_take_gltf_meshes_with_their_edges() {
+    let (p, _, t) = cube();
+    let codes = codes_for(&p, &t, cube_level(&p, &t));
+    let mut file = GltfFile::new();
+    let idx: Vec<u32> = t.iter().flatten().copied().collect();
+    let mut prim = file.triangles(&p, &idx, None);
+    prim["extensions"] = edge_visibility(&mut file, &codes);
+    one_mesh(&mut file, vec![prim]);
+    write("scene-cube.glb", &file.glb());
+    let scene = write(
+        "scene.json",
+        br#"{"objects": [
+            {"mesh": "scene-cube.glb"},
+            {"mesh": "scene-cube.glb", "edges": "all", "transform": {"translate": [3, 0, 0]}}
+        ]}"#,
+    );
+    let loaded = wirepass::cli::load_world(scene.to_str(), &Default::default()).unwrap();
+    let meshes = &loaded.world.meshes;
+    assert_eq!(meshes.len(), 2);
+    assert_eq!(meshes[0].edges, EdgeSelection::Authored);
+    let expected: Vec<u8> = (0..12).map(|i| CUBE_MASK[i % 2]).collect();
+    assert_eq!(meshes[0].mesh.outline_mask().to_vec(), expected);
+    assert_eq!(meshes[1].edges, EdgeSelection::All);
+    assert!(meshes[1].mesh.outline_mask().iter().all(|&m| m == 0b111));
 }

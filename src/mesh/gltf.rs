@@ -38,7 +38,7 @@
 
 use super::adjacency::NO_NEIGHBOUR;
 use super::load::{file_error, io_error, open};
-use super::{EdgeSelection, Mesh, ALL_EDGES};
+use super::{EdgeSelection, Mesh};
 use crate::camera::{DepthRange, View};
 use crate::error::{Error, Result};
 use glam::dcamera::rh::{proj::directx as proj, view::look_at_mat4};
@@ -845,7 +845,13 @@ fn build_mesh(
             mode,
             Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
         ) {
-            notes.push(format!("{at}: {mode:?} are not triangles; skipped"));
+            let name = match mode {
+                Mode::Points => "POINTS",
+                Mode::Lines => "LINES",
+                Mode::LineLoop => "LINE_LOOP",
+                _ => "LINE_STRIP",
+            };
+            notes.push(format!("{at}: mode {name} is not triangles; skipped"));
             continue;
         }
         if p.morph_targets().next().is_some() {
@@ -1175,7 +1181,6 @@ fn finish(b: Builder, what: &str, name: String) -> Res<GltfMesh> {
             .with_authored_edges(drawn)
             .and_then(|m| m.with_outline_mask(outline))
             .map_err(invalid)?;
-        debug_assert!(mesh.outline_mask().iter().all(|&m| m <= ALL_EDGES));
         edges = Some(EdgeSelection::Authored);
     }
     Ok(GltfMesh {
