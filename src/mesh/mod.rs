@@ -376,6 +376,8 @@ impl Mesh {
         let mut normals = Vec::new();
         let mut triangles = Vec::new();
         let mut polygon_edges = Vec::new();
+        let any_outline = meshes.iter().any(|m| m.outline_mask.is_some());
+        let any_authored = meshes.iter().any(|m| m.authored_edges.is_some());
         let (mut outline, mut authored) = (Vec::new(), Vec::new());
         for m in meshes {
             let base = positions.len() as u32;
@@ -383,14 +385,18 @@ impl Mesh {
             normals.extend_from_slice(&m.normals);
             triangles.extend(m.triangles.iter().map(|t| t.map(|v| v + base)));
             polygon_edges.extend_from_slice(&m.polygon_edges);
-            outline.extend_from_slice(&m.outline_mask());
-            authored.extend_from_slice(m.authored_edges().unwrap_or(&m.polygon_edges));
+            if any_outline {
+                outline.extend_from_slice(&m.outline_mask());
+            }
+            if any_authored {
+                authored.extend_from_slice(m.authored_edges().unwrap_or(&m.polygon_edges));
+            }
         }
         let mut merged = Mesh::new(positions, Some(normals), triangles, Some(polygon_edges))?;
-        if meshes.iter().any(|m| m.outline_mask.is_some()) {
+        if any_outline {
             merged = merged.with_outline_mask(outline)?;
         }
-        if meshes.iter().any(|m| m.authored_edges.is_some()) {
+        if any_authored {
             merged = merged.with_authored_edges(authored)?;
         }
         Ok(merged)
