@@ -1,6 +1,6 @@
 //! CPU parts: OBJ loading, edge adjacency, BVH build and the ray-cast ground truth; loading
-//! a 2M-triangle mesh as binary STL, binary PLY and OBJ (with each load's peak heap use,
-//! printed once, since criterion only times), and OBJ faces of a million corners.
+//! a 2M-triangle mesh as binary STL, binary PLY, OBJ and GLB (with each load's peak heap
+//! use, printed once, since criterion only times), and OBJ faces of a million corners.
 //! `cargo bench --bench cpu`
 
 use criterion::{criterion_group, criterion_main, Criterion};
@@ -15,6 +15,9 @@ use wirepass::mesh::{adjacency, load, load_obj};
 use wirepass::raycast::{render_raycast, RayCaster};
 use wirepass::render::{Shot, World};
 use wirepass::{Camera, EdgeSelection, Style};
+
+#[path = "../tests/common/gltf_file.rs"]
+mod gltf_file;
 
 fn bunny_path() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/meshes/stanford-bunny.obj")
@@ -102,8 +105,9 @@ fn report_memory(label: &str, path: &Path) {
     );
 }
 
-/// Writes `mesh` as a binary STL, a binary little-endian PLY and an OBJ into `dir`.
-fn write_formats(mesh: &wirepass::Mesh, dir: &Path) -> [(&'static str, PathBuf); 3] {
+/// Writes `mesh` as a binary STL, a binary little-endian PLY, an OBJ and a GLB (u32
+/// indices, float positions, no normals) into `dir`.
+fn write_formats(mesh: &wirepass::Mesh, dir: &Path) -> [(&'static str, PathBuf); 4] {
     let p = mesh.positions();
     let tris = mesh.triangles();
     let stl = dir.join("mesh.stl");
@@ -154,7 +158,22 @@ fn write_formats(mesh: &wirepass::Mesh, dir: &Path) -> [(&'static str, PathBuf);
         writeln!(out, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1).unwrap();
     }
     out.flush().unwrap();
-    [("binary STL", stl), ("binary PLY", ply), ("OBJ", obj)]
+
+    let glb = dir.join("mesh.glb");
+    let mut file = gltf_file::GltfFile::new();
+    let positions: Vec<[f32; 3]> = p.iter().map(|v| v.to_array()).collect();
+    let indices: Vec<u32> = tris.iter().flatten().copied().collect();
+    let primitive = file.triangles(&positions, &indices, None);
+    let m = file.mesh(vec![primitive]);
+    let node = file.node(serde_json::json!({ "mesh": m }));
+    file.scene(&[node]);
+    std::fs::write(&glb, file.glb()).unwrap();
+    [
+        ("binary STL", stl),
+        ("binary PLY", ply),
+        ("OBJ", obj),
+        ("GLB", glb),
+    ]
 }
 
 /// An OBJ of one polygon with the given corners.

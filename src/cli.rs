@@ -12,8 +12,8 @@ use glam::{DVec3, Vec3};
 use std::path::Path;
 
 /// Loads one mesh from `spec`: a procedural name (`sphere:N`, `grid:N`, `torus:N`,
-/// `layers:K`), a mesh file (OBJ, STL or PLY, by extension: see [`mesh::load`]), or, when
-/// `None`, the built-in default scene as one mesh.
+/// `layers:K`), a mesh file (OBJ, STL, PLY or glTF, by extension: see [`mesh::load`]), or,
+/// when `None`, the built-in default scene as one mesh.
 pub fn load_mesh(spec: Option<&str>) -> Result<Mesh> {
     match spec {
         None => Ok(mesh::default_scene()),
@@ -29,17 +29,82 @@ fn mesh_spec(s: &str) -> Result<Mesh> {
     mesh::load(Path::new(s))
 }
 
+/// What the command line asks of the scene it loads.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct WorldOptions {
+    /// `--edges`: the edges to draw; `None` draws a file's own edges where it has them
+    /// (glTF edge extensions), else polygon edges.
+    pub edges: Option<EdgeSelection>,
+    /// `--camera N`: the file's N-th camera (a glTF file's, in node order, or a scene
+    /// file's only one); `None` takes the first the file has, if any.
+    pub camera: Option<usize>,
+    /// `--line-width`, when given: it overrides the widths a glTF file gives its meshes
+    /// (a scene file's per-object widths still override it, as they say).
+    pub line_width: Option<f32>,
+}
+
+/// A loaded scene: the world, the file's camera (the one picked), and notes on what the
+/// file had that is not drawn, for stderr.
+#[derive(Clone, Debug)]
+pub struct Loaded {
+    /// The meshes and objects.
+    pub world: World,
+    /// The file's camera, if it has one.
+    pub camera: Option<FileCamera>,
+    /// Notes from the loader (glTF: skipped primitives, unused cameras, …).
+    pub notes: Vec<String>,
+}
+
 /// Loads what `spec` names as a world: a scene file (`.json`, with its camera if it has
-/// one), one mesh (procedural or a file) drawing `edges`, or, when `None`, the built-in
-/// scene (a torus and a sphere).
-pub fn load_world(spec: Option<&str>, edges: EdgeSelection) -> Result<(World, Option<FileCamera>)> {
-    match spec {
-        None => Ok((crate::render::default_world(edges), None)),
-        Some(s) if s.to_ascii_lowercase().ends_with(".json") => {
-            crate::scene_file::load(Path::new(s), edges, &mesh_spec)
+/// one), a glTF file (`.gltf`, `.glb`: its scene, every mesh once and placed by its nodes,
+/// and its cameras), one mesh (procedural or another mesh file), or, when `None`, the
+/// built-in scene (a torus and a sphere). An out-of-range `options.camera` is an error.
+pub fn load_world(spec: Option<&str>, options: &WorldOptions) -> Result<Loaded> {
+    let edges = options.edges;
+    let lower = spec.map(str::to_ascii_lowercase).unwrap_or_default();
+    let (world, cameras, notes) = match spec {
+        None => (
+            crate::render::default_world(edges.unwrap_or_default()),
+            Vec::new(),
+            Vec::new(),
+        ),
+        Some(s) if lower.ends_with(".json") => {
+            let (world, camera) = crate::scene_file::load(Path::new(s), edges, &mesh_spec)?;
+            (world, camera.into_iter().collect(), Vec::new())
         }
-        Some(s) => Ok((World::single(mesh_spec(s)?, edges), None)),
-    }
+        Some(s) if lower.ends_with(".gltf") || lower.ends_with(".glb") => {
+            let doc = mesh::gltf::load_gltf(Path::new(s))?;
+            let cameras = doc.cameras.iter().map(|&c| FileCamera::Gltf(c)).collect();
+            let notes = doc.notes.clone();
+            let mut world = World::from_gltf(doc, edges);
+            if options.line_width.is_some() {
+                for o in &mut world.objects {
+                    o.style.line_width = None;
+                }
+            }
+            (world, cameras, notes)
+        }
+        Some(s) => {
+            let (mesh, edges) = mesh_spec(s)?.resolve_edges(edges);
+            (World::single(mesh, edges), Vec::new(), Vec::new())
+        }
+    };
+    let camera = match options.camera {
+        None => cameras.first().copied(),
+        Some(n) => Some(*cameras.get(n).ok_or_else(|| {
+            let name = spec.unwrap_or("the built-in scene");
+            Error::InvalidSetting(match cameras.len() {
+                0 => format!("--camera {n}: {name} has no cameras"),
+                1 => format!("--camera {n}: {name} has one camera, --camera 0"),
+                k => format!("--camera {n}: {name} has {k} cameras, 0 to {}", k - 1),
+            })
+        })?),
+    };
+    Ok(Loaded {
+        world,
+        camera,
+        notes,
+    })
 }
 
 /// Parses `WxH`.
@@ -88,6 +153,10 @@ pub struct CameraArgs {
     /// Far plane distance.
     #[arg(long, allow_hyphen_values = true)]
     pub far: Option<f32>,
+    /// Use the file's N-th camera (a glTF file's, counting from 0 in node order); without
+    /// it and the options above, the file's first camera, if it has one.
+    #[arg(long, value_name = "N", conflicts_with_all = ["eye", "target", "up", "fov", "near", "far"])]
+    pub camera: Option<usize>,
 }
 
 fn parse_vec3_arg(s: &str) -> std::result::Result<Vec3, String> {
@@ -95,7 +164,7 @@ fn parse_vec3_arg(s: &str) -> std::result::Result<Vec3, String> {
 }
 
 impl CameraArgs {
-    /// True when no camera option is given.
+    /// True when no camera placement option (eye, target, up, fov, near, far) is given.
     pub fn is_empty(&self) -> bool {
         self.eye.is_none()
             && self.target.is_none()

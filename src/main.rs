@@ -3,7 +3,7 @@
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
-use wirepass::cli::{load_world, parse_size, CameraArgs};
+use wirepass::cli::{load_world, parse_size, CameraArgs, WorldOptions};
 use wirepass::gpu::GpuContext;
 use wirepass::render::{render, Method, Shot, World};
 use wirepass::style::DepthFade;
@@ -22,8 +22,8 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Render a scene (a SCENE.json file, an OBJ, STL or PLY file, `sphere:N`, `grid:N`,
-    /// `torus:N`, `layers:K`, or the built-in scene).
+    /// Render a scene (a SCENE.json file, a glTF or GLB file, an OBJ, STL or PLY file,
+    /// `sphere:N`, `grid:N`, `torus:N`, `layers:K`, or the built-in scene).
     Render(RenderArgs),
     /// Render one scene with the CPU ray-cast ground truth and every GPU method, and report
     /// how closely each matches it (images, error maps, sheet.png, report.json).
@@ -42,16 +42,17 @@ fn parse_edges(s: &str) -> std::result::Result<EdgeSelection, String> {
 /// What to draw and how it looks: shared by `render` and `compare`.
 #[derive(clap::Args)]
 struct SceneArgs {
-    /// Scene file (.json: objects with transforms and styles, and a camera), OBJ, STL or PLY
-    /// file, or procedural mesh (`sphere:20000`, `grid:1k`, `torus:5000`); default: the
-    /// built-in scene.
+    /// Scene file (.json: objects with transforms and styles, and a camera), glTF scene
+    /// (.gltf, .glb: its meshes, nodes and cameras), OBJ, STL or PLY file, or procedural
+    /// mesh (`sphere:20000`, `grid:1k`, `torus:5000`); default: the built-in scene.
     mesh: Option<String>,
     /// Image size WIDTHxHEIGHT.
     #[arg(long, default_value = "800x600")]
     size: String,
-    /// Line width in pixels.
-    #[arg(long, default_value_t = 1.5, allow_hyphen_values = true)]
-    line_width: f32,
+    /// Line width in pixels [default: 1.5, or the glTF file's own widths]; given, it
+    /// overrides a glTF file's widths.
+    #[arg(long, allow_hyphen_values = true)]
+    line_width: Option<f32>,
     /// Line colour, #rrggbb[aa] (sRGB).
     #[arg(long, default_value = "#0a0f19")]
     wire_color: String,
@@ -61,10 +62,12 @@ struct SceneArgs {
     /// Background colour, #rrggbb (sRGB).
     #[arg(long, default_value = "#ffffff")]
     background: String,
-    /// Which edges to draw: all, polygon (no triangulation diagonals), or
-    /// feature[:DEGREES] (creases sharper than DEGREES, default 1, plus boundaries).
-    #[arg(long, default_value = "polygon", value_parser = parse_edges)]
-    edges: EdgeSelection,
+    /// Which edges to draw: all, polygon (no triangulation diagonals), authored (the
+    /// file's own: glTF edge visibility or outlines), or feature[:DEGREES] (creases sharper
+    /// than DEGREES, default 1, plus boundaries) [default: authored where the file has
+    /// them, else polygon]. Any but authored also lets every edge be an outline again.
+    #[arg(long, value_parser = parse_edges)]
+    edges: Option<EdgeSelection>,
     /// Outlines (silhouettes and boundaries) at full width over the background and farther
     /// surfaces, whatever --edges selects: on or off. Only deferred and raycast draw them.
     #[arg(long, default_value = "on", value_parser = parse_switch, action = clap::ArgAction::Set)]
@@ -94,12 +97,22 @@ fn parse_fade(s: &str) -> std::result::Result<DepthFade, String> {
     })
 }
 
+/// The line width when neither the command line nor the file gives one.
+const DEFAULT_LINE_WIDTH: f32 = 1.5;
+
+/// Prints the loader's notes, one line each.
+fn print_notes(notes: &[String]) {
+    for note in notes {
+        eprintln!("wirepass: note: {note}");
+    }
+}
+
 impl SceneArgs {
     /// Checks the settings, then loads the scene and places the camera.
     fn load(&self) -> Result<(World, View, Style, (u32, u32))> {
         let size = parse_size(&self.size)?;
         let style = Style {
-            line_width: self.line_width,
+            line_width: self.line_width.unwrap_or(DEFAULT_LINE_WIDTH),
             wire_color: Color::from_hex(&self.wire_color)?,
             fill_color: Color::from_hex(&self.fill_color)?,
             background: Color::from_hex(&self.background)?,
@@ -108,9 +121,27 @@ impl SceneArgs {
             ..Style::default()
         };
         style.validate()?;
-        let (world, file_camera) = load_world(self.mesh.as_deref(), self.edges)?;
-        let view = self.camera.view(&world, file_camera.as_ref(), size)?;
-        Ok((world, view, style, size))
+        let options = WorldOptions {
+            edges: self.edges,
+            camera: self.camera.camera,
+            line_width: self.line_width,
+        };
+        let loaded = load_world(self.mesh.as_deref(), &options)?;
+        print_notes(&loaded.notes);
+        let file_camera = loaded.camera.filter(|_| self.camera.is_empty());
+        if let Some(wirepass::scene_file::FileCamera::Gltf(c)) = &file_camera {
+            let image = f64::from(size.0) / f64::from(size.1);
+            if let Some(a) = c.aspect().filter(|a| (a / image - 1.0).abs() > 0.01) {
+                print_notes(&[format!(
+                    "the camera's aspect ratio is {a:.3} and the image's {image:.3}: the view is \
+                     stretched to fit (--size with the camera's aspect avoids that)"
+                )]);
+            }
+        }
+        let view = self
+            .camera
+            .view(&loaded.world, file_camera.as_ref(), size)?;
+        Ok((loaded.world, view, style, size))
     }
 }
 
@@ -197,16 +228,17 @@ fn compare_command(args: &CompareArgs) -> Result<()> {
 
 #[derive(clap::Args)]
 struct BenchArgs {
-    /// Scenes: scene files, OBJ, STL or PLY files, or procedural meshes
-    /// (`sphere:20000 sphere:2M`);
-    /// default: the built-in scene.
+    /// Scenes: scene files, glTF or GLB files, OBJ, STL or PLY files, or procedural meshes
+    /// (`sphere:20000 sphere:2M`); default: the built-in scene. Each is framed by the
+    /// automatic camera.
     scenes: Vec<String>,
-    /// Which edges to draw (all, polygon, feature[:DEGREES]).
-    #[arg(long, default_value = "polygon", value_parser = parse_edges)]
-    edges: EdgeSelection,
-    /// Line width in pixels.
-    #[arg(long, default_value_t = 1.5)]
-    line_width: f32,
+    /// Which edges to draw (all, polygon, authored, feature[:DEGREES]) [default: authored
+    /// where the file has them, else polygon].
+    #[arg(long, value_parser = parse_edges)]
+    edges: Option<EdgeSelection>,
+    /// Line width in pixels [default: 1.5, or the glTF file's own widths].
+    #[arg(long)]
+    line_width: Option<f32>,
     /// Image sizes, comma separated: 1280x720,1920x1080.
     #[arg(long, default_value = "1280x720")]
     size: String,
@@ -245,12 +277,19 @@ fn bench_command(args: &BenchArgs) -> Result<()> {
     for spec in specs {
         let name = spec.unwrap_or("built-in");
         progress.set_message(format!("loading {name}"));
-        let (world, _) = load_world(spec, args.edges)?;
+        let options = WorldOptions {
+            edges: args.edges,
+            camera: None,
+            line_width: args.line_width,
+        };
+        let loaded = load_world(spec, &options)?;
+        print_notes(&loaded.notes);
+        let world = loaded.world;
         for &size in &sizes {
             progress.set_message(format!("{name} at {}x{}", size.0, size.1));
             let style = Style {
                 silhouettes: args.silhouettes,
-                line_width: args.line_width,
+                line_width: args.line_width.unwrap_or(DEFAULT_LINE_WIDTH),
                 ..Style::default()
             };
             style.validate()?;

@@ -138,6 +138,41 @@ impl World {
     }
 }
 
+impl World {
+    /// A glTF scene as a world: each glTF mesh once, an object per instance in node order,
+    /// with the file's line width where it gives one. Each mesh draws `edges`, or, when that
+    /// is `None`, its authored edges where it has them (polygon edges otherwise); see
+    /// [`Mesh::resolve_edges`] for what an explicit selection does to the file's outline mask.
+    pub fn from_gltf(doc: crate::mesh::gltf::Document, edges: Option<EdgeSelection>) -> World {
+        let widths: Vec<Option<f32>> = doc.meshes.iter().map(|m| m.line_width).collect();
+        let meshes = doc
+            .meshes
+            .into_iter()
+            .map(|m| {
+                let (mesh, edges) = m.mesh.resolve_edges(edges.or(m.edges));
+                WorldMesh {
+                    mesh: Arc::new(mesh),
+                    edges,
+                    name: m.name,
+                }
+            })
+            .collect();
+        let objects = doc
+            .instances
+            .into_iter()
+            .map(|(mesh, transform)| Object {
+                mesh,
+                transform,
+                style: InstanceStyle {
+                    line_width: widths[mesh],
+                    ..InstanceStyle::default()
+                },
+            })
+            .collect();
+        World { meshes, objects }
+    }
+}
+
 /// The built-in scene: a torus and a sphere, two meshes drawing `edges`.
 pub fn default_world(edges: EdgeSelection) -> World {
     let mut world = World::default();

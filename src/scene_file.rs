@@ -17,10 +17,11 @@
 //! - `transform`: 16 numbers, column-major, or `{"translate", "rotate_deg", "scale"}` (each
 //!   optional): `rotate_deg` turns about X, then Y, then Z (R = Rz·Ry·Rx), `scale` is three
 //!   numbers or one, and the transform is T·R·S.
-//! - `edges`: `all`, `polygon`, `feature[:DEG]` or `none` (draws none of the object's edges;
-//!   it still occludes, and still has its outline unless `outlines` is false). Edge
-//!   selection (feature angles, adjacency, welding) is computed per mesh in its own
-//!   coordinates. Default: the command line's `--edges`.
+//! - `edges`: `all`, `polygon`, `authored`, `feature[:DEG]` or `none` (draws none of the
+//!   object's edges; it still occludes, and still has its outline unless `outlines` is
+//!   false). Edge selection (feature angles, adjacency, welding) is computed per mesh in its
+//!   own coordinates. Default: the command line's `--edges`, else the mesh file's own edges
+//!   where it has them (glTF), else `polygon`.
 //! - `outlines`, `wire_color` (`#rrggbb[aa]`, sRGB), `line_width` (pixels): per-object
 //!   overrides of the command line's style.
 //! - `camera`: `{"eye", "target", "up", "fov", "near", "far"}` (a perspective look-at;
@@ -67,6 +68,8 @@ pub enum FileCamera {
     },
     /// The renderer's own matrices, used as they are.
     Matrices(View),
+    /// A glTF file's camera.
+    Gltf(crate::mesh::gltf::GltfCamera),
 }
 
 impl FileCamera {
@@ -83,16 +86,19 @@ impl FileCamera {
                 far,
             } => View::orthographic((eye, target, up), height, aspect, (near, far)),
             FileCamera::Matrices(v) => v,
+            FileCamera::Gltf(c) => c.view(aspect),
         }
     }
 }
 
-/// Loads a scene file. Objects without `edges` draw `edges`; meshes named more than once (with
+/// Loads a scene file. Objects without `edges` draw `edges`, or, where that is `None`, their
+/// mesh's authored edges if it has them (polygon edges otherwise: see
+/// [`Mesh::resolve_edges`](crate::Mesh::resolve_edges)); meshes named more than once (with
 /// the same edges) are loaded once. `load_mesh` turns a mesh spec (procedural name or path,
 /// already made relative to the scene file's folder) into a mesh.
 pub fn load(
     path: &Path,
-    edges: EdgeSelection,
+    edges: Option<EdgeSelection>,
     load_mesh: &dyn Fn(&str) -> Result<crate::Mesh>,
 ) -> Result<(World, Option<FileCamera>)> {
     let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
@@ -153,8 +159,10 @@ pub fn load(
             None => (edges, false),
             Some(Value::String(s)) if s == "none" => (edges, true),
             Some(Value::String(s)) => (
-                s.parse::<EdgeSelection>()
-                    .map_err(|e| fail(format!("{}: {e}", field("edges"))))?,
+                Some(
+                    s.parse::<EdgeSelection>()
+                        .map_err(|e| fail(format!("{}: {e}", field("edges"))))?,
+                ),
                 false,
             ),
             Some(_) => return Err(fail(format!("{}: not a string", field("edges")))),
@@ -166,6 +174,7 @@ pub fn load(
             None => {
                 let mesh =
                     load_mesh(&resolved).map_err(|e| fail(format!("{}: {e}", field("mesh"))))?;
+                let (mesh, object_edges) = mesh.resolve_edges(object_edges);
                 world.meshes.push(WorldMesh {
                     mesh: Arc::new(mesh),
                     edges: object_edges,
@@ -428,7 +437,7 @@ mod tests {
             ],
             "camera": {"eye": [0, 0, 5], "orthographic": {"height": 4, "near": 0.1, "far": 20}}}"##,
         );
-        let (world, camera) = load(&path, EdgeSelection::Polygon, &procedural).unwrap();
+        let (world, camera) = load(&path, Some(EdgeSelection::Polygon), &procedural).unwrap();
         assert_eq!(world.meshes.len(), 2, "same mesh and edges load once");
         assert_eq!(world.objects.len(), 3);
         assert_eq!(world.objects[1].style.edges, Some(false));
@@ -490,7 +499,7 @@ mod tests {
                     source: std::io::Error::from(std::io::ErrorKind::NotFound),
                 }),
             };
-            let e = load(&path, EdgeSelection::Polygon, &loader)
+            let e = load(&path, Some(EdgeSelection::Polygon), &loader)
                 .err()
                 .unwrap_or_else(|| panic!("{text} loaded"))
                 .to_string();

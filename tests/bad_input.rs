@@ -1,5 +1,5 @@
-//! The catalogue of bad mesh files in `tests/data/bad/` (OBJ, STL, PLY and an unknown
-//! extension), and binary ones written here: each one is an `Err` from
+//! The catalogue of bad mesh files in `tests/data/bad/` (OBJ, STL, PLY, glTF and an
+//! unknown extension), and binary ones written here (STL, PLY, GLB): each one is an `Err` from
 //! `wirepass::mesh::load` that names the file, says what is wrong and where (the line in
 //! text formats, the byte offset in binary ones); and on the command line it is a non-zero
 //! exit with exactly one error line naming the file, never a panic. Headers that declare
@@ -11,6 +11,9 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use wirepass::mesh::{load, load_obj};
+
+#[path = "common/gltf_file.rs"]
+mod gltf_file;
 
 /// The system allocator, recording the largest single request: a loader that reserves for
 /// a count that a header declares shows up here long before it runs out of memory.
@@ -125,9 +128,66 @@ const CATALOGUE: &[(&str, Option<usize>, &[&str])] = &[
     (
         "unknown_extension.xyz",
         None,
-        &["unknown mesh file extension '.xyz'", ".obj, .stl, .ply"],
+        &[
+            "unknown mesh file extension '.xyz'",
+            ".obj, .stl, .ply, .gltf, .glb",
+        ],
+    ),
+    ("empty.gltf", None, &["empty file, not a glTF file"]),
+    ("empty.glb", None, &["empty file, not a glTF file"]),
+    (
+        "invalid_json.gltf",
+        None,
+        &["not glTF JSON", "EOF while parsing", "line 5"],
+    ),
+    (
+        "accessor_past_buffer.gltf",
+        None,
+        &[
+            "mesh 0, primitive 0: accessor 0: 4 elements of 12 bytes",
+            "run past the 36 bytes of buffer view 0",
+        ],
+    ),
+    (
+        "huge_accessor_count.gltf",
+        None,
+        &["accessor 0: 4000000000 elements", "run past the 36 bytes"],
+    ),
+    (
+        "missing_buffer.gltf",
+        None,
+        &["buffer 0: cannot read", "missing.bin", "No such file"],
+    ),
+    (
+        "out_of_range_index.gltf",
+        None,
+        &["index 2 refers to vertex 7, but the primitive has 3 vertices"],
+    ),
+    (
+        "missing_accessor.gltf",
+        None,
+        &["invalid glTF: meshes[0].primitives[0].attributes: accessor 5 does not exist"],
+    ),
+    (
+        "nan_position.gltf",
+        None,
+        &["mesh 0: vertex 1 has a non-finite coordinate"],
     ),
 ];
+
+/// A valid GLB of one triangle, to break.
+fn glb() -> Vec<u8> {
+    let mut file = gltf_file::GltfFile::new();
+    let prim = file.triangles(
+        &[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        &[0, 1, 2],
+        None,
+    );
+    let m = file.mesh(vec![prim]);
+    let n = file.node(serde_json::json!({"mesh": m}));
+    file.scene(&[n]);
+    file.glb()
+}
 
 /// A binary STL: an 80-byte header, the declared `count`, then `triangles`.
 fn binary_stl(count: u32, triangles: &[[f32; 9]]) -> Vec<u8> {
@@ -173,6 +233,16 @@ fn binary_cases() -> Vec<(PathBuf, Option<usize>, Vec<String>)> {
     }
     let mut ply_huge = ply_header(4_000_000_000, 1);
     ply_huge.extend([0u8; 40]);
+    let valid_glb = glb();
+    let word = |bytes: &mut Vec<u8>, at: usize, w: u32| {
+        bytes[at..at + 4].copy_from_slice(&w.to_le_bytes());
+    };
+    let mut short_header = valid_glb.clone();
+    word(&mut short_header, 8, 8);
+    let mut version_1 = valid_glb.clone();
+    word(&mut version_1, 4, 1);
+    let mut long_chunk = valid_glb.clone();
+    word(&mut long_chunk, 12, 1 << 30);
     let cases: Vec<(&str, Vec<u8>, Vec<String>)> = vec![
         (
             "truncated.stl",
@@ -210,6 +280,35 @@ fn binary_cases() -> Vec<(PathBuf, Option<usize>, Vec<String>)> {
                 "declares 4000000000 vertex elements, at least 48000000000 bytes".into(),
                 "only 40 bytes follow".into(),
             ],
+        ),
+        (
+            "truncated.glb",
+            valid_glb[..valid_glb.len() / 2].to_vec(),
+            vec![format!(
+                "the GLB header declares {} bytes, but the file has {} (truncated)",
+                valid_glb.len(),
+                valid_glb.len() / 2
+            )],
+        ),
+        (
+            "short_header.glb",
+            short_header,
+            vec!["the GLB header declares 8 bytes, too few for a JSON chunk".into()],
+        ),
+        (
+            "version_1.glb",
+            version_1,
+            vec!["GLB version 1; wirepass reads glTF 2.0".into()],
+        ),
+        (
+            "long_json_chunk.glb",
+            long_chunk,
+            vec!["not a valid GLB file".into(), "JSON chunk length".into()],
+        ),
+        (
+            "tiny.glb",
+            b"glTF\x02\0".to_vec(),
+            vec!["shorter than its 12-byte header".into()],
         ),
     ];
     let dir = temp_dir().join("binary");
@@ -327,7 +426,7 @@ fn huge_declared_counts_fail_fast_without_reserving_them() {
         .map(|(path, ..)| path)
         .filter(|p| p.to_string_lossy().contains("huge"))
         .collect();
-    assert_eq!(huge.len(), 3);
+    assert_eq!(huge.len(), 4);
     for path in huge {
         LARGEST.store(0, Ordering::Relaxed);
         let start = std::time::Instant::now();
@@ -360,6 +459,7 @@ fn missing_files_and_directories_are_one_clear_line() {
         ("a-folder.obj", "an OBJ"),
         ("a-folder.stl", "an STL"),
         ("a-folder.ply", "a PLY"),
+        ("a-folder.gltf", "a glTF"),
     ] {
         let folder = dir.join(name);
         std::fs::create_dir_all(&folder).unwrap();

@@ -2,7 +2,8 @@
 //! - random OBJ-ish text never panics the loader, and every mesh it accepts has finite
 //!   positions and normals and in-range indices;
 //! - random bytes, and random mutations of valid binary and ASCII STL and PLY files (ASCII,
-//!   little and big endian), never panic their loaders, and what they accept is as valid;
+//!   little and big endian) and of glTF files (GLB and base64 JSON, with edge extensions, a
+//!   camera and instances), never panic their loaders, and what they accept is as valid;
 //! - `edge_math::edge_eval` on random triangles seen by random valid cameras (vertices behind
 //!   the eye included) at random pixels never gives a NaN distance, and its barycentrics sum
 //!   to 1 whenever the triangle's screen area is not degenerate.
@@ -13,6 +14,9 @@ use glam::{DVec2, Vec3};
 use proptest::prelude::*;
 use std::path::PathBuf;
 use wirepass::{edge_math, Camera};
+
+#[path = "common/gltf_file.rs"]
+mod gltf_file;
 
 fn config() -> ProptestConfig {
     ProptestConfig {
@@ -250,14 +254,44 @@ fn valid_files() -> &'static [(&'static str, Vec<u8>)] {
             }
             out
         };
+        let gltf = sphere_gltf(&mesh);
         vec![
             ("stl", binary),
             ("stl", ascii.into_bytes()),
             ("ply", ply_ascii.into_bytes()),
             ("ply", binary_ply(false)),
             ("ply", binary_ply(true)),
+            ("glb", gltf.glb()),
+            ("gltf", gltf.embedded()),
         ]
     })
+}
+
+/// The sphere as a glTF scene: placed twice under a parent node (once mirrored), with a
+/// camera, edge visibility codes and an outline list on its one primitive.
+fn sphere_gltf(mesh: &wirepass::Mesh) -> gltf_file::GltfFile {
+    use serde_json::json;
+    let p: Vec<[f32; 3]> = mesh.positions().iter().map(|v| v.to_array()).collect();
+    let idx: Vec<u32> = mesh.triangles().iter().flatten().copied().collect();
+    let mut file = gltf_file::GltfFile::new();
+    let mut prim = file.triangles(&p, &idx, None);
+    let codes: Vec<[u8; 3]> = (0..mesh.triangle_count())
+        .map(|t| [(t % 4) as u8, 2, 3])
+        .collect();
+    let vis = file.bytes(&gltf_file::visibility_bits(&codes));
+    let outline = file.indices(&idx[..6], gltf_file::UNSIGNED_SHORT);
+    prim["extensions"] = json!({
+        "EXT_mesh_primitive_edge_visibility": {"visibility": vis},
+        "CESIUM_primitive_outline": {"indices": outline},
+    });
+    let m = file.mesh(vec![prim]);
+    let a = file.node(json!({"mesh": m, "translation": [2.0, 0.0, 0.0]}));
+    let b = file.node(json!({"mesh": m, "scale": [-1.0, 1.0, 1.0]}));
+    let c = file.camera(json!({"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1}}));
+    let cam = file.node(json!({"camera": c, "translation": [0.0, 0.0, 5.0]}));
+    let parent = file.node(json!({"children": [a, b, cam], "rotation": [0.0, 0.6, 0.0, 0.8]}));
+    file.scene(&[parent]);
+    file
 }
 
 /// One edit of a file: at a position (taken modulo the length), overwrite, insert or
@@ -277,6 +311,8 @@ fn start() -> impl Strategy<Value = &'static [u8]> {
           property float y\nproperty float z\nelement face 1\n\
           property list uchar int vertex_indices\nend_header\n",
         b"ply\nformat binary_big_endian 1.0\n",
+        b"glTF\x02\0\0\0",
+        b"{\"asset\": {\"version\": \"2.0\"}, ",
     ])
 }
 
@@ -284,8 +320,8 @@ proptest! {
     #![proptest_config(config())]
 
     #[test]
-    fn random_bytes_never_panic_the_stl_and_ply_loaders(
-        extension in prop::sample::select(vec!["stl", "ply"]),
+    fn random_bytes_never_panic_the_stl_ply_and_gltf_loaders(
+        extension in prop::sample::select(vec!["stl", "ply", "glb", "gltf"]),
         start in start(),
         rest in prop::collection::vec(any::<u8>(), 0..600),
     ) {
@@ -295,8 +331,8 @@ proptest! {
     }
 
     #[test]
-    fn mutated_stl_and_ply_files_never_panic(
-        which in 0usize..5,
+    fn mutated_stl_ply_and_gltf_files_never_panic(
+        which in 0usize..7,
         edits in prop::collection::vec(edit(), 1..8),
     ) {
         let (extension, valid) = &valid_files()[which];
@@ -323,7 +359,9 @@ fn the_valid_files_load() {
         let path = temp_file(extension, bytes);
         let mesh = wirepass::mesh::load(&path).unwrap_or_else(|e| panic!("file {k}: {e}"));
         std::fs::remove_file(&path).unwrap();
-        let expected = wirepass::mesh::sphere(24).unwrap().triangle_count();
+        // The glTF scene places the sphere twice.
+        let copies = if extension.starts_with("gl") { 2 } else { 1 };
+        let expected = copies * wirepass::mesh::sphere(24).unwrap().triangle_count();
         assert_eq!(mesh.triangle_count(), expected, "file {k}");
     }
 }

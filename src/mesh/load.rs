@@ -33,6 +33,16 @@ pub const FORMATS: &[Format] = &[
         name: "PLY",
         load: super::ply::load_ply,
     },
+    Format {
+        extension: "gltf",
+        name: "glTF",
+        load: super::gltf::load_gltf_mesh,
+    },
+    Format {
+        extension: "glb",
+        name: "glTF",
+        load: super::gltf::load_gltf_mesh,
+    },
 ];
 
 /// The format of `path` by its extension, compared case-insensitively.
@@ -43,8 +53,9 @@ pub fn format_of(path: &Path) -> Option<&'static Format> {
         .find(|f| f.extension.eq_ignore_ascii_case(extension))
 }
 
-/// Loads a mesh file with the loader its extension names (`.obj`, `.stl`, `.ply`, in any
-/// case). A missing file is an [`Error::Io`]; an unknown extension is an
+/// Loads a mesh file with the loader its extension names (`.obj`, `.stl`, `.ply`, `.gltf`,
+/// `.glb`, in any case; a glTF scene comes as one mesh: see
+/// [`load_gltf_mesh`](super::gltf::load_gltf_mesh)). A missing file is an [`Error::Io`]; an unknown extension is an
 /// [`Error::MeshFile`] that names the supported ones.
 pub fn load(path: &Path) -> Result<Mesh> {
     if let Some(format) = format_of(path) {

@@ -4,6 +4,8 @@
 pub mod adjacency;
 pub mod clusters;
 #[cfg(feature = "formats")]
+pub mod gltf;
+#[cfg(feature = "formats")]
 mod load;
 #[cfg(feature = "formats")]
 mod obj;
@@ -45,6 +47,13 @@ pub enum EdgeSelection {
     /// threshold in degrees, plus boundary and non-manifold edges (vertices welded by
     /// position). Three.js `EdgesGeometry` uses 1°.
     Feature(f32),
+    /// The edges the file itself says to draw (glTF's `EXT_mesh_primitive_edge_visibility`
+    /// or `CESIUM_primitive_outline`: see [`Mesh::with_authored_edges`]); [`Polygon`]
+    /// for a mesh without them. Only with this selection does a file's outline mask
+    /// ([`Mesh::with_outline_mask`]) apply: see [`Mesh::resolve_edges`].
+    ///
+    /// [`Polygon`]: EdgeSelection::Polygon
+    Authored,
 }
 
 /// Default threshold of [`EdgeSelection::Feature`], in degrees.
@@ -53,16 +62,17 @@ pub const DEFAULT_FEATURE_ANGLE: f32 = 1.0;
 impl std::str::FromStr for EdgeSelection {
     type Err = Error;
 
-    /// Parses `all`, `polygon`, `feature` or `feature:DEGREES`.
+    /// Parses `all`, `polygon`, `authored`, `feature` or `feature:DEGREES`.
     fn from_str(s: &str) -> Result<Self> {
         let bad = || {
             Error::InvalidSetting(format!(
-                "edges {s:?} is not all, polygon, feature or feature:DEGREES (0 to 180)"
+                "edges {s:?} is not all, polygon, authored, feature or feature:DEGREES (0 to 180)"
             ))
         };
         match s.split_once(':') {
             None if s == "all" => Ok(EdgeSelection::All),
             None if s == "polygon" => Ok(EdgeSelection::Polygon),
+            None if s == "authored" => Ok(EdgeSelection::Authored),
             None if s == "feature" => Ok(EdgeSelection::Feature(DEFAULT_FEATURE_ANGLE)),
             Some(("feature", deg)) => match deg.trim().parse::<f32>() {
                 Ok(d) if (0.0..=180.0).contains(&d) => Ok(EdgeSelection::Feature(d)),
@@ -83,6 +93,8 @@ pub struct Mesh {
     polygon_edges: Vec<u8>,
     /// Edges that may be outlines, when the file restricts them.
     outline_mask: Option<Vec<u8>>,
+    /// The edges the file says to draw, when it says.
+    authored_edges: Option<Vec<u8>>,
     /// Edge adjacency, computed on first use.
     neighbours: std::sync::OnceLock<Vec<[u32; 3]>>,
     /// Per triangle, what lets the outline pass skip it: see [`Mesh::outline_hints`].
@@ -169,6 +181,7 @@ impl Mesh {
             triangles,
             polygon_edges,
             outline_mask: None,
+            authored_edges: None,
             neighbours: Default::default(),
             outline_hints: Default::default(),
             outline_clusters: Default::default(),
@@ -201,6 +214,53 @@ impl Mesh {
             EdgeSelection::All => vec![ALL_EDGES; self.triangles.len()],
             EdgeSelection::Polygon => self.polygon_edges.clone(),
             EdgeSelection::Feature(degrees) => self.feature_edges(degrees),
+            EdgeSelection::Authored => self
+                .authored_edges
+                .clone()
+                .unwrap_or_else(|| self.polygon_edges.clone()),
+        }
+    }
+
+    /// The per-triangle mask of edges the file says to draw, if it says
+    /// ([`Mesh::with_authored_edges`]).
+    pub fn authored_edges(&self) -> Option<&[u8]> {
+        self.authored_edges.as_deref()
+    }
+
+    /// This mesh with the file's own choice of drawn edges (bit `i` of each triangle's mask
+    /// for edge `i`), which [`EdgeSelection::Authored`] draws.
+    pub fn with_authored_edges(mut self, mask: Vec<u8>) -> Result<Mesh> {
+        if mask.len() != self.triangles.len() {
+            return Err(Error::InvalidMesh(format!(
+                "{} authored edge masks for {} triangles",
+                mask.len(),
+                self.triangles.len()
+            )));
+        }
+        self.authored_edges = Some(mask.into_iter().map(|m| m & ALL_EDGES).collect());
+        Ok(self)
+    }
+
+    /// This mesh with every edge allowed as an outline again (see [`Mesh::outline_mask`]).
+    pub fn without_outline_mask(mut self) -> Mesh {
+        self.outline_mask = None;
+        self
+    }
+
+    /// The mesh and edge selection to draw when `requested` was asked for (`None`: nothing
+    /// was): by default the file's own edges ([`EdgeSelection::Authored`]) where the mesh
+    /// has them, else [`EdgeSelection::Polygon`].
+    ///
+    /// A file's outline mask belongs with its authored edges: it says which edges may be
+    /// silhouettes and boundaries *when the file's edges are drawn*. Any other selection
+    /// asks for the geometry's own edges, so the mask is dropped and every edge may be an
+    /// outline again.
+    pub fn resolve_edges(self, requested: Option<EdgeSelection>) -> (Mesh, EdgeSelection) {
+        match requested {
+            None if self.authored_edges.is_some() => (self, EdgeSelection::Authored),
+            None => (self, EdgeSelection::Polygon),
+            Some(EdgeSelection::Authored) => (self, EdgeSelection::Authored),
+            Some(other) => (self.without_outline_mask(), other),
         }
     }
 
@@ -309,19 +369,37 @@ impl Mesh {
     }
 
     /// Concatenates meshes into one scene; ids of later meshes follow those of earlier ones.
+    /// Outline masks and authored edges are kept where any mesh has them (the others
+    /// allowing every outline, and drawing their polygon edges as authored ones).
     pub fn merge(meshes: &[Mesh]) -> Result<Mesh> {
         let mut positions = Vec::new();
         let mut normals = Vec::new();
         let mut triangles = Vec::new();
         let mut polygon_edges = Vec::new();
+        let any_outline = meshes.iter().any(|m| m.outline_mask.is_some());
+        let any_authored = meshes.iter().any(|m| m.authored_edges.is_some());
+        let (mut outline, mut authored) = (Vec::new(), Vec::new());
         for m in meshes {
             let base = positions.len() as u32;
             positions.extend_from_slice(&m.positions);
             normals.extend_from_slice(&m.normals);
             triangles.extend(m.triangles.iter().map(|t| t.map(|v| v + base)));
             polygon_edges.extend_from_slice(&m.polygon_edges);
+            if any_outline {
+                outline.extend_from_slice(&m.outline_mask());
+            }
+            if any_authored {
+                authored.extend_from_slice(m.authored_edges().unwrap_or(&m.polygon_edges));
+            }
         }
-        Mesh::new(positions, Some(normals), triangles, Some(polygon_edges))
+        let mut merged = Mesh::new(positions, Some(normals), triangles, Some(polygon_edges))?;
+        if any_outline {
+            merged = merged.with_outline_mask(outline)?;
+        }
+        if any_authored {
+            merged = merged.with_authored_edges(authored)?;
+        }
+        Ok(merged)
     }
 }
 
@@ -415,6 +493,10 @@ mod tests {
             "feature:30".parse::<EdgeSelection>().unwrap(),
             EdgeSelection::Feature(30.0)
         );
+        assert_eq!(
+            "authored".parse::<EdgeSelection>().unwrap(),
+            EdgeSelection::Authored
+        );
         for bad in [
             "",
             "feature:",
@@ -425,6 +507,45 @@ mod tests {
         ] {
             assert!(bad.parse::<EdgeSelection>().is_err(), "{bad}");
         }
+    }
+
+    #[test]
+    fn authored_edges_and_their_outline_mask_go_together() {
+        // Without authored edges, Authored is Polygon and nothing is asked of the mask.
+        assert_eq!(
+            quad().edge_mask(EdgeSelection::Authored),
+            vec![0b011, 0b110]
+        );
+        let (_, edges) = quad().resolve_edges(None);
+        assert_eq!(edges, EdgeSelection::Polygon);
+        let authored = || {
+            quad()
+                .with_authored_edges(vec![0b001, 0b100])
+                .and_then(|m| m.with_outline_mask(vec![0b011, 0b100]))
+                .unwrap()
+        };
+        assert_eq!(
+            authored().edge_mask(EdgeSelection::Authored),
+            vec![0b001, 0b100]
+        );
+        let (m, edges) = authored().resolve_edges(None);
+        assert_eq!(edges, EdgeSelection::Authored);
+        assert_eq!(m.outline_mask().to_vec(), vec![0b011, 0b100]);
+        let (m, edges) = authored().resolve_edges(Some(EdgeSelection::All));
+        assert_eq!(edges, EdgeSelection::All);
+        assert_eq!(
+            m.outline_mask().to_vec(),
+            vec![ALL_EDGES; 2],
+            "the mask is dropped"
+        );
+        // Merging keeps both, the plain quad drawing its polygon edges.
+        let merged = Mesh::merge(&[authored(), quad()]).unwrap();
+        assert_eq!(
+            merged.edge_mask(EdgeSelection::Authored),
+            vec![0b001, 0b100, 0b011, 0b110]
+        );
+        assert_eq!(merged.outline_mask().to_vec(), vec![0b011, 0b100, 7, 7]);
+        assert!(quad().with_authored_edges(vec![1]).is_err());
     }
 
     #[test]

@@ -231,6 +231,7 @@ pub fn default_scene() -> Mesh {
         triangles: scene.triangles,
         polygon_edges: scene.edges,
         outline_mask: None,
+        authored_edges: None,
         neighbours: Default::default(),
         outline_hints: Default::default(),
         outline_clusters: Default::default(),

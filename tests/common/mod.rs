@@ -1,6 +1,8 @@
 //! Helpers shared by the GPU integration tests.
 #![allow(dead_code)]
 
+pub mod gltf_file;
+
 use glam::{DVec2, Vec3};
 use std::path::PathBuf;
 use std::sync::OnceLock;
