@@ -278,34 +278,60 @@ fn draw_piece(seg: Segment, k0: f32, k1: f32, length_px: f32) {
     var runs: array<vec2<f32>, MAX_RUNS>;
     var count = 0u;
     let steps = max(u32(ceil(length_px * (k1 - k0) * RUN_SAMPLES_PER_PX)), 1u);
+    // One loop and one call of seg_visible: sample k0 and then each step; where visibility
+    // changes between two steps, the next RUN_BISECTIONS iterations bisect that interval.
+    // (A shader holding one copy of the visibility test instead of three compiles smaller,
+    // and lavapipe runs every copy for every lane.)
+    var j = 0u;
+    var bisections = 0u;
     var last_k = k0;
-    var last_visible = seg_visible(seg, k0);
+    var last_visible = false;
     var start = k0;
-    for (var j = 1u; j <= steps; j++) {
-        let k = mix(k0, k1, f32(j) / f32(steps));
-        let now = seg_visible(seg, k);
-        if now != last_visible {
-            var lo = last_k;
-            var hi = k;
-            for (var i = 0u; i < RUN_BISECTIONS; i++) {
-                let mid = 0.5 * (lo + hi);
-                if seg_visible(seg, mid) == last_visible {
-                    lo = mid;
-                } else {
-                    hi = mid;
-                }
-            }
-            if now {
-                start = hi;
-            } else if count < MAX_RUNS {
-                runs[count] = vec2<f32>(start, lo);
-                count++;
-            } else {
-                runs[MAX_RUNS - 1u].y = lo;
-            }
+    var lo = k0;
+    var hi = k0;
+    var step_k = k0;
+    loop {
+        var k = mix(k0, k1, f32(j) / f32(steps));
+        if bisections > 0u {
+            k = 0.5 * (lo + hi);
         }
-        last_k = k;
-        last_visible = now;
+        let now = seg_visible(seg, k);
+        if bisections > 0u {
+            if now == last_visible {
+                lo = k;
+            } else {
+                hi = k;
+            }
+            bisections -= 1u;
+            if bisections == 0u {
+                // The change between last_k and step_k lies between lo and hi.
+                if !last_visible {
+                    start = hi;
+                } else if count < MAX_RUNS {
+                    runs[count] = vec2<f32>(start, lo);
+                    count++;
+                } else {
+                    runs[MAX_RUNS - 1u].y = lo;
+                }
+                last_visible = !last_visible;
+                last_k = step_k;
+                j++;
+            }
+        } else if j == 0u {
+            last_visible = now;
+            j = 1u;
+        } else if now != last_visible {
+            lo = last_k;
+            hi = k;
+            step_k = k;
+            bisections = RUN_BISECTIONS;
+        } else {
+            last_k = k;
+            j++;
+        }
+        if bisections == 0u && j > steps {
+            break;
+        }
     }
     if last_visible {
         if count < MAX_RUNS {

@@ -324,8 +324,12 @@ fn a_scene_file_with_an_orthographic_camera_matches_the_ground_truth() {
         ),
     )
     .unwrap();
-    let (world, camera) =
-        wirepass::cli::load_world(Some(scene.to_str().unwrap()), EdgeSelection::Polygon).unwrap();
+    let options = wirepass::cli::WorldOptions {
+        edges: Some(EdgeSelection::Polygon),
+        ..Default::default()
+    };
+    let wirepass::cli::Loaded { world, camera, .. } =
+        wirepass::cli::load_world(Some(scene.to_str().unwrap()), &options).unwrap();
     assert_eq!(world.objects.len(), 3);
     assert_eq!(
         world.meshes.len(),
