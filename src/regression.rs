@@ -150,6 +150,19 @@ pub fn statistics(map: &[f32]) -> Difference {
 
 /// FLIP difference of `b` against `a` (`a` is the reference). Different sizes are an
 /// [`Error::InvalidSetting`] naming both.
+///
+/// ```
+/// use wirepass::regression::{difference, Rgba, Threshold};
+///
+/// let grey = vec![128u8; 4 * 16 * 16];
+/// let mut marked = grey.clone();
+/// marked[..4].copy_from_slice(&[255, 0, 0, 255]); // one red pixel
+/// let d = difference(Rgba::new(&grey, (16, 16))?, Rgba::new(&marked, (16, 16))?)?;
+/// assert!(d.max > 0.5 && d.mean < 0.01);
+/// let threshold = Threshold { mean: 0.002, p99: 0.02 };
+/// assert!(d.exceeds(&threshold).is_some()); // the mean of one pixel in 256 is over 0.002
+/// # Ok::<(), wirepass::Error>(())
+/// ```
 pub fn difference(a: Rgba<'_>, b: Rgba<'_>) -> Result<Difference> {
     Ok(statistics(&flip_map(a, b)?))
 }
