@@ -62,7 +62,7 @@
 //!
 //! With `default-features = false` the crate is the pass alone (wgpu without backends, which
 //! the host picks through its own wgpu dependency, glam, bytemuck, thiserror, pollster).
-//! `formats` adds the mesh loaders (OBJ, STL, PLY, glTF), `parallel` preprocessing on all
+//! `formats` adds the mesh loaders (OBJ, STL, PLY), `parallel` preprocessing on all
 //! cores, `regression` FLIP image comparison, `tools` the ray-cast ground truth, compare and
 //! bench, and `cli` (the default) the `wirepass` command line.
 
