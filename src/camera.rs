@@ -194,8 +194,8 @@ impl View {
         if !z_e.is_finite() || z_e == 0.0 {
             return bad("the projection gives no depth along the view axis".into());
         }
-        let (a, b) = (0.0, -z_e);
-        match (self.depth, b > a) {
+        let depth_grows = z_e < 0.0;
+        match (self.depth, depth_grows) {
             (DepthRange::Standard, false) => bad(
                 "the projection puts nearer points at greater depth, as a reverse-Z one does: \
                  declare DepthRange::Reversed"
