@@ -184,19 +184,18 @@ impl View {
             return Ok(());
         }
         // Perspective: along the eye's forward axis, depth must grow (standard) or fall
-        // (reversed) with distance, as the convention says.
+        // (reversed) with distance, as the convention says. At distance s along it, clip w
+        // is w1·s (w vanishes at the eye) and z is z_e + z1·s, so NDC depth is
+        // z_e / (w1·s) + z1 / w1: it grows with s exactly when z_e < 0. Deciding on the sign
+        // rather than on sampled depths keeps a camera 1e-30 across as exact as a unit one.
         let eye = null_vector(p);
-        let eye = (eye / eye.w).truncate();
-        let forward = w.truncate().normalize();
-        let ndc_z = |s: f64| {
-            let c = p * (eye + forward * s).extend(1.0);
-            c.z / c.w
-        };
-        let (a, b) = (ndc_z(1.0), ndc_z(2.0));
-        if !(a.is_finite() && b.is_finite()) || a == b {
+        let eye = eye / eye.w;
+        let z_e = p.row(2).dot(eye);
+        if !z_e.is_finite() || z_e == 0.0 {
             return bad("the projection gives no depth along the view axis".into());
         }
-        match (self.depth, b > a) {
+        let depth_grows = z_e < 0.0;
+        match (self.depth, depth_grows) {
             (DepthRange::Standard, false) => bad(
                 "the projection puts nearer points at greater depth, as a reverse-Z one does: \
                  declare DepthRange::Reversed"

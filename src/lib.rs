@@ -4,6 +4,67 @@
 //! pass writes a triangle id and depth per pixel, and a compute pass reconstructs, per pixel,
 //! the exact screen-space distance to the visible triangle's edges and composites the shaded
 //! colour with the line. Its cost depends on the pixel count, not on the triangle count.
+//!
+//! The pass lives in the host's frame: the host owns the device, the encoder and the
+//! targets; meshes are uploaded once into a [`MeshStore`]; each frame is a [`Scene`] of
+//! [`Instance`]s seen through a [`View`] (the host's own matrices, or a [`Camera`]), which
+//! [`DeferredPass::prepare`] checks and uploads and [`DeferredPass::encode`] records. The
+//! result goes to a storage texture ([`OutputTarget::Shaded`], [`OutputTarget::Overlay`]) or
+//! into the host's own render pass ([`DeferredPass::render`], any colour format, MSAA, with
+//! the host's depth hiding lines through [`Canvas::with_host_depth`]). Everything runs on a
+//! device opened with `wgpu::Limits::default()`, and every misuse is an [`Error`].
+//!
+//! ## A frame, headless
+//!
+//! ```
+//! use wirepass::glam::DMat4;
+//! use wirepass::gpu::texture_2d;
+//! use wirepass::{
+//!     wgpu, Camera, DeferredPass, EdgeSelection, Instance, MeshStore, OutputTarget,
+//!     PassOptions, Scene, Style,
+//! };
+//!
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! // The host's device: here a headless one with the WebGPU default limits.
+//! let instance =
+//!     wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+//! let adapter = pollster::block_on(instance.request_adapter(&Default::default()))?;
+//! let (device, queue) = pollster::block_on(adapter.request_device(&Default::default()))?;
+//!
+//! // Once: the pass, and the meshes.
+//! let mut pass = DeferredPass::new(&device, PassOptions::default())?;
+//! let mut meshes = MeshStore::new(&device);
+//! let torus = wirepass::mesh::torus(2000)?;
+//! let id = meshes.insert(&device, &queue, &torus, EdgeSelection::Polygon)?;
+//!
+//! // Each frame: instances, a view, a style; prepare, then encode into the host's encoder.
+//! let size = (320, 240);
+//! let (lo, hi) = torus.bounds_f64();
+//! let view = Camera::framing(lo, hi, 320.0 / 240.0).to_view(320.0 / 240.0);
+//! let instances = [Instance::new(id, DMat4::IDENTITY)];
+//! let scene = Scene::borrowed(view, &instances);
+//! let frame = pass.prepare(&device, &meshes, &scene, &Style::default(), size)?;
+//!
+//! let usage = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC;
+//! let output = texture_2d(&device, "output", size, pass.output_format(), usage);
+//! let mut encoder = device.create_command_encoder(&Default::default());
+//! let target = output.create_view(&Default::default());
+//! pass.encode(&device, &mut encoder, &meshes, &frame, OutputTarget::Shaded(&target))?;
+//! queue.submit([encoder.finish()]);
+//!
+//! let rgba = wirepass::gpu::read_texture(&device, &queue, &output, wgpu::TextureAspect::All)?;
+//! assert_eq!(rgba.len(), 4 * 320 * 240);
+//! # Ok(())
+//! # }
+//! ```
+//!
+//! ## Features
+//!
+//! With `default-features = false` the crate is the pass alone (wgpu without backends, which
+//! the host picks through its own wgpu dependency, glam, bytemuck, thiserror, pollster).
+//! `formats` adds the mesh loaders (OBJ, STL, PLY, glTF), `parallel` preprocessing on all
+//! cores, `regression` FLIP image comparison, `tools` the ray-cast ground truth, compare and
+//! bench, and `cli` (the default) the `wirepass` command line.
 
 #![warn(missing_docs)]
 

@@ -150,6 +150,28 @@ pub fn statistics(map: &[f32]) -> Difference {
 
 /// FLIP difference of `b` against `a` (`a` is the reference). Different sizes are an
 /// [`Error::InvalidSetting`] naming both.
+///
+/// ```
+/// use wirepass::regression::{difference, Rgba, Threshold};
+///
+/// let grey = vec![128u8; 4 * 32 * 32];
+/// let same = difference(Rgba::new(&grey, (32, 32))?, Rgba::new(&grey, (32, 32))?)?;
+/// assert_eq!(same.max, 0.0);
+///
+/// // A red 4×4 square in one corner.
+/// let mut marked = grey.clone();
+/// for y in 0..4 {
+///     for x in 0..4 {
+///         marked[4 * (32 * y + x)..][..4].copy_from_slice(&[255, 0, 0, 255]);
+///     }
+/// }
+/// let d = difference(Rgba::new(&grey, (32, 32))?, Rgba::new(&marked, (32, 32))?)?;
+/// println!("{d}");
+/// assert!(d.max > d.p99 && d.mean < d.max);
+/// let threshold = Threshold { mean: 0.002, p99: 0.02 };
+/// assert!(d.exceeds(&threshold).is_some());
+/// # Ok::<(), wirepass::Error>(())
+/// ```
 pub fn difference(a: Rgba<'_>, b: Rgba<'_>) -> Result<Difference> {
     Ok(statistics(&flip_map(a, b)?))
 }

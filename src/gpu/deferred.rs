@@ -155,6 +155,60 @@ impl PreparedFrame {
 /// The deferred wireframe pass. Construct once with [`DeferredPass::new`]; each frame,
 /// [`prepare`](Self::prepare) the scene, then [`encode`](Self::encode) it into the host's
 /// command encoder.
+///
+/// Into the host's own render pass, with the host's depth hiding the lines (the crate-level
+/// docs show the storage-texture path):
+///
+/// ```no_run
+/// use wirepass::gpu::{Canvas, Composite, HostDepth, OutputTarget, PassOptions, RenderTarget};
+/// use wirepass::{wgpu, DeferredPass, MeshStore, Scene, Style};
+///
+/// # fn frame(
+/// #     device: &wgpu::Device,
+/// #     queue: &wgpu::Queue,
+/// #     meshes: &MeshStore,
+/// #     scene: &Scene,
+/// #     color: &wgpu::TextureView,
+/// #     depth: &wgpu::Texture,
+/// # ) -> wirepass::Result<()> {
+/// // Once: a pass for the host's attachments (4x MSAA sRGB colour, its depth-stencil).
+/// let mut pass = DeferredPass::new(
+///     device,
+///     PassOptions {
+///         render_target: Some(RenderTarget {
+///             format: wgpu::TextureFormat::Rgba8UnormSrgb,
+///             sample_count: 4,
+///             depth_stencil: Some(wgpu::TextureFormat::Depth24PlusStencil8),
+///             content: Composite::Lines,
+///         }),
+///         ..Default::default()
+///     },
+/// )?;
+///
+/// // Each frame, after the host has drawn its scene into `color` and `depth` with the
+/// // scene's view: the lines, hidden where the host's surfaces are in front.
+/// let size = (depth.width(), depth.height());
+/// let canvas = Canvas::new(size).with_host_depth(HostDepth { texture: depth, view: scene.view });
+/// let frame = pass.prepare(device, meshes, scene, &Style::default(), canvas)?;
+/// let mut encoder = device.create_command_encoder(&Default::default());
+/// pass.encode(device, &mut encoder, meshes, &frame, OutputTarget::RenderPass)?;
+/// {
+///     let mut overlay = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+///         color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+///             view: color,
+///             depth_slice: None,
+///             resolve_target: None,
+///             ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store },
+///         })],
+///         ..Default::default()
+///     });
+///     // The host may draw its own overlays here too.
+///     pass.render(&mut overlay, &frame)?;
+/// }
+/// queue.submit([encoder.finish()]);
+/// # Ok(())
+/// # }
+/// ```
 pub struct DeferredPass {
     id: u32,
     format: wgpu::TextureFormat,

@@ -393,7 +393,22 @@ fn instance_record(
     (slot, cluster_first): (u32, u32),
 ) -> InstanceRecord {
     let model = transform * mesh.local_to_mesh();
-    let rows = view.clip_rows(model);
+    let mut rows = view.clip_rows(model);
+    // Clip coordinates are homogeneous: every use of them (screen lines, coverage, depth,
+    // the near-plane sign) is unchanged by a common positive factor. A scene 1e-30 or 1e30
+    // across would under- or overflow in f32 (its edge lines are products of two clip
+    // points), so far from unit size the rows are scaled by a power of two towards 1.
+    let largest = rows
+        .clip
+        .to_cols_array()
+        .iter()
+        .chain(&rows.depth.to_array())
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    if largest > 0.0 && !(2f64.powi(-16)..=2f64.powi(16)).contains(&largest) {
+        let k = 2f64.powi(-largest.log2().floor() as i32);
+        rows.clip *= k;
+        rows.depth *= k;
+    }
     let mut local_eye = model.inverse() * eye;
     local_eye = if local_eye.w != 0.0 {
         local_eye / local_eye.w

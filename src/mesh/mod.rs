@@ -85,6 +85,23 @@ impl std::str::FromStr for EdgeSelection {
 
 /// A validated triangle mesh. All objects and groups of a file form one mesh, so triangle
 /// ids (the index into [`Mesh::triangles`]) are global across the scene.
+///
+/// ```
+/// use wirepass::glam::Vec3;
+/// use wirepass::Mesh;
+///
+/// // A unit quad as two triangles; the mask keeps the diagonal (edge 2 of each triangle:
+/// // from its third vertex back to its first) out of the polygon edges.
+/// let positions = vec![Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y];
+/// let quad = Mesh::new(positions, None, vec![[0, 1, 2], [2, 3, 0]], Some(vec![0b011, 0b011]))?;
+/// assert_eq!(quad.triangle_count(), 2);
+///
+/// // Bad input is an error, never a panic.
+/// let nan = vec![Vec3::ZERO, Vec3::X, Vec3::new(f32::NAN, 0.0, 0.0)];
+/// assert!(Mesh::new(nan, None, vec![[0, 1, 2]], None).is_err());
+/// assert!(Mesh::new(vec![Vec3::ZERO; 3], None, vec![[0, 1, 3]], None).is_err());
+/// # Ok::<(), wirepass::Error>(())
+/// ```
 #[derive(Clone, Debug)]
 pub struct Mesh {
     positions: Vec<Vec3>,
