@@ -254,7 +254,14 @@ impl Camera {
             }
         }
         let dir = (self.target - self.eye).as_dvec3();
-        if dir.length() <= 1e-12 * self.eye.as_dvec3().length().max(1.0) {
+        // Relative to the camera's own scale, so a camera framing a mesh 1e-30 across is
+        // as valid as one framing a unit mesh.
+        let scale = self
+            .eye
+            .as_dvec3()
+            .length()
+            .max(self.target.as_dvec3().length());
+        if dir.length() <= 1e-12 * scale {
             return bad(format!("eye and target are the same point {}", self.eye));
         }
         let up = self.up.as_dvec3();

@@ -373,6 +373,10 @@ fn meshes_of_tiny_and_huge_extent_render_like_a_unit_one() {
     );
     for scale in [1e-30f32, 1e30] {
         let scaled = at_scale(scale);
+        let camera = common::framing(&scaled, size);
+        camera
+            .validate()
+            .unwrap_or_else(|e| panic!("x{scale:e}: the framing camera: {e}"));
         let frame = draw(&scaled);
         let same_ids = frame
             .ids
