@@ -107,13 +107,12 @@ impl HostImport {
         }
         host.view.validate()?;
         let multisampled = t.sample_count() > 1;
-        let info = device.adapter_info();
-        if multisampled && info.backend == wgpu::Backend::Gl {
+        if multisampled && device.adapter_info().backend == wgpu::Backend::Gl {
             // wgpu's GL backend cannot render into a multisampled texture that can also be
             // bound (gfx-rs/wgpu#6084): such a depth holds nothing, and the host's own pass
             // with it draws nothing either.
             return Err(Error::MissingFeature {
-                adapter: info.name,
+                adapter: device.adapter_info().name,
                 what: "a multisampled depth texture that can be both rendered and bound \
                        (wgpu's GL backend cannot; give a single-sampled depth)"
                     .into(),
