@@ -1,11 +1,17 @@
-// The deferred edge pass, after common.wgsl and scene.wgsl. Two dispatches:
+// The deferred edge pass, after common.wgsl and scene.wgsl. Three dispatches, so that work
+// only some pixels need runs only for them (a software rasterizer runs both sides of every
+// branch and every memory access for all lanes):
 //
-// `edge_main`, one invocation per output pixel: the triangle the rasterizer gave the pixel
-// is tested exactly at the centre; where it covers the centre with room to spare (nearly
-// every pixel), the pixel is finished here: distance to the drawn edges, perspective-correct
-// barycentrics, shading, the line. Pixels it cannot decide (the centre within
-// COVERAGE_MARGIN of the triangle's boundary or outside it, background next to foreground)
-// are appended to a list instead.
+// `classify_main`, one invocation per output pixel: background and host pixels with no
+// foreground next to them are finished here (the outline pass's line, if any, over the
+// background); the 8×8 tiles that hold anything else are listed.
+//
+// `tile_main`, dispatched indirectly over the listed tiles: the triangle the rasterizer gave
+// a pixel is tested exactly at the centre; where it covers the centre with room to spare
+// (nearly every pixel), the pixel is finished here: distance to the drawn edges,
+// perspective-correct barycentrics, shading, the line. Pixels it cannot decide (the centre
+// within COVERAGE_MARGIN of the triangle's boundary or outside it, background next to
+// foreground) are appended to a list instead.
 //
 // `refine_main`, dispatched indirectly over that list only: the exact coverage search among
 // the neighbourhood's triangles and the walks across edges from them.
@@ -15,17 +21,18 @@
 // depth seeded the targets: a triangle must also be nearer than it), and the output
 // mode: MODE_SHADE, MODE_OVERLAY, MODE_RESULT (with SHADED: surface and lines, else lines
 // only), MODE_DIAGNOSTIC.
-
 #if OUTLINES
 // What the outline pass left per target pixel: the greatest `line_key` (and, with COLORS,
 // the greatest (level, instance) pair after it).
 @group(0) @binding(12) var<storage, read> acc: array<u32>;
 #endif
 
-// The pixels `edge_main` leaves to `refine_main`, and the indirect dispatch size for them.
+// The pixels `tile_main` leaves to `refine_main`, and the indirect dispatch size for them:
+// LIST_WIDTH workgroups wide, as many rows as the list needs (one workgroup per tile, or per
+// 64 pixels). A loop over the list instead costs a software rasterizer far more.
 struct WorkList {
     x: atomic<u32>,
-    y: u32,
+    y: atomic<u32>,
     z: u32,
     count: atomic<u32>,
     items: array<u32>,
@@ -41,8 +48,23 @@ struct WorkListRead {
 }
 @group(0) @binding(16) var<storage, read> work: WorkListRead;
 
-// Workgroups of `refine_main` at most; each then takes every MAX_REFINE_GROUPS × 64-th item.
-const MAX_REFINE_GROUPS: u32 = 16384u;
+// The tiles `classify_main` leaves to `tile_main`, and the indirect dispatch size for them.
+@group(0) @binding(24) var<storage, read_write> tiles_rw: WorkList;
+@group(0) @binding(25) var<storage, read> tiles: WorkListRead;
+
+const LIST_WIDTH: u32 = 256u;
+
+// The least dispatch size (x, y) of a list whose item k is there, one workgroup per `per`
+// items.
+fn list_size(k: u32, per: u32) -> vec2<u32> {
+    let group = k / per;
+    return vec2<u32>(min(group + 1u, LIST_WIDTH), group / LIST_WIDTH + 1u);
+}
+
+// The list index of workgroup `group` of an indirect dispatch made by `append`.
+fn list_group(group: vec3<u32>) -> u32 {
+    return group.y * LIST_WIDTH + group.x;
+}
 
 #if MODE_SHADE
 @group(0) @binding(20) var out_color: texture_storage_2d<OUTPUT_FORMAT, write>;
@@ -76,13 +98,9 @@ struct Pixel {
     depth: f32,
 }
 
-// The pixel's line and surface, given the triangle that covers its centre (`s.inst` is
-// BACKGROUND_ID or HOST_ID for none).
-fn finish(xy: vec2<u32>, s: Sample) -> Pixel {
-    var p: Pixel;
-    p.inst = s.inst;
-    p.tri = s.tri;
-    p.depth = 0.0;
+// The line the outline pass left in target pixel `xy`: its key (0 for none) and the
+// instance slot whose line it is.
+fn outline_at(xy: vec2<u32>) -> vec2<u32> {
     var key = 0u;
     var owner = 0u;
 #if OUTLINES
@@ -94,42 +112,67 @@ fn finish(xy: vec2<u32>, s: Sample) -> Pixel {
     key = acc[k];
 #endif
 #endif
-    if s.inst == HOST_ID {
+    return vec2<u32>(key, owner);
+}
+
+// A pixel whose centre no triangle covers (`inst` is BACKGROUND_ID or HOST_ID): only the
+// outline pass's line colours it.
+fn empty_pixel(xy: vec2<u32>, inst: u32) -> Pixel {
+    var p: Pixel;
+    p.inst = inst;
+    p.tri = 0u;
+    p.depth = 0.0;
+    if inst == HOST_ID {
         p.depth = host_at(vec2<i32>(xy));
     }
-    var own = NO_EDGE;
-    var own_line = 0.0;
-    var own_key = 0u;
-    if s.inst < HOST_ID {
-        let inst = s.inst;
-        let flags = instances[inst].flags;
-        var mask = info[instances[inst].triangle_base + s.tri] & 7u;
-        if (flags & INSTANCE_EDGES) == 0u {
-            mask = 0u;
-        }
-        let d = drawn_distances(s.lines, vec3<f32>(s.clip0.z, s.clip1.z, s.clip2.z), mask);
-        own = min(d.x, min(d.y, d.z));
-        let b = s.bary;
-        let local = b.x * s.v0.xyz + b.y * s.v1.xyz + b.z * s.v2.xyz;
-        let view_depth = dot(instances[inst].fade_row, vec4<f32>(local, 1.0));
-        own_line = line_intensity(own, instances[inst].line_width) * depth_fade(view_depth, frame.fade);
-        if own < NO_EDGE {
-            own_key = line_key(own_line, own);
-        }
-        let n = b.x * unpack_normal(bitcast<u32>(s.v0.w)) + b.y * unpack_normal(bitcast<u32>(s.v1.w)) + b.z * unpack_normal(bitcast<u32>(s.v2.w));
-        let face = cross(s.v1.xyz - s.v0.xyz, s.v2.xyz - s.v0.xyz);
-        p.surface = surface_color(frame, instances[inst], local, n, face);
-        p.depth = s.depth;
+    let outline = outline_at(xy);
+    if outline.x == 0u {
+        p.distance = NO_EDGE;
+        p.line = 0.0;
+        p.wire = instances[slot(min(inst, frame.instances - 1u))].wire_color;
+    } else {
+        p.distance = key_distance(outline.x);
+        p.line = key_intensity(outline.x);
+        p.wire = instances[slot(outline.y)].wire_color;
     }
-    // The stronger line colours the pixel; equal ones go to the nearer.
-    if own_key >= key {
+    return p;
+}
+
+// A pixel whose centre triangle `s` covers: the stronger of the triangle's own line and the
+// outline pass's colours it, equal ones going to the nearer.
+fn surface_pixel(xy: vec2<u32>, s: Sample) -> Pixel {
+    var p: Pixel;
+    p.inst = s.inst;
+    p.tri = s.tri;
+    let outline = outline_at(xy);
+    let inst = s.inst;
+    let flags = instances[slot(inst)].flags;
+    var mask = info[instances[slot(inst)].triangle_base + s.tri] & 7u;
+    if (flags & INSTANCE_EDGES) == 0u {
+        mask = 0u;
+    }
+    let d = drawn_distances(s.lines, vec3<f32>(s.clip0.z, s.clip1.z, s.clip2.z), mask);
+    let own = min(d.x, min(d.y, d.z));
+    let b = s.bary;
+    let local = b.x * s.v0.xyz + b.y * s.v1.xyz + b.z * s.v2.xyz;
+    let view_depth = dot(instances[slot(inst)].fade_row, vec4<f32>(local, 1.0));
+    let own_line = line_intensity(own, instances[slot(inst)].line_width) * depth_fade(view_depth, frame.fade);
+    var own_key = 0u;
+    if own < NO_EDGE {
+        own_key = line_key(own_line, own);
+    }
+    let n = b.x * unpack_normal(bitcast<u32>(s.v0.w)) + b.y * unpack_normal(bitcast<u32>(s.v1.w)) + b.z * unpack_normal(bitcast<u32>(s.v2.w));
+    let face = cross(s.v1.xyz - s.v0.xyz, s.v2.xyz - s.v0.xyz);
+    p.surface = surface_color(frame, instances[slot(inst)], local, n, face);
+    p.depth = s.depth;
+    if own_key >= outline.x {
         p.distance = own;
         p.line = own_line;
-        p.wire = instances[min(s.inst, frame.instances - 1u)].wire_color;
+        p.wire = instances[slot(inst)].wire_color;
     } else {
-        p.distance = key_distance(key);
-        p.line = key_intensity(key);
-        p.wire = instances[owner].wire_color;
+        p.distance = key_distance(outline.x);
+        p.line = key_intensity(outline.x);
+        p.wire = instances[slot(outline.y)].wire_color;
     }
     return p;
 }
@@ -185,28 +228,69 @@ fn no_sample(inst: u32) -> Sample {
     return s;
 }
 
+// Whether any pixel of this workgroup's tile needs `tile_main`.
+var<workgroup> tile_busy: atomic<u32>;
+
 @compute @workgroup_size(8, 8)
-fn edge_main(@builtin(global_invocation_id) gid: vec3<u32>) {
-    if !all(vec2<f32>(gid.xy) < frame.output_size) {
-        return;
-    }
+fn classify_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) lane: u32, @builtin(workgroup_id) group: vec3<u32>) {
+    let inside = all(vec2<f32>(gid.xy) < frame.output_size);
     let xy = gid.xy + vec2<u32>(frame.output_offset);
-    let raster = textureLoad(ids, xy, 0).xy;
-    var s = no_sample(raster.x);
-    var certain: bool;
-    if raster.x < HOST_ID {
-        s = sample(raster.x, raster.y, pixel_centre(xy));
-        certain = s.covers && s.margin >= COVERAGE_MARGIN;
-    } else {
-        certain = !foreground_next_to(xy);
+    let raster = id_at(vec2<i32>(xy)).x;
+    let empty = raster >= HOST_ID && !foreground_next_to(xy);
+    if inside && empty {
+        store_pixel(xy, empty_pixel(xy, raster));
     }
-    if !certain {
-        let k = atomicAdd(&work_rw.count, 1u);
-        work_rw.items[k] = xy.x | (xy.y << 16u);
-        atomicMax(&work_rw.x, min(k / 64u + 1u, MAX_REFINE_GROUPS));
-        return;
+    if inside && !empty {
+        atomicStore(&tile_busy, 1u);
     }
-    store_pixel(xy, finish(xy, s));
+    workgroupBarrier();
+    if lane == 0u && atomicLoad(&tile_busy) != 0u {
+        let k = atomicAdd(&tiles_rw.count, 1u);
+        tiles_rw.items[k] = group.x | (group.y << 16u);
+        let size = list_size(k, 1u);
+        atomicMax(&tiles_rw.x, size.x);
+        atomicMax(&tiles_rw.y, size.y);
+    }
+}
+
+@compute @workgroup_size(8, 8)
+fn tile_main(@builtin(local_invocation_id) local: vec3<u32>, @builtin(workgroup_id) group: vec3<u32>) {
+    let t = list_group(group);
+    if t < tiles.count {
+        let tile = tiles.items[t];
+        let at = vec2<u32>(tile & 0xffffu, tile >> 16u) * 8u + local.xy;
+        let xy = at + vec2<u32>(frame.output_offset);
+        let raster = textureLoad(ids, xy, 0).xy;
+        let foreground = raster.x < HOST_ID;
+        // Memory reads are skipped for masked lanes, so background lanes do not sample.
+        var s = no_sample(raster.x);
+        if foreground {
+            s = sample(raster.x, raster.y, pixel_centre(xy));
+        }
+        let certain = foreground && s.covers && s.margin >= COVERAGE_MARGIN;
+        // Background pixels of a listed tile with no foreground next to them were finished
+        // by classify_main.
+        let pending = all(vec2<f32>(at) < frame.output_size) && (foreground || foreground_next_to(xy));
+        if pending && certain {
+            store_pixel(xy, surface_pixel(xy, s));
+        }
+        if pending && !certain {
+            let k = atomicAdd(&work_rw.count, 1u);
+            work_rw.items[k] = xy.x | (xy.y << 16u);
+            let size = list_size(k, 64u);
+            atomicMax(&work_rw.x, size.x);
+            atomicMax(&work_rw.y, size.y);
+        }
+    }
+}
+
+// The pixel's line and surface, given the triangle that covers its centre (`s.inst` is
+// BACKGROUND_ID or HOST_ID for none).
+fn finish(xy: vec2<u32>, s: Sample) -> Pixel {
+    if s.inst < HOST_ID {
+        return surface_pixel(xy, s);
+    }
+    return empty_pixel(xy, s.inst);
 }
 
 // The triangle whose surface the centre of target pixel `xy` sees, for a pixel `edge_main`
@@ -241,7 +325,7 @@ fn resolve(xy: vec2<u32>) -> Sample {
         if id.x >= HOST_ID {
             continue;
         }
-        let s = locate(id.x, id.y, point, steps);
+        let s = locate(id.x, id.y, point, steps, true);
         if s.covers && s.depth > host && (!found || s.near < best.near) {
             best = s;
             found = true;
@@ -254,9 +338,9 @@ fn resolve(xy: vec2<u32>) -> Sample {
 }
 
 @compute @workgroup_size(64)
-fn refine_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
-    let count = work.count;
-    for (var k = gid.x; k < count; k += 64u * groups.x) {
+fn refine_main(@builtin(local_invocation_index) lane: u32, @builtin(workgroup_id) group: vec3<u32>) {
+    let k = list_group(group) * 64u + lane;
+    if k < work.count {
         let item = work.items[k];
         let xy = vec2<u32>(item & 0xffffu, item >> 16u);
         store_pixel(xy, finish(xy, resolve(xy)));

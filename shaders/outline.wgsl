@@ -53,7 +53,7 @@ fn instance_of_cluster(f: u32) -> u32 {
     var hi = frame.instances;
     while hi - lo > 1u {
         let mid = (lo + hi) / 2u;
-        if instances[mid].cluster_first <= f {
+        if instances[slot(mid)].cluster_first <= f {
             lo = mid;
         } else {
             hi = mid;
@@ -73,11 +73,11 @@ fn outline_cull(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
         return;
     }
     let inst = instance_of_cluster(f);
-    if (instances[inst].flags & INSTANCE_OUTLINES) == 0u {
+    if (instances[slot(inst)].flags & INSTANCE_OUTLINES) == 0u {
         return;
     }
-    let c = f - instances[inst].cluster_first;
-    if !cluster_may_fold(clusters[instances[inst].cluster_base + c], instances[inst].eye) {
+    let c = f - instances[slot(inst)].cluster_first;
+    if !cluster_may_fold(clusters[instances[slot(inst)].cluster_base + c], instances[slot(inst)].eye) {
         return;
     }
     let k = atomicAdd(&cull_rw.count, 1u);
@@ -95,7 +95,7 @@ fn outline_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocati
     for (var k = group.x; k < count; k += groups.x) {
         let item = cull.items[k];
         let t = item.y * CLUSTER_TRIANGLES + lane;
-        if t < instances[item.x].triangles {
+        if t < instances[slot(item.x)].triangles {
             outline_triangle(item.x, t);
         }
     }
@@ -103,8 +103,8 @@ fn outline_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocati
 
 // Finds the outline edges of triangle t of instance `inst` and draws them.
 fn outline_triangle(inst: u32, t: u32) {
-    let base = instances[inst].triangle_base;
-    let vbase = instances[inst].vertex_base;
+    let base = instances[slot(inst)].triangle_base;
+    let vbase = instances[slot(inst)].vertex_base;
     let v = corners(base + t) + vbase;
     var p = array<vec3<f32>, 3>(vertex_at(v.x).xyz, vertex_at(v.y).xyz, vertex_at(v.z).xyz);
     // Most triangles are seen well away from edge-on, further than their edges fold: none of
@@ -122,7 +122,7 @@ fn outline_triangle(inst: u32, t: u32) {
         fold_bound = 2.0;
     }
     let normal = cross(p[1] - p[0], p[2] - p[0]);
-    let eye = instances[inst].eye;
+    let eye = instances[slot(inst)].eye;
     var may_fold = true;
     if eye.w != 0.0 {
         let e = eye.xyz / eye.w;
@@ -231,13 +231,13 @@ fn seg_visible(s: Segment, k: f32) -> bool {
 // Writes edge a -> b (of triangle t of `inst`, with neighbour n) into every pixel within reach
 // of its visible part.
 fn draw_outline(inst: u32, t: u32, n: u32, a: vec3<f32>, b: vec3<f32>) {
-    let clip = instances[inst].clip;
+    let clip = instances[slot(inst)].clip;
     let ha = vec4<f32>(a, 1.0);
     let hb = vec4<f32>(b, 1.0);
     let ca = clip * ha;
     let cb = clip * hb;
-    let depth_row = instances[inst].depth_row;
-    let fade_row = instances[inst].fade_row;
+    let depth_row = instances[slot(inst)].depth_row;
+    let fade_row = instances[slot(inst)].fade_row;
     // In front of the near plane and not beyond the far one.
     var s = keep_positive(vec2<f32>(0.0, 1.0), ca.z, cb.z);
     s = keep_positive(s, dot(depth_row, ha), dot(depth_row, hb));
@@ -345,7 +345,7 @@ fn draw_piece(seg: Segment, k0: f32, k1: f32, length_px: f32) {
         return;
     }
 
-    let width = instances[seg.inst].line_width;
+    let width = instances[slot(seg.inst)].line_width;
     let reach = line_reach(width);
     let along = seg.end.xy - seg.start.xy;
     let q0 = seg.start.xy + k0 * along;
@@ -433,7 +433,7 @@ fn visible_at(x: vec2<f32>, near: f32, w: f32, reverse: f32, inst: u32, t: u32, 
             continue;
         }
         last = id;
-        let s = locate(id.x, id.y, x, WALK_STEPS);
+        let s = locate(id.x, id.y, x, WALK_STEPS, false);
         if s.covers && !(s.inst == inst && (s.tri == t || s.tri == n)) && nearer(s.near, near, w) {
             return false;
         }

@@ -2,10 +2,28 @@
 // id target, with the exact test of one triangle at one screen point. Assembled after
 // common.wgsl, before the outline and edge passes.
 //
-// Flags: SPLIT (the store's vertex and per-triangle buffers are bound as two halves each).
+// Flags: SPLIT (the store's vertex and per-triangle buffers are bound as two halves each),
+// UNIFORM_INSTANCES (the frame's instance records fit a uniform buffer) and ONE_INSTANCE (the
+// frame has one instance).
 
 @group(0) @binding(0) var<uniform> frame: Frame;
+#if UNIFORM_INSTANCES
+// Few instances: a uniform buffer. Software rasterizers read uniform buffers with plain
+// gathers, or once for all lanes at a constant index, but storage buffers lane by lane.
+@group(0) @binding(18) var<uniform> instances: array<Instance, UNIFORM_INSTANCE_CAPACITY>;
+#else
 @group(0) @binding(1) var<storage, read> instances: array<Instance>;
+#endif
+
+// Where instance slot `i`'s record is read: with ONE_INSTANCE always slot 0, a constant
+// index, so every lane reads the same record (background ids fold to it too).
+fn slot(i: u32) -> u32 {
+#if ONE_INSTANCE
+    return 0u;
+#else
+    return i;
+#endif
+}
 // Per vertex: local position (xyz) and the packed normal's bits (w).
 @group(0) @binding(2) var<storage, read> vertices: array<vec4<f32>>;
 #if SPLIT
@@ -168,10 +186,10 @@ fn sample(inst: u32, tri: u32, point: vec2<f32>) -> Sample {
     var s: Sample;
     s.inst = inst;
     s.tri = tri;
-    let clip = instances[inst].clip;
-    let depth_row = instances[inst].depth_row;
-    let base = instances[inst].vertex_base;
-    let v = corners(instances[inst].triangle_base + tri) + base;
+    let clip = instances[slot(inst)].clip;
+    let depth_row = instances[slot(inst)].depth_row;
+    let base = instances[slot(inst)].vertex_base;
+    let v = corners(instances[slot(inst)].triangle_base + tri) + base;
     s.v0 = vertex_at(v.x);
     s.v1 = vertex_at(v.y);
     s.v2 = vertex_at(v.z);
@@ -220,13 +238,28 @@ const WALK_STEPS: u32 = 24u;
 // lies beyond, for at most `steps` steps, until a triangle covers it; returns the last
 // triangle's sample. Finds the owner of a point that the rasterizer gave to a neighbour when
 // the owner (a sub-pixel triangle, say) has no rasterized pixel of its own. The walk stays
-// within the instance. With 0 steps it is the sample of `tri` itself. One `sample` in one
-// loop, so a shader holds one copy of it.
-fn locate(inst: u32, tri: u32, point: vec2<f32>, steps: u32) -> Sample {
+// within the instance. With 0 steps it is the sample of `tri` itself. With `stop_at_fold`
+// it also ends where it would cross a silhouette (the next triangle faces the eye the other
+// way than the last one that faced it either way): the triangle beyond a silhouette edge lies on screen on this side of the edge, so it
+// cannot cover a point beyond it, and the walk would only wander over the surface's far side
+// (a walk from the mesh towards a background point does that for all its steps). One
+// `sample` in one loop, so a shader holds one copy of it.
+fn locate(inst: u32, tri: u32, point: vec2<f32>, steps: u32, stop_at_fold: bool) -> Sample {
     var t = tri;
     var s: Sample;
+    let eye = instances[slot(inst)].eye;
+    var facing = 0.0;
     for (var step = 0u; step <= steps; step++) {
-        s = sample(inst, t, point);
+        let next_s = sample(inst, t, point);
+        let side = dot(towards_eye(next_s.v0.xyz, eye), cross(next_s.v1.xyz - next_s.v0.xyz, next_s.v2.xyz - next_s.v0.xyz));
+        if stop_at_fold && side * facing < 0.0 {
+            break;
+        }
+        s = next_s;
+        // Edge-on and degenerate triangles (side 0) face neither way.
+        if side != 0.0 {
+            facing = side;
+        }
         let b = s.bary;
         let lowest = min(b.x, min(b.y, b.z));
         // Covered, or inside but beyond the near or far plane, or degenerate: stop.
@@ -235,7 +268,7 @@ fn locate(inst: u32, tri: u32, point: vec2<f32>, steps: u32) -> Sample {
         }
         // Corner k's weight is negative beyond the opposite edge k + 1 (mod 3).
         let edge = select(select(0u, 2u, b.y == lowest), 1u, b.x == lowest);
-        let next = neighbour(instances[inst].triangle_base + t, edge);
+        let next = neighbour(instances[slot(inst)].triangle_base + t, edge);
         if next == BACKGROUND_ID {
             break;
         }

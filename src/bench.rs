@@ -49,8 +49,9 @@ pub struct Run {
     pub size: [u32; 2],
     /// Method name.
     pub method: String,
-    /// GPU time of each pass, and of each group of passes (`edge` is `edge.main` plus
-    /// `edge.refine`, `outline` is `outline.cull` plus `outline.draw`).
+    /// GPU time of each pass, and of each group of passes: `edge` is the sum of its
+    /// dispatches (`edge.classify`, `edge.tiles`, `edge.refine`; the floor's `edge.floor`),
+    /// `outline` of `outline.cull` and `outline.draw`.
     pub passes: BTreeMap<String, Stats>,
     /// Median over frames of the sum of the passes.
     pub total_median_ms: f64,

@@ -390,7 +390,8 @@ fn timer_reports_every_pass() {
                 "visibility",
                 "outline.cull",
                 "outline.draw",
-                "edge.main",
+                "edge.classify",
+                "edge.tiles",
                 "edge.refine"
             ]
         );

@@ -5,7 +5,7 @@
 //! `wgpu::Limits::default()` (8 storage buffers per stage), and no two passes spell out the
 //! same layout.
 
-use super::frame::FrameData;
+use super::frame::{FrameData, INSTANCE_BYTES, UNIFORM_INSTANCE_CAPACITY};
 use super::mesh_store::{TRIANGLE_BYTES, VERTEX_BYTES};
 use crate::error::{Error, Result};
 
@@ -31,12 +31,17 @@ pub(crate) enum Res {
     Work = 16,
     /// The host's depth (reverse depth bits per target pixel).
     HostDepth = 17,
+    /// The instance records as a uniform array (frames with few instances).
+    UniformInstances = 18,
     /// The output colour (a storage texture of the pass's format, or the frame's result).
     OutColor = 20,
     /// The host's colour image, for overlay.
     HostColor = 21,
     OutDiagnostic = 22,
     OutIds = 23,
+    /// The edge pass's list of tiles for `tile_main`.
+    TilesRw = 24,
+    Tiles = 25,
 }
 
 impl Res {
@@ -64,8 +69,8 @@ impl Res {
         };
         use Res::*;
         let ty = match self {
-            Frame => buffer(wgpu::BufferBindingType::Uniform),
-            AccRw | CullRw | WorkRw => write,
+            Frame | UniformInstances => buffer(wgpu::BufferBindingType::Uniform),
+            AccRw | CullRw | WorkRw | TilesRw => write,
             Ids | HostDepth => texture(wgpu::TextureSampleType::Uint),
             HostColor => texture(wgpu::TextureSampleType::Float { filterable: false }),
             OutColor => storage_texture(color),
@@ -89,19 +94,36 @@ impl Res {
             .filter(|r| {
                 !matches!(
                     r,
-                    Frame | Ids | HostDepth | HostColor | OutColor | OutDiagnostic | OutIds
+                    Frame
+                        | UniformInstances
+                        | Ids
+                        | HostDepth
+                        | HostColor
+                        | OutColor
+                        | OutDiagnostic
+                        | OutIds
                 )
             })
             .count() as u32
     }
 }
 
+/// The instance records' binding: uniform where the frame's few instances allow it
+/// (`UNIFORM_INSTANCES` in `scene.wgsl`).
+pub(crate) fn instances(uniform: bool) -> Res {
+    if uniform {
+        Res::UniformInstances
+    } else {
+        Res::Instances
+    }
+}
+
 /// The scene resources a pass over the mesh store reads, with the second halves of the
 /// split buffers where the store is split.
-pub(crate) fn store_resources(split: bool, neighbours: bool) -> Vec<Res> {
+pub(crate) fn store_resources(split: bool, neighbours: bool, uniform_instances: bool) -> Vec<Res> {
     let mut r = vec![
         Res::Frame,
-        Res::Instances,
+        instances(uniform_instances),
         Res::Vertices,
         Res::Indices,
         Res::Info,
@@ -206,6 +228,7 @@ pub(crate) struct Sources<'a> {
     pub acc: Option<&'a wgpu::Buffer>,
     pub cull: Option<&'a wgpu::Buffer>,
     pub work: Option<&'a wgpu::Buffer>,
+    pub tiles: Option<&'a wgpu::Buffer>,
     pub out_color: Option<&'a wgpu::TextureView>,
     pub host_color: Option<&'a wgpu::TextureView>,
     pub out_diagnostic: Option<&'a wgpu::TextureView>,
@@ -222,6 +245,7 @@ impl<'a> Sources<'a> {
             acc: None,
             cull: None,
             work: None,
+            tiles: None,
             out_color: None,
             host_color: None,
             out_diagnostic: None,
@@ -265,6 +289,13 @@ pub(crate) fn bind_group(
         let resource = match r {
             Frame => f.frame.as_entire_binding(),
             Instances => f.instances.as_entire_binding(),
+            UniformInstances => wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                buffer: &f.instances,
+                offset: 0,
+                size: wgpu::BufferSize::new(
+                    u64::from(UNIFORM_INSTANCE_CAPACITY) * INSTANCE_BYTES,
+                ),
+            }),
             Vertices => half(&store.vertices, store.split.vertices, VERTEX_BYTES, false),
             VerticesHi => half(&store.vertices, store.split.vertices, VERTEX_BYTES, true),
             Indices => half(&store.indices, store.split.triangles, TRIANGLE_BYTES, false),
@@ -290,6 +321,7 @@ pub(crate) fn bind_group(
             AccRw | Acc => sources.acc.ok_or_else(|| missing(r))?.as_entire_binding(),
             CullRw | Cull => sources.cull.ok_or_else(|| missing(r))?.as_entire_binding(),
             WorkRw | Work => sources.work.ok_or_else(|| missing(r))?.as_entire_binding(),
+            TilesRw | Tiles => sources.tiles.ok_or_else(|| missing(r))?.as_entire_binding(),
             OutColor => {
                 wgpu::BindingResource::TextureView(sources.out_color.ok_or_else(|| missing(r))?)
             }

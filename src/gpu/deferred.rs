@@ -1,7 +1,7 @@
 //! The deferred wireframe pass: the visibility pass, the outline pass (with outlines on) and
 //! the edge pass, for a whole scene of instances at once.
 
-use super::bindings::{store_resources, Compute, Res, Sources};
+use super::bindings::{self, store_resources, Compute, Res, Sources};
 use super::composite::{Composite, CompositePipeline, RenderTarget};
 use super::frame::{Canvas, FrameData};
 use super::host::{HostFrame, HostImport};
@@ -86,10 +86,15 @@ struct Variant {
     outlines: bool,
     colors: bool,
     host: bool,
+    /// The instance records are bound as a uniform array.
+    uniform_instances: bool,
+    /// The frame has exactly one instance.
+    one_instance: bool,
 }
 
 struct EdgePipelines {
-    main: Compute,
+    classify: Compute,
+    tiles: Compute,
     refine: Compute,
 }
 
@@ -387,6 +392,8 @@ impl DeferredPass {
             outlines: frame.data.outlines,
             colors: frame.data.outlines && frame.data.mixed_colors,
             host: frame.host.is_some(),
+            uniform_instances: frame.data.uniform_instances,
+            one_instance: frame.data.uniforms.instances() == 1,
         }
     }
 
@@ -430,7 +437,7 @@ impl DeferredPass {
         };
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let module = edge_module(device, self.format, &flags);
-        let mut common = store_resources(v.split, false);
+        let mut common = store_resources(v.split, false, v.uniform_instances);
         common.push(Res::Ids);
         if v.host {
             common.push(Res::HostDepth);
@@ -444,7 +451,14 @@ impl DeferredPass {
             r.extend_from_slice(&out);
             r
         };
-        let main = Compute::new(device, &module, "edge_main", with(&[Res::WorkRw]), color)?;
+        let classify = Compute::new(device, &module, "classify_main", with(&[Res::TilesRw]), color)?;
+        let tiles = Compute::new(
+            device,
+            &module,
+            "tile_main",
+            with(&[Res::Tiles, Res::WorkRw]),
+            color,
+        )?;
         let mut refine_res = with(&[Res::Work, Res::Neighbours]);
         if v.split {
             refine_res.push(Res::NeighboursHi);
@@ -453,7 +467,11 @@ impl DeferredPass {
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(Error::Device(format!("building the edge pass: {e}")));
         }
-        let p = Arc::new(EdgePipelines { main, refine });
+        let p = Arc::new(EdgePipelines {
+            classify,
+            tiles,
+            refine,
+        });
         cache.insert((mode, v), p.clone());
         Ok(p)
     }
@@ -480,10 +498,15 @@ impl DeferredPass {
             device,
             &module,
             "outline_cull",
-            vec![Res::Frame, Res::Instances, Res::Clusters, Res::CullRw],
+            vec![
+                Res::Frame,
+                bindings::instances(v.uniform_instances),
+                Res::Clusters,
+                Res::CullRw,
+            ],
             self.format,
         )?;
-        let mut draw_res = store_resources(v.split, true);
+        let mut draw_res = store_resources(v.split, true, v.uniform_instances);
         draw_res.extend([Res::Ids, Res::Cull, Res::AccRw]);
         if v.host {
             draw_res.push(Res::HostDepth);
@@ -513,7 +536,7 @@ impl DeferredPass {
 
     /// [`encode`](Self::encode) with GPU timestamps around each pass, named
     /// `"visibility"`, `"outline.cull"` and `"outline.draw"` (when outlines are drawn), and
-    /// `"edge.main"` and `"edge.refine"`, in `timer`.
+    /// `"edge.classify"`, `"edge.tiles"` and `"edge.refine"`, in `timer`.
     pub fn encode_timed(
         &self,
         device: &wgpu::Device,
@@ -623,6 +646,7 @@ impl DeferredPass {
             acc: Some(&t.acc),
             cull: Some(&frame.cull),
             work: Some(&t.work),
+            tiles: Some(&t.tiles),
             out_color,
             host_color,
             out_diagnostic: diag.as_ref(),
@@ -634,7 +658,7 @@ impl DeferredPass {
             let group = self.floor.bind(device, &sources)?;
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("wirepass floor"),
-                timestamp_writes: timer.and_then(|t| t.compute_span("edge.main")),
+                timestamp_writes: timer.and_then(|t| t.compute_span("edge.floor")),
             });
             pass.set_pipeline(&self.floor.pipeline);
             pass.set_bind_group(0, &group, &[]);
@@ -657,27 +681,30 @@ impl DeferredPass {
             let n = self.results.fetch_add(1, Ordering::Relaxed) + 1;
             frame.encoded.store(n, Ordering::Relaxed);
         }
-        let main = edge.main.bind(device, &sources)?;
+        let classify = edge.classify.bind(device, &sources)?;
+        let tiles = edge.tiles.bind(device, &sources)?;
         let refine = edge.refine.bind(device, &sources)?;
+        encoder.copy_buffer_to_buffer(&self.reset, 0, &t.tiles, 0, LIST_HEADER);
         encoder.copy_buffer_to_buffer(&self.reset, 0, &t.work, 0, LIST_HEADER);
-        {
+        // Each dispatch is a pass of its own, timed on its own (the benchmark sums the
+        // `edge.*` spans into the edge pass).
+        let dispatches: [(&str, &str, &Compute, &wgpu::BindGroup, Option<&wgpu::Buffer>); 3] = [
+            ("wirepass edge classify", "edge.classify", &edge.classify, &classify, None),
+            ("wirepass edge tiles", "edge.tiles", &edge.tiles, &tiles, Some(&t.tiles)),
+            ("wirepass edge refine", "edge.refine", &edge.refine, &refine, Some(&t.work)),
+        ];
+        for (label, span, pipeline, group, indirect) in dispatches {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("wirepass edge pass"),
-                timestamp_writes: timer
-                    .as_deref_mut()
-                    .and_then(|t| t.compute_span("edge.main")),
+                label: Some(label),
+                timestamp_writes: timer.as_deref_mut().and_then(|t| t.compute_span(span)),
             });
-            pass.set_pipeline(&edge.main.pipeline);
-            pass.set_bind_group(0, &main, &[]);
-            pass.dispatch_workgroups(w.div_ceil(TILE), h.div_ceil(TILE), 1);
+            pass.set_pipeline(&pipeline.pipeline);
+            pass.set_bind_group(0, group, &[]);
+            match indirect {
+                Some(list) => pass.dispatch_workgroups_indirect(list, 0),
+                None => pass.dispatch_workgroups(w.div_ceil(TILE), h.div_ceil(TILE), 1),
+            }
         }
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("wirepass edge refine"),
-            timestamp_writes: timer.and_then(|t| t.compute_span("edge.refine")),
-        });
-        pass.set_pipeline(&edge.refine.pipeline);
-        pass.set_bind_group(0, &refine, &[]);
-        pass.dispatch_workgroups_indirect(&t.work, 0);
         Ok(())
     }
 
@@ -772,6 +799,12 @@ fn variant_flags(v: Variant) -> Vec<&'static str> {
     }
     if v.host {
         flags.push("HOST");
+    }
+    if v.uniform_instances {
+        flags.push("UNIFORM_INSTANCES");
+    }
+    if v.one_instance {
+        flags.push("ONE_INSTANCE");
     }
     flags
 }

@@ -62,10 +62,24 @@ const INSTANCE_OUTLINES: u32 = 2;
 /// Most instances a frame may hold; instance slots must fit the outline keys' 20 bits.
 pub const MAX_INSTANCES: u32 = 1 << 20;
 
+/// Instance records a uniform buffer holds (`scene.wgsl`, `UNIFORM_INSTANCES`): frames with
+/// up to this many bind them as uniforms, which software rasterizers read many times faster
+/// than storage buffers; 256 records are 52 KiB, within `Limits::default()`'s 64 KiB.
+pub(crate) const UNIFORM_INSTANCE_CAPACITY: u32 = 256;
+
 /// Byte offset of `InstanceRecord::index`, read as an instance-rate vertex attribute.
 pub(crate) const INSTANCE_INDEX_OFFSET: u64 = 204;
 /// Byte offsets of `vertex_base` and `triangle_base`.
 pub(crate) const INSTANCE_BASES_OFFSET: u64 = 184;
+/// Size of an `InstanceRecord`.
+pub(crate) const INSTANCE_BYTES: u64 = std::mem::size_of::<InstanceRecord>() as u64;
+
+impl FrameUniforms {
+    /// Instances in the frame.
+    pub fn instances(&self) -> u32 {
+        self.instances
+    }
+}
 
 impl InstanceRecord {
     /// The f32 mesh-local → clip matrix the GPU uses (rows x, y, near, w).
@@ -193,6 +207,9 @@ pub(crate) struct FrameData {
     /// Whether instances differ in line colour (the outline pass then keeps, per pixel,
     /// which instance's line it holds).
     pub mixed_colors: bool,
+    /// Whether the instance buffer can be bound as a uniform array of
+    /// [`UNIFORM_INSTANCE_CAPACITY`] records.
+    pub uniform_instances: bool,
 }
 
 impl FrameData {
@@ -321,17 +338,27 @@ impl FrameData {
             contents: bytemuck::bytes_of(&uniforms),
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         });
-        // Bindings need a non-empty buffer, even for a scene without instances.
+        // Bindings need a non-empty buffer, even for a scene without instances; a uniform
+        // binding needs the whole declared array.
+        let uniform_bytes = u64::from(UNIFORM_INSTANCE_CAPACITY) * INSTANCE_BYTES;
+        let uniform_instances = records.len() as u64 <= u64::from(UNIFORM_INSTANCE_CAPACITY)
+            && u64::from(device.limits().max_uniform_buffer_binding_size) >= uniform_bytes;
         let mut contents: Vec<u8> = bytemuck::cast_slice(&records).to_vec();
-        if contents.is_empty() {
-            contents = vec![0; std::mem::size_of::<InstanceRecord>()];
+        let least = if uniform_instances {
+            uniform_bytes
+        } else {
+            INSTANCE_BYTES
+        };
+        contents.resize(contents.len().max(least as usize), 0);
+        let mut usage =
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST;
+        if uniform_instances {
+            usage |= wgpu::BufferUsages::UNIFORM;
         }
         let instances = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("wirepass instances"),
             contents: &contents,
-            usage: wgpu::BufferUsages::STORAGE
-                | wgpu::BufferUsages::VERTEX
-                | wgpu::BufferUsages::COPY_DST,
+            usage,
         });
         Ok(FrameData {
             uniforms,
@@ -345,6 +372,7 @@ impl FrameData {
             guard,
             outlines,
             mixed_colors,
+            uniform_instances,
         })
     }
 

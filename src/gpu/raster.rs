@@ -54,7 +54,7 @@ pub(super) fn clear_color(format: wgpu::TextureFormat, bg: [f32; 4]) -> wgpu::Co
 
 /// The resources the baselines' shaders read: the scene, in the vertex and fragment stages.
 pub(super) fn resources(split: bool) -> Vec<Res> {
-    store_resources(split, false)
+    store_resources(split, false, false)
 }
 
 /// The bind group layout and pipeline layout for [`resources`].

@@ -83,7 +83,10 @@ pub fn specialise(source: &str, flags: &[&str]) -> String {
 /// A complete module: `common.wgsl`, then `parts` in order, specialised with `flags`.
 /// `enable` directives must come first in WGSL, so they are lifted out of the parts.
 pub fn assemble(parts: &[&str], flags: &[&str]) -> String {
-    let body = parts.join("\n");
+    let body = parts.join("\n").replace(
+        "UNIFORM_INSTANCE_CAPACITY",
+        &super::frame::UNIFORM_INSTANCE_CAPACITY.to_string(),
+    );
     let body = specialise(&body, flags);
     let (enables, rest): (Vec<&str>, Vec<&str>) = body
         .lines()
@@ -138,6 +141,14 @@ pub fn host_depth_source(multisampled: bool) -> String {
     assemble(&[HOST_DEPTH], flags)
 }
 
+/// How the compute passes read the instance records: from storage (many instances), from a
+/// uniform array, or from its only record.
+const INSTANCE_FLAGS: [&[&str]; 3] = [
+    &[],
+    &["UNIFORM_INSTANCES"],
+    &["UNIFORM_INSTANCES", "ONE_INSTANCE"],
+];
+
 /// Every module the crate builds, named by its settings: each pass in each of its
 /// specialisations, for validation without a GPU.
 pub fn variants() -> Vec<(String, String)> {
@@ -190,10 +201,14 @@ pub fn variants() -> Vec<(String, String)> {
                     if colors {
                         flags.push("COLORS");
                     }
-                    out.push((
-                        format!("edge {format:?} {flags:?}"),
-                        edge_source(format, &flags),
-                    ));
+                    for instances in INSTANCE_FLAGS {
+                        let mut flags = flags.clone();
+                        flags.extend_from_slice(instances);
+                        out.push((
+                            format!("edge {format:?} {flags:?}"),
+                            edge_source(format, &flags),
+                        ));
+                    }
                 }
             }
         }
@@ -210,7 +225,11 @@ pub fn variants() -> Vec<(String, String)> {
             if colors {
                 flags.push("COLORS");
             }
-            out.push((format!("outline {flags:?}"), outline_source(&flags)));
+            for instances in INSTANCE_FLAGS {
+                let mut flags = flags.clone();
+                flags.extend_from_slice(instances);
+                out.push((format!("outline {flags:?}"), outline_source(&flags)));
+            }
         }
         for format in [
             F::Rgba8Unorm,

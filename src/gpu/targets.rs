@@ -40,6 +40,8 @@ pub(crate) struct Targets {
     pub acc_colors: bool,
     /// The refine list: header, then one packed pixel per entry.
     pub work: wgpu::Buffer,
+    /// The edge pass's list of 8×8 output tiles with work for its tile dispatch.
+    pub tiles: wgpu::Buffer,
     pub result: Option<wgpu::Texture>,
     pub diagnostic: Option<(wgpu::Texture, wgpu::Texture)>,
     /// The host's depth, where the frame has one.
@@ -95,6 +97,8 @@ impl Targets {
                 limit: binding,
             });
         }
+        let tiles = u64::from(spec.output.0.div_ceil(8)) * u64::from(spec.output.1.div_ceil(8));
+        let tiles_bytes = LIST_HEADER + 4 * tiles;
         use wgpu::TextureUsages as U;
         let texture =
             |label, size, format, usage| super::texture_2d(device, label, size, format, usage);
@@ -130,6 +134,11 @@ impl Targets {
             work: buffer(
                 "wirepass refine list",
                 work_bytes,
+                wgpu::BufferUsages::INDIRECT,
+            ),
+            tiles: buffer(
+                "wirepass tile list",
+                tiles_bytes,
                 wgpu::BufferUsages::INDIRECT,
             ),
             result: spec.result.then(|| {
@@ -174,7 +183,7 @@ impl Targets {
             u64::from(t.width()) * u64::from(t.height()) * u64::from(texel)
         };
         let mut n = tex(&self.ids) + 4 * u64::from(self.size.0) * u64::from(self.size.1);
-        n += self.acc.size() + self.work.size();
+        n += self.acc.size() + self.work.size() + self.tiles.size();
         if let Some(r) = &self.result {
             n += tex(r);
         }
