@@ -27,9 +27,8 @@
 @group(0) @binding(12) var<storage, read> acc: array<u32>;
 #endif
 
-// The pixels `tile_main` leaves to `refine_main`, and the indirect dispatch size for them:
-// LIST_WIDTH workgroups wide, as many rows as the list needs (one workgroup per tile, or per
-// 64 pixels). A loop over the list instead costs a software rasterizer far more.
+// The pixels `tile_main` leaves to `refine_main`, and the indirect dispatch size for them
+// (`list_size`).
 struct WorkList {
     x: atomic<u32>,
     y: atomic<u32>,
@@ -52,19 +51,6 @@ struct WorkListRead {
 @group(0) @binding(24) var<storage, read_write> tiles_rw: WorkList;
 @group(0) @binding(25) var<storage, read> tiles: WorkListRead;
 
-const LIST_WIDTH: u32 = 256u;
-
-// The least dispatch size (x, y) of a list whose item k is there, one workgroup per `per`
-// items.
-fn list_size(k: u32, per: u32) -> vec2<u32> {
-    let group = k / per;
-    return vec2<u32>(min(group + 1u, LIST_WIDTH), group / LIST_WIDTH + 1u);
-}
-
-// The list index of workgroup `group` of an indirect dispatch made by `append`.
-fn list_group(group: vec3<u32>) -> u32 {
-    return group.y * LIST_WIDTH + group.x;
-}
 
 #if MODE_SHADE
 @group(0) @binding(20) var out_color: texture_storage_2d<OUTPUT_FORMAT, write>;

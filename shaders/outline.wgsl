@@ -26,7 +26,7 @@
 // indirect dispatch size for visiting them; starts as (0, 1, 1, 0).
 struct OutlineList {
     x: atomic<u32>,
-    y: u32,
+    y: atomic<u32>,
     z: u32,
     count: atomic<u32>,
     items: array<vec2<u32>>,
@@ -41,10 +41,6 @@ struct OutlineListRead {
     items: array<vec2<u32>>,
 }
 @group(0) @binding(14) var<storage, read> cull: OutlineListRead;
-
-// Workgroups of `outline_main` at most; each then takes every MAX_OUTLINE_GROUPS-th listed
-// cluster. Below every device's max_compute_workgroups_per_dimension (at least 65535).
-const MAX_OUTLINE_GROUPS: u32 = 16384u;
 
 // The instance whose clusters hold the cull's flat cluster index f: the last with
 // cluster_first <= f (instances are in the order of their cluster_first).
@@ -82,7 +78,9 @@ fn outline_cull(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     }
     let k = atomicAdd(&cull_rw.count, 1u);
     cull_rw.items[k] = vec2<u32>(inst, c);
-    atomicMax(&cull_rw.x, min(k + 1u, MAX_OUTLINE_GROUPS));
+    let size = list_size(k, 1u);
+    atomicMax(&cull_rw.x, size.x);
+    atomicMax(&cull_rw.y, size.y);
 }
 
 // Triangles per cluster, and invocations per workgroup of both entry points.
@@ -90,9 +88,9 @@ const CLUSTER_TRIANGLES: u32 = 64u;
 
 // One invocation per triangle of each listed cluster.
 @compute @workgroup_size(64)
-fn outline_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32, @builtin(num_workgroups) groups: vec3<u32>) {
-    let count = cull.count;
-    for (var k = group.x; k < count; k += groups.x) {
+fn outline_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+    let k = list_group(group);
+    if k < cull.count {
         let item = cull.items[k];
         let t = item.y * CLUSTER_TRIANGLES + lane;
         if t < instances[slot(item.x)].triangles {

@@ -15,6 +15,23 @@
 @group(0) @binding(1) var<storage, read> instances: array<Instance>;
 #endif
 
+// Indirect dispatches over a list that a pass appends to are LIST_WIDTH workgroups wide and
+// as many rows as the list needs, each workgroup taking its own item (or its own `per`
+// items). A loop over the list instead costs a software rasterizer far more.
+const LIST_WIDTH: u32 = 256u;
+
+// The least dispatch size (x, y) of a list whose item k is there, one workgroup per `per`
+// items.
+fn list_size(k: u32, per: u32) -> vec2<u32> {
+    let group = k / per;
+    return vec2<u32>(min(group + 1u, LIST_WIDTH), group / LIST_WIDTH + 1u);
+}
+
+// The list index of workgroup `group` of an indirect dispatch made by `append`.
+fn list_group(group: vec3<u32>) -> u32 {
+    return group.y * LIST_WIDTH + group.x;
+}
+
 // Where instance slot `i`'s record is read: with ONE_INSTANCE always slot 0, a constant
 // index, so every lane reads the same record (background ids fold to it too).
 fn slot(i: u32) -> u32 {
