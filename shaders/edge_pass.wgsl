@@ -2,16 +2,16 @@
 // only some pixels need runs only for them (a software rasterizer runs both sides of every
 // branch and every memory access for all lanes):
 //
-// `classify_main`, one invocation per output pixel: background and host pixels with no
-// foreground next to them are finished here (the outline pass's line, if any, over the
-// background); the 8×8 tiles that hold anything else are listed.
+// `classify_main`, one invocation per output pixel: background and host pixels are finished
+// here (the outline pass's line, if any, over the background); the 8×8 tiles that hold
+// foreground are listed.
 //
 // `tile_main`, dispatched indirectly over the listed tiles: the triangle the rasterizer gave
 // a pixel is tested exactly at the centre; where it covers the centre with room to spare
 // (nearly every pixel), the pixel is finished here: distance to the drawn edges,
 // perspective-correct barycentrics, shading, the line. Pixels it cannot decide (the centre
-// within COVERAGE_MARGIN of the triangle's boundary or outside it, background next to
-// foreground) are appended to a list instead.
+// within COVERAGE_MARGIN of the triangle's boundary or outside it) are appended to a list
+// instead, and so is the background next to the tiles' foreground.
 //
 // `refine_main`, dispatched indirectly over that list only: the exact coverage search among
 // the neighbourhood's triangles and the walks across edges from them.
@@ -25,16 +25,19 @@
 // What the outline pass left per target pixel: the greatest `line_key` (and, with COLORS,
 // the greatest (level, instance) pair after it).
 @group(0) @binding(12) var<storage, read> acc: array<u32>;
+// Per 8×8 output tile, the stamp of the last frame whose outline lines may reach it.
+@group(0) @binding(27) var outline_tiles: texture_2d<u32>;
 #endif
 
 // The pixels `tile_main` leaves to `refine_main`, and the indirect dispatch size for them
 // (`list_size`).
+// After the list, one mark bit per target pixel (0 until the pixel is listed).
 struct WorkList {
     x: atomic<u32>,
     y: atomic<u32>,
     z: u32,
     count: atomic<u32>,
-    items: array<u32>,
+    items: array<atomic<u32>>,
 }
 @group(0) @binding(15) var<storage, read_write> work_rw: WorkList;
 
@@ -47,8 +50,16 @@ struct WorkListRead {
 }
 @group(0) @binding(16) var<storage, read> work: WorkListRead;
 
-// The tiles `classify_main` leaves to `tile_main`, and the indirect dispatch size for them.
-@group(0) @binding(24) var<storage, read_write> tiles_rw: WorkList;
+// The tiles `classify_main` leaves to `tile_main`, and the indirect dispatch size for them;
+// after the list, one mark per tile of the output (0 until the tile is listed).
+struct TileList {
+    x: atomic<u32>,
+    y: atomic<u32>,
+    z: u32,
+    count: atomic<u32>,
+    items: array<atomic<u32>>,
+}
+@group(0) @binding(24) var<storage, read_write> tiles_rw: TileList;
 @group(0) @binding(25) var<storage, read> tiles: WorkListRead;
 
 
@@ -102,8 +113,8 @@ fn outline_at(xy: vec2<u32>) -> vec2<u32> {
 }
 
 // A pixel whose centre no triangle covers (`inst` is BACKGROUND_ID or HOST_ID): only the
-// outline pass's line colours it.
-fn empty_pixel(xy: vec2<u32>, inst: u32) -> Pixel {
+// outline pass's line colours it. Without `outlined` no line reaches it.
+fn empty_pixel(xy: vec2<u32>, inst: u32, outlined: bool) -> Pixel {
     var p: Pixel;
     p.inst = inst;
     p.tri = 0u;
@@ -111,7 +122,11 @@ fn empty_pixel(xy: vec2<u32>, inst: u32) -> Pixel {
     if inst == HOST_ID {
         p.depth = host_at(vec2<i32>(xy));
     }
-    let outline = outline_at(xy);
+    // Behind the condition, lanes of tiles no line reaches skip the read.
+    var outline = vec2<u32>(0u);
+    if outlined {
+        outline = outline_at(xy);
+    }
     if outline.x == 0u {
         p.distance = NO_EDGE;
         p.line = 0.0;
@@ -196,16 +211,6 @@ fn store_pixel(xy: vec2<u32>, p: Pixel) {
 #endif
 }
 
-// True when one of the four edge-adjacent pixels is foreground.
-fn foreground_next_to(xy: vec2<u32>) -> bool {
-    let q = vec2<i32>(xy);
-    let l = id_at(q - vec2<i32>(1, 0)).x;
-    let r = id_at(q + vec2<i32>(1, 0)).x;
-    let u = id_at(q - vec2<i32>(0, 1)).x;
-    let d = id_at(q + vec2<i32>(0, 1)).x;
-    return min(min(l, r), min(u, d)) < HOST_ID;
-}
-
 fn no_sample(inst: u32) -> Sample {
     var s: Sample;
     s.inst = inst;
@@ -214,29 +219,55 @@ fn no_sample(inst: u32) -> Sample {
     return s;
 }
 
-// Whether any pixel of this workgroup's tile needs `tile_main`.
-var<workgroup> tile_busy: atomic<u32>;
-
 @compute @workgroup_size(8, 8)
-fn classify_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) lane: u32, @builtin(workgroup_id) group: vec3<u32>) {
+fn classify_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(workgroup_id) group: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let inside = all(vec2<f32>(gid.xy) < frame.output_size);
     let xy = gid.xy + vec2<u32>(frame.output_offset);
-    let raster = id_at(vec2<i32>(xy)).x;
-    let empty = raster >= HOST_ID && !foreground_next_to(xy);
+    let raster = textureLoad(ids, xy, 0).x;
+    let empty = raster >= HOST_ID;
+    // Background next to foreground is written here too; tile_main lists it again for
+    // refine_main, which decides it.
+    var outlined = false;
+#if OUTLINES
+    outlined = textureLoad(outline_tiles, group.xy, 0).x == frame.stamp;
+#endif
     if inside && empty {
-        store_pixel(xy, empty_pixel(xy, raster));
+        store_pixel(xy, empty_pixel(xy, raster, outlined));
     }
+    // The first foreground pixel of a tile lists it: the tile's mark, after the list, is
+    // cleared each frame (a workgroup barrier and vote would cost every tile).
     if inside && !empty {
-        atomicStore(&tile_busy, 1u);
+        let tile = group.x | (group.y << 16u);
+        let marks = groups.x * groups.y;
+        if atomicExchange(&tiles_rw.items[marks + group.y * groups.x + group.x], 1u) == 0u {
+            let k = atomicAdd(&tiles_rw.count, 1u);
+            atomicStore(&tiles_rw.items[k], tile);
+            let size = list_size(k, 1u);
+            atomicMax(&tiles_rw.x, size.x);
+            atomicMax(&tiles_rw.y, size.y);
+        }
     }
-    workgroupBarrier();
-    if lane == 0u && atomicLoad(&tile_busy) != 0u {
-        let k = atomicAdd(&tiles_rw.count, 1u);
-        tiles_rw.items[k] = group.x | (group.y << 16u);
-        let size = list_size(k, 1u);
-        atomicMax(&tiles_rw.x, size.x);
-        atomicMax(&tiles_rw.y, size.y);
+}
+
+// Edge-adjacent pixel i (left, right, up, down) of a pixel, as an offset.
+fn neighbour_offset(i: u32) -> vec2<i32> {
+    let d = select(-1, 1, (i & 1u) != 0u);
+    return select(vec2<i32>(0, d), vec2<i32>(d, 0), i < 2u);
+}
+
+// Appends target pixel xy to the refine list, once.
+fn refine_later(xy: vec2<u32>) {
+    let pixels = u32(frame.target_size.x) * u32(frame.target_size.y);
+    let index = xy.y * u32(frame.target_size.x) + xy.x;
+    let bit = 1u << (index & 31u);
+    if (atomicOr(&work_rw.items[pixels + index / 32u], bit) & bit) != 0u {
+        return;
     }
+    let k = atomicAdd(&work_rw.count, 1u);
+    atomicStore(&work_rw.items[k], xy.x | (xy.y << 16u));
+    let size = list_size(k, 64u);
+    atomicMax(&work_rw.x, size.x);
+    atomicMax(&work_rw.y, size.y);
 }
 
 @compute @workgroup_size(8, 8)
@@ -247,25 +278,39 @@ fn tile_main(@builtin(local_invocation_id) local: vec3<u32>, @builtin(workgroup_
         let at = vec2<u32>(tile & 0xffffu, tile >> 16u) * 8u + local.xy;
         let xy = at + vec2<u32>(frame.output_offset);
         let raster = textureLoad(ids, xy, 0).xy;
-        let foreground = raster.x < HOST_ID;
+        // Background pixels were finished by classify_main.
+        let foreground = all(vec2<f32>(at) < frame.output_size) && raster.x < HOST_ID;
         // Memory reads are skipped for masked lanes, so background lanes do not sample.
         var s = no_sample(raster.x);
         if foreground {
             s = sample(raster.x, raster.y, pixel_centre(xy));
         }
         let certain = foreground && s.covers && s.margin >= COVERAGE_MARGIN;
-        // Background pixels of a listed tile with no foreground next to them were finished
-        // by classify_main.
-        let pending = all(vec2<f32>(at) < frame.output_size) && (foreground || foreground_next_to(xy));
-        if pending && certain {
+        if certain {
             store_pixel(xy, surface_pixel(xy, s));
         }
-        if pending && !certain {
-            let k = atomicAdd(&work_rw.count, 1u);
-            work_rw.items[k] = xy.x | (xy.y << 16u);
-            let size = list_size(k, 64u);
-            atomicMax(&work_rw.x, size.x);
-            atomicMax(&work_rw.y, size.y);
+        // Pixels for refine_main: bit 4 this one, where the exact test could not decide it;
+        // bits 0-3 the background next to it (left, right, up, down), which may hold a
+        // triangle the rasterizer missed. The targets are the output, with no band around
+        // it, so every foreground neighbour of an output pixel is one of a listed tile's.
+        let q = vec2<i32>(xy);
+        let first = vec2<i32>(frame.output_offset);
+        let last = vec2<i32>(frame.output_offset + frame.output_size) - 1;
+        var pending = select(0u, 16u, foreground && !certain);
+        for (var i = 0u; i < 4u; i++) {
+            let n = q + neighbour_offset(i);
+            if all(n >= first) && all(n <= last) && id_at(n).x >= HOST_ID {
+                pending |= 1u << i;
+            }
+        }
+        if !foreground {
+            pending = 0u;
+        }
+        // A loop ends once no lane has work left, so tiles without any cost nearly nothing.
+        while pending != 0u {
+            let i = firstTrailingBit(pending);
+            pending &= pending - 1u;
+            refine_later(vec2<u32>(q + select(neighbour_offset(i), vec2<i32>(0), i == 4u)));
         }
     }
 }
@@ -276,7 +321,7 @@ fn finish(xy: vec2<u32>, s: Sample) -> Pixel {
     if s.inst < HOST_ID {
         return surface_pixel(xy, s);
     }
-    return empty_pixel(xy, s.inst);
+    return empty_pixel(xy, s.inst, true);
 }
 
 // The triangle whose surface the centre of target pixel `xy` sees, for a pixel `edge_main`

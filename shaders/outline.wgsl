@@ -21,6 +21,9 @@
 
 @group(0) @binding(9) var<storage, read> clusters: array<Cluster>;
 @group(0) @binding(11) var<storage, read_write> acc_rw: array<atomic<u32>>;
+// Per 8×8 output tile, the stamp of the last frame whose outline lines may reach it: the
+// edge pass reads `acc` for the background only in tiles marked for its own frame.
+@group(0) @binding(26) var outline_tiles_rw: texture_storage_2d<r32uint, write>;
 
 // The (instance, cluster) pairs that `outline_cull` finds may hold an outline edge, and the
 // indirect dispatch size for visiting them; starts as (0, 1, 1, 0).
@@ -360,6 +363,9 @@ fn draw_piece(seg: Segment, k0: f32, k1: f32, length_px: f32) {
     let band = reach * 1.4142135 + 1.0;
     let first_m = max(i32(floor(min(q0[major], q1[major]) - reach - origin[major])), 0);
     let last_m = min(i32(ceil(max(q0[major], q1[major]) + reach - origin[major])), last[major]);
+    let first_o = max(i32(floor(min(q0[minor], q1[minor]) - band - origin[minor])), 0);
+    let last_o = min(i32(ceil(max(q0[minor], q1[minor]) + band - origin[minor])), last[minor]);
+    mark_outline_tiles(first_m, last_m, first_o, last_o, major);
     for (var m = first_m; m <= last_m; m++) {
         var f = 0.0;
         if span[major] != 0.0 {
@@ -408,6 +414,26 @@ fn draw_piece(seg: Segment, k0: f32, k1: f32, length_px: f32) {
 #else
             atomicMax(&acc_rw[index], key);
 #endif
+        }
+    }
+}
+
+// Marks the output tiles that pixels [first_m, last_m] along axis `major` and
+// [first_o, last_o] across it (target pixels) fall in.
+fn mark_outline_tiles(first_m: i32, last_m: i32, first_o: i32, last_o: i32, major: u32) {
+    var lo = vec2<i32>(first_m, first_o);
+    var hi = vec2<i32>(last_m, last_o);
+    if major == 1u {
+        lo = lo.yx;
+        hi = hi.yx;
+    }
+    let offset = vec2<i32>(frame.output_offset);
+    let tiles = vec2<i32>(textureDimensions(outline_tiles_rw)) - 1;
+    let t0 = clamp((lo - offset) / 8, vec2<i32>(0), tiles);
+    let t1 = clamp((hi - offset) / 8, vec2<i32>(0), tiles);
+    for (var y = t0.y; y <= t1.y; y++) {
+        for (var x = t0.x; x <= t1.x; x++) {
+            textureStore(outline_tiles_rw, vec2<i32>(x, y), vec4<u32>(frame.stamp));
         }
     }
 }

@@ -451,7 +451,11 @@ impl DeferredPass {
             r.extend_from_slice(&out);
             r
         };
-        let classify = Compute::new(device, &module, "classify_main", with(&[Res::TilesRw]), color)?;
+        let mut classify_res = vec![Res::TilesRw];
+        if v.outlines {
+            classify_res.push(Res::OutlineTiles);
+        }
+        let classify = Compute::new(device, &module, "classify_main", with(&classify_res), color)?;
         let tiles = Compute::new(
             device,
             &module,
@@ -507,7 +511,7 @@ impl DeferredPass {
             self.format,
         )?;
         let mut draw_res = store_resources(v.split, true, v.uniform_instances);
-        draw_res.extend([Res::Ids, Res::Cull, Res::AccRw]);
+        draw_res.extend([Res::Ids, Res::Cull, Res::AccRw, Res::OutlineTilesRw]);
         if v.host {
             draw_res.push(Res::HostDepth);
         }
@@ -632,6 +636,7 @@ impl DeferredPass {
             )?;
         }
         let ids = t.ids.create_view(&Default::default());
+        let outline_tiles = t.outline_tiles.create_view(&Default::default());
         let host_depth = t.host.as_ref().map(|h| h.create_view(&Default::default()));
         let (diag, resolved) = match &t.diagnostic {
             Some((d, r)) => (
@@ -647,6 +652,7 @@ impl DeferredPass {
             cull: Some(&frame.cull),
             work: Some(&t.work),
             tiles: Some(&t.tiles),
+            outline_tiles: Some(&outline_tiles),
             out_color,
             host_color,
             out_diagnostic: diag.as_ref(),
@@ -684,14 +690,41 @@ impl DeferredPass {
         let classify = edge.classify.bind(device, &sources)?;
         let tiles = edge.tiles.bind(device, &sources)?;
         let refine = edge.refine.bind(device, &sources)?;
+        encoder.clear_buffer(&t.tiles, 0, None);
         encoder.copy_buffer_to_buffer(&self.reset, 0, &t.tiles, 0, LIST_HEADER);
+        let marks = LIST_HEADER + 4 * u64::from(t.size.0) * u64::from(t.size.1);
+        encoder.clear_buffer(&t.work, marks, None);
         encoder.copy_buffer_to_buffer(&self.reset, 0, &t.work, 0, LIST_HEADER);
         // Each dispatch is a pass of its own, timed on its own (the benchmark sums the
         // `edge.*` spans into the edge pass).
-        let dispatches: [(&str, &str, &Compute, &wgpu::BindGroup, Option<&wgpu::Buffer>); 3] = [
-            ("wirepass edge classify", "edge.classify", &edge.classify, &classify, None),
-            ("wirepass edge tiles", "edge.tiles", &edge.tiles, &tiles, Some(&t.tiles)),
-            ("wirepass edge refine", "edge.refine", &edge.refine, &refine, Some(&t.work)),
+        let dispatches: [(
+            &str,
+            &str,
+            &Compute,
+            &wgpu::BindGroup,
+            Option<&wgpu::Buffer>,
+        ); 3] = [
+            (
+                "wirepass edge classify",
+                "edge.classify",
+                &edge.classify,
+                &classify,
+                None,
+            ),
+            (
+                "wirepass edge tiles",
+                "edge.tiles",
+                &edge.tiles,
+                &tiles,
+                Some(&t.tiles),
+            ),
+            (
+                "wirepass edge refine",
+                "edge.refine",
+                &edge.refine,
+                &refine,
+                Some(&t.work),
+            ),
         ];
         for (label, span, pipeline, group, indirect) in dispatches {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {

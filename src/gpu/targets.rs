@@ -26,6 +26,8 @@ pub const RESULT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 /// Size of the header (indirect dispatch size x, y, z, then a count) of the outline and
 /// refine lists.
 pub(crate) const LIST_HEADER: u64 = 16;
+/// Format of [`Targets::outline_tiles`].
+pub(crate) const OUTLINE_TILES_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 
 #[derive(Clone)]
 pub(crate) struct Targets {
@@ -42,6 +44,8 @@ pub(crate) struct Targets {
     pub work: wgpu::Buffer,
     /// The edge pass's list of 8×8 output tiles with work for its tile dispatch.
     pub tiles: wgpu::Buffer,
+    /// Per 8×8 output tile, the stamp of the last frame whose outline lines reach it.
+    pub outline_tiles: wgpu::Texture,
     pub result: Option<wgpu::Texture>,
     pub diagnostic: Option<(wgpu::Texture, wgpu::Texture)>,
     /// The host's depth, where the frame has one.
@@ -85,7 +89,8 @@ impl Targets {
                 limit: binding,
             });
         }
-        let work_bytes = LIST_HEADER + 4 * u64::from(spec.output.0) * u64::from(spec.output.1);
+        // The list, then a mark bit per target pixel.
+        let work_bytes = LIST_HEADER + 4 * pixels + 4 * pixels.div_ceil(32);
         if work_bytes > binding {
             return Err(Error::OverLimit {
                 what: format!(
@@ -98,7 +103,8 @@ impl Targets {
             });
         }
         let tiles = u64::from(spec.output.0.div_ceil(8)) * u64::from(spec.output.1.div_ceil(8));
-        let tiles_bytes = LIST_HEADER + 4 * tiles;
+        // The list, then a mark per tile.
+        let tiles_bytes = LIST_HEADER + 8 * tiles;
         use wgpu::TextureUsages as U;
         let texture =
             |label, size, format, usage| super::texture_2d(device, label, size, format, usage);
@@ -140,6 +146,12 @@ impl Targets {
                 "wirepass tile list",
                 tiles_bytes,
                 wgpu::BufferUsages::INDIRECT,
+            ),
+            outline_tiles: texture(
+                "wirepass outline tiles",
+                (spec.output.0.div_ceil(8), spec.output.1.div_ceil(8)),
+                OUTLINE_TILES_FORMAT,
+                U::STORAGE_BINDING | U::TEXTURE_BINDING,
             ),
             result: spec.result.then(|| {
                 texture(
