@@ -1,6 +1,7 @@
 // The deferred edge pass, after common.wgsl and scene.wgsl. Three dispatches, so that work
-// only some pixels need runs only for them (a software rasterizer runs both sides of every
-// branch and every memory access for all lanes):
+// only some pixels need runs only for them (a software rasterizer runs the arithmetic of
+// both sides of every branch, and a loop until its last lane is done; it skips only the
+// memory reads of masked lanes):
 //
 // `classify_main`, one invocation per output pixel: background and host pixels are finished
 // here (the outline pass's line, if any, over the background); the 8×8 tiles that hold
@@ -30,8 +31,7 @@
 #endif
 
 // The pixels `tile_main` leaves to `refine_main`, and the indirect dispatch size for them
-// (`list_size`).
-// After the list, one mark bit per target pixel (0 until the pixel is listed).
+// (`list_size`); after the list, one mark bit per target pixel (0 until it is listed).
 struct WorkList {
     x: atomic<u32>,
     y: atomic<u32>,
@@ -61,7 +61,6 @@ struct TileList {
 }
 @group(0) @binding(24) var<storage, read_write> tiles_rw: TileList;
 @group(0) @binding(25) var<storage, read> tiles: WorkListRead;
-
 
 #if MODE_SHADE
 @group(0) @binding(20) var out_color: texture_storage_2d<OUTPUT_FORMAT, write>;
@@ -324,7 +323,7 @@ fn finish(xy: vec2<u32>, s: Sample) -> Pixel {
     return empty_pixel(xy, s.inst, true);
 }
 
-// The triangle whose surface the centre of target pixel `xy` sees, for a pixel `edge_main`
+// The triangle whose surface the centre of target pixel `xy` sees, for a pixel `tile_main`
 // could not decide: the nearest of the triangles covering the centre among the rasterizer's
 // triangle, the 3×3 neighbourhood's, and those a walk from them reaches (the walk from the
 // neighbours only when the pixel itself is background). If none covers it, the pixel is

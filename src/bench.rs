@@ -59,6 +59,18 @@ pub struct Run {
     pub cpu: Stats,
     /// GPU memory the method allocates: mesh buffers and its targets.
     pub gpu_bytes: u64,
+    /// The deferred method's edge pass: share of output tiles the tile dispatch visited and
+    /// of pixels the refine dispatch decided, in the last frame.
+    pub edge_work: Option<EdgeShares>,
+}
+
+/// The deferred edge pass's later dispatches, as shares of the output.
+#[derive(Clone, Copy, Debug, serde::Serialize)]
+pub struct EdgeShares {
+    /// Tiles with foreground among all 8×8 output tiles.
+    pub tiles: f64,
+    /// Pixels refined among all output pixels.
+    pub refined: f64,
 }
 
 /// A method being measured: its pass, prepared frame and output.
@@ -240,6 +252,19 @@ pub fn bench_scene(
         }
     }
     let store_bytes = up.store.gpu_bytes();
+    let mut shares = Vec::new();
+    for subject in &subjects {
+        shares.push(match subject {
+            Subject::Deferred(_, frame, _) => {
+                let w = frame.edge_work(device, queue)?;
+                Some(EdgeShares {
+                    tiles: f64::from(w.tiles) / f64::from(w.all_tiles.max(1)),
+                    refined: f64::from(w.refined) / f64::from(w.pixels.max(1)),
+                })
+            }
+            _ => None,
+        });
+    }
     Ok(subjects
         .iter()
         .enumerate()
@@ -255,6 +280,7 @@ pub fn bench_scene(
             total_median_ms: Stats::of(&totals[i]).median_ms,
             cpu: Stats::of(&cpu[i]),
             gpu_bytes: store_bytes + subject.bytes(&lines),
+            edge_work: shares[i],
         })
         .collect())
 }
@@ -277,12 +303,19 @@ pub fn markdown(runs: &[Run]) -> String {
                 .map(|s| format!("{:.3}", s.median_ms))
                 .unwrap_or_else(|| "–".into())
         };
-        let other: Vec<_> = r
+        let mut other: Vec<_> = r
             .passes
             .iter()
             .filter(|(k, _)| k.as_str() != "visibility")
             .map(|(k, s)| format!("{k} {:.3}", s.median_ms))
             .collect();
+        if let Some(w) = r.edge_work {
+            other.push(format!(
+                "tiles {:.1} %, refined {:.2} % of pixels",
+                100.0 * w.tiles,
+                100.0 * w.refined
+            ));
+        }
         out += &format!(
             "| {} | {} | {}x{} | {} | {} | {} | {:.3} | {} | {:.1} |\n",
             r.scene,

@@ -457,3 +457,92 @@ fn vertex_pulling_fallback_matches_primitive_index() {
         "the fallback visibility pass must give the same ids"
     );
 }
+
+#[test]
+fn edge_work_lists_the_tiles_with_foreground_and_the_background_beside_it() {
+    let ctx = gpu();
+    let device = &ctx.device;
+    let mesh = load("suzanne.obj");
+    let size = (100, 70);
+    let cam = framing(&mesh, size);
+    let (store, scene) = single(&mesh, EdgeSelection::Polygon, cam.to_view(100.0 / 70.0));
+    let mut pass = DeferredPass::new(device, PassOptions::default())
+        .unwrap()
+        .with_diagnostics();
+    let frame = pass
+        .prepare(device, &store, &scene, &Style::default(), size)
+        .unwrap();
+    let mut encoder = device.create_command_encoder(&Default::default());
+    pass.encode(
+        device,
+        &mut encoder,
+        &store,
+        &frame,
+        OutputTarget::Diagnostic,
+    )
+    .unwrap();
+    ctx.queue.submit([encoder.finish()]);
+    let work = frame.edge_work(device, &ctx.queue).unwrap();
+    // What the rasterizer left, read back: foreground where the instance slot is valid.
+    let ids = wirepass::gpu::read_texture(
+        device,
+        &ctx.queue,
+        frame.id_texture(),
+        wgpu::TextureAspect::All,
+    )
+    .unwrap();
+    let (w, h) = (size.0 as i64, size.1 as i64);
+    let fg = |x: i64, y: i64| {
+        (0..w).contains(&x) && (0..h).contains(&y) && {
+            let i = ((y * w + x) * 8) as usize;
+            u32::from_le_bytes(ids[i..i + 4].try_into().unwrap()) < u32::MAX - 1
+        }
+    };
+    let tiles = (0..(h + 7) / 8)
+        .flat_map(|ty| (0..(w + 7) / 8).map(move |tx| (tx, ty)))
+        .filter(|&(tx, ty)| (0..64).any(|k| fg(tx * 8 + k % 8, ty * 8 + k / 8)))
+        .count() as u32;
+    let mut beside = 0;
+    let mut foreground = 0;
+    for y in 0..h {
+        for x in 0..w {
+            if fg(x, y) {
+                foreground += 1;
+            } else if fg(x - 1, y) || fg(x + 1, y) || fg(x, y - 1) || fg(x, y + 1) {
+                beside += 1;
+            }
+        }
+    }
+    assert_eq!(work.tiles, tiles, "{work:?}");
+    assert_eq!(work.all_tiles, 13 * 9);
+    assert_eq!(work.pixels, 7000);
+    assert!(tiles > 10 && beside > 50, "{tiles} tiles, {beside} beside");
+    // Every background pixel beside the foreground once, and the foreground the exact test
+    // could not settle: a few per cent of it at most.
+    assert!(
+        work.refined >= beside && work.refined <= beside + foreground / 20,
+        "{work:?}: {beside} background pixels beside {foreground} foreground"
+    );
+
+    // Looking away from the mesh: nothing for the later dispatches.
+    let away = Camera {
+        target: cam.eye + (cam.eye - cam.target),
+        ..cam
+    };
+    let (store, scene) = single(&mesh, EdgeSelection::Polygon, away.to_view(100.0 / 70.0));
+    let frame = pass
+        .prepare(device, &store, &scene, &Style::default(), size)
+        .unwrap();
+    let mut encoder = device.create_command_encoder(&Default::default());
+    pass.encode(
+        device,
+        &mut encoder,
+        &store,
+        &frame,
+        OutputTarget::Diagnostic,
+    )
+    .unwrap();
+    ctx.queue.submit([encoder.finish()]);
+    let work = frame.edge_work(device, &ctx.queue).unwrap();
+    assert_eq!((work.tiles, work.refined), (0, 0), "{work:?}");
+}

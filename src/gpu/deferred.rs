@@ -118,7 +118,39 @@ pub struct PreparedFrame {
     encoded: AtomicU64,
 }
 
+/// How much of a frame the edge pass's later dispatches took on (see
+/// [`PreparedFrame::edge_work`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct EdgeWork {
+    /// 8×8 output tiles holding foreground, which the tile dispatch visited.
+    pub tiles: u32,
+    /// Output tiles in all.
+    pub all_tiles: u32,
+    /// Pixels the refine dispatch decided: centres the exact test could not settle from the
+    /// rasterizer's triangle, and background next to foreground.
+    pub refined: u32,
+    /// Output pixels in all.
+    pub pixels: u32,
+}
+
 impl PreparedFrame {
+    /// What the edge pass's tile and refine dispatches took on in the last encode of this
+    /// frame, read back from the GPU (it waits for the work submitted so far): for tools and
+    /// benchmarks.
+    pub fn edge_work(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<EdgeWork> {
+        let count = |buffer: &wgpu::Buffer| -> Result<u32> {
+            let bytes = super::readback::read_buffer(device, queue, buffer, 12, 4)?;
+            Ok(u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]))
+        };
+        let (w, h) = self.targets.output;
+        Ok(EdgeWork {
+            tiles: count(&self.targets.tiles)?,
+            all_tiles: w.div_ceil(TILE) * h.div_ceil(TILE),
+            refined: count(&self.targets.work)?,
+            pixels: w * h,
+        })
+    }
+
     /// The output size.
     pub fn output_size(&self) -> (u32, u32) {
         self.targets.output

@@ -355,7 +355,7 @@ impl FrameData {
         // binding needs the whole declared array.
         let uniform_bytes = u64::from(UNIFORM_INSTANCE_CAPACITY) * INSTANCE_BYTES;
         let uniform_instances = records.len() as u64 <= u64::from(UNIFORM_INSTANCE_CAPACITY)
-            && u64::from(device.limits().max_uniform_buffer_binding_size) >= uniform_bytes;
+            && device.limits().max_uniform_buffer_binding_size >= uniform_bytes;
         let mut contents: Vec<u8> = bytemuck::cast_slice(&records).to_vec();
         let least = if uniform_instances {
             uniform_bytes

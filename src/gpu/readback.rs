@@ -43,6 +43,38 @@ pub fn read_texture(
         texture.size(),
     );
     queue.submit([encoder.finish()]);
+    let bytes = map_read(device, &buffer)?;
+    let mut out = Vec::with_capacity((row * height) as usize);
+    for y in 0..height as usize {
+        let start = y * padded as usize;
+        out.extend_from_slice(&bytes[start..start + row as usize]);
+    }
+    Ok(out)
+}
+
+/// Reads `size` bytes of `buffer` from `offset` (both multiples of 4), once the work
+/// submitted before has finished.
+pub(crate) fn read_buffer(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    buffer: &wgpu::Buffer,
+    offset: u64,
+    size: u64,
+) -> Result<Vec<u8>> {
+    let staging = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("wirepass readback"),
+        size,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut encoder = device.create_command_encoder(&Default::default());
+    encoder.copy_buffer_to_buffer(buffer, offset, &staging, 0, size);
+    queue.submit([encoder.finish()]);
+    map_read(device, &staging)
+}
+
+/// Maps a MAP_READ buffer, waits for it, and copies it out.
+fn map_read(device: &wgpu::Device, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
     let (tx, rx) = std::sync::mpsc::channel();
     buffer.map_async(wgpu::MapMode::Read, .., move |r| {
         let _ = tx.send(r);
@@ -56,11 +88,7 @@ pub fn read_texture(
     let view = buffer
         .get_mapped_range(..)
         .map_err(|e| Error::Device(format!("reading a readback buffer: {e}")))?;
-    let mut out = Vec::with_capacity((row * height) as usize);
-    for y in 0..height as usize {
-        let start = y * padded as usize;
-        out.extend_from_slice(&view[start..start + row as usize]);
-    }
+    let out = view.to_vec();
     drop(view);
     buffer.unmap();
     Ok(out)

@@ -137,15 +137,16 @@ impl Targets {
                 wgpu::BufferUsages::empty(),
             ),
             acc_colors: spec.acc_colors,
+            // Read back by PreparedFrame::edge_work.
             work: buffer(
                 "wirepass refine list",
                 work_bytes,
-                wgpu::BufferUsages::INDIRECT,
+                wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_SRC,
             ),
             tiles: buffer(
                 "wirepass tile list",
                 tiles_bytes,
-                wgpu::BufferUsages::INDIRECT,
+                wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_SRC,
             ),
             outline_tiles: texture(
                 "wirepass outline tiles",
