@@ -27,7 +27,7 @@ fn list_size(k: u32, per: u32) -> vec2<u32> {
     return vec2<u32>(min(group + 1u, LIST_WIDTH), group / LIST_WIDTH + 1u);
 }
 
-// The list index of workgroup `group` of an indirect dispatch made by `append`.
+// The list index of workgroup `group` of an indirect dispatch sized by `list_size`.
 fn list_group(group: vec3<u32>) -> u32 {
     return group.y * LIST_WIDTH + group.x;
 }
@@ -41,6 +41,7 @@ fn slot(i: u32) -> u32 {
     return i;
 #endif
 }
+
 // Per vertex: local position (xyz) and the packed normal's bits (w).
 @group(0) @binding(2) var<storage, read> vertices: array<vec4<f32>>;
 #if SPLIT
@@ -257,10 +258,11 @@ const WALK_STEPS: u32 = 24u;
 // the owner (a sub-pixel triangle, say) has no rasterized pixel of its own. The walk stays
 // within the instance. With 0 steps it is the sample of `tri` itself. With `stop_at_fold`
 // it also ends where it would cross a silhouette (the next triangle faces the eye the other
-// way than the last one that faced it either way): the triangle beyond a silhouette edge lies on screen on this side of the edge, so it
-// cannot cover a point beyond it, and the walk would only wander over the surface's far side
-// (a walk from the mesh towards a background point does that for all its steps). One
-// `sample` in one loop, so a shader holds one copy of it.
+// way than the last one that faced it either way): the triangle beyond a silhouette edge
+// lies on screen on this side of the edge, so it cannot cover a point beyond it, and the
+// walk would only wander over the surface's far side (a walk from the mesh towards a
+// background point does that for all its steps). One `sample` in one loop, so a shader
+// holds one copy of it.
 fn locate(inst: u32, tri: u32, point: vec2<f32>, steps: u32, stop_at_fold: bool) -> Sample {
     var t = tri;
     var s: Sample;
