@@ -30,37 +30,31 @@
 @group(0) @binding(27) var outline_tiles: texture_2d<u32>;
 #endif
 
-// The pixels `tile_main` leaves to `refine_main`, and the indirect dispatch size for them
-// (`list_size`); after the list, one mark bit per target pixel (0 until it is listed).
-struct WorkList {
+// A list one dispatch appends to and the next is dispatched over: the indirect dispatch
+// size (`list_size`), the count, the items, then marks of what is listed (0 until it is).
+struct List {
     x: atomic<u32>,
     y: atomic<u32>,
     z: u32,
     count: atomic<u32>,
     items: array<atomic<u32>>,
 }
-@group(0) @binding(15) var<storage, read_write> work_rw: WorkList;
 
-struct WorkListRead {
+struct ListRead {
     x: u32,
     y: u32,
     z: u32,
     count: u32,
     items: array<u32>,
 }
-@group(0) @binding(16) var<storage, read> work: WorkListRead;
 
-// The tiles `classify_main` leaves to `tile_main`, and the indirect dispatch size for them;
-// after the list, one mark per tile of the output (0 until the tile is listed).
-struct TileList {
-    x: atomic<u32>,
-    y: atomic<u32>,
-    z: u32,
-    count: atomic<u32>,
-    items: array<atomic<u32>>,
-}
-@group(0) @binding(24) var<storage, read_write> tiles_rw: TileList;
-@group(0) @binding(25) var<storage, read> tiles: WorkListRead;
+// The pixels `tile_main` leaves to `refine_main`, with a mark bit per target pixel.
+@group(0) @binding(15) var<storage, read_write> work_rw: List;
+@group(0) @binding(16) var<storage, read> work: ListRead;
+
+// The tiles `classify_main` leaves to `tile_main`, with a mark per output tile.
+@group(0) @binding(24) var<storage, read_write> tiles_rw: List;
+@group(0) @binding(25) var<storage, read> tiles: ListRead;
 
 #if MODE_SHADE
 @group(0) @binding(20) var out_color: texture_storage_2d<OUTPUT_FORMAT, write>;

@@ -469,20 +469,24 @@ fn edge_work_lists_the_tiles_with_foreground_and_the_background_beside_it() {
     let mut pass = DeferredPass::new(device, PassOptions::default())
         .unwrap()
         .with_diagnostics();
-    let frame = pass
-        .prepare(device, &store, &scene, &Style::default(), size)
+    let mut draw = |store: &MeshStore, scene: &Scene<'_>| {
+        let frame = pass
+            .prepare(device, store, scene, &Style::default(), size)
+            .unwrap();
+        let mut encoder = device.create_command_encoder(&Default::default());
+        pass.encode(
+            device,
+            &mut encoder,
+            store,
+            &frame,
+            OutputTarget::Diagnostic,
+        )
         .unwrap();
-    let mut encoder = device.create_command_encoder(&Default::default());
-    pass.encode(
-        device,
-        &mut encoder,
-        &store,
-        &frame,
-        OutputTarget::Diagnostic,
-    )
-    .unwrap();
-    ctx.queue.submit([encoder.finish()]);
-    let work = frame.edge_work(device, &ctx.queue).unwrap();
+        ctx.queue.submit([encoder.finish()]);
+        let work = frame.edge_work(device, &ctx.queue).unwrap();
+        (frame, work)
+    };
+    let (frame, work) = draw(&store, &scene);
     // What the rasterizer left, read back: foreground where the instance slot is valid.
     let ids = wirepass::gpu::read_texture(
         device,
@@ -530,19 +534,6 @@ fn edge_work_lists_the_tiles_with_foreground_and_the_background_beside_it() {
         ..cam
     };
     let (store, scene) = single(&mesh, EdgeSelection::Polygon, away.to_view(100.0 / 70.0));
-    let frame = pass
-        .prepare(device, &store, &scene, &Style::default(), size)
-        .unwrap();
-    let mut encoder = device.create_command_encoder(&Default::default());
-    pass.encode(
-        device,
-        &mut encoder,
-        &store,
-        &frame,
-        OutputTarget::Diagnostic,
-    )
-    .unwrap();
-    ctx.queue.submit([encoder.finish()]);
-    let work = frame.edge_work(device, &ctx.queue).unwrap();
+    let (_, work) = draw(&store, &scene);
     assert_eq!((work.tiles, work.refined), (0, 0), "{work:?}");
 }
