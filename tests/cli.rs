@@ -88,7 +88,8 @@ fn bad_settings_give_one_clear_line() {
         (&["render", "--wire-color", "red", "-o", o], "colour"),
         (&["render", "--eye", "1,2", "-o", o], "x,y,z"),
         (&["render", "sphere:2", "-o", o], "sphere"),
-        (&["render", "cube:10", "-o", o], "procedural"),
+        (&["render", "box:10", "-o", o], "procedural"),
+        (&["render", "cube:10", "-o", o], "needs 12"),
         (
             &["render", "/no/such/mesh.obj", "-o", o],
             "/no/such/mesh.obj",

@@ -16,7 +16,7 @@ const MAX_TRIANGLES: usize = 200_000_000;
 const MAJOR_RADIUS: f64 = 1.0;
 const MINOR_RADIUS: f64 = 0.35;
 
-/// A procedural mesh named on the command line as `sphere:N`, `grid:N` or `torus:N`, where
+/// A procedural mesh named on the command line as `sphere:N`, `grid:N`, `torus:N` or `cube:N`, where
 /// `N` is the approximate triangle count.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Procedural {
@@ -28,6 +28,8 @@ pub enum Procedural {
     Torus(usize),
     /// [`layers`]: this many parallel grids one behind the other (depth complexity).
     Layers(usize),
+    /// [`cube`] with about this many triangles.
+    Cube(usize),
 }
 
 /// Triangles in each grid of [`layers`] (8 × 8 quads).
@@ -41,13 +43,17 @@ impl Procedural {
             Procedural::Grid(n) => grid(n),
             Procedural::Torus(n) => torus(n),
             Procedural::Layers(k) => layers(k),
+            Procedural::Cube(n) => cube(n),
         }
     }
 
     /// The requested triangle count; the mesh has about this many.
     pub fn triangle_target(&self) -> usize {
         match *self {
-            Procedural::Sphere(n) | Procedural::Grid(n) | Procedural::Torus(n) => n,
+            Procedural::Sphere(n)
+            | Procedural::Grid(n)
+            | Procedural::Torus(n)
+            | Procedural::Cube(n) => n,
             Procedural::Layers(k) => k.saturating_mul(LAYER_TRIANGLES),
         }
     }
@@ -58,7 +64,8 @@ impl Procedural {
             Procedural::Sphere(n)
             | Procedural::Grid(n)
             | Procedural::Torus(n)
-            | Procedural::Layers(n) => n,
+            | Procedural::Layers(n)
+            | Procedural::Cube(n) => n,
         }
     }
 
@@ -68,6 +75,7 @@ impl Procedural {
             Procedural::Grid(_) => "grid",
             Procedural::Torus(_) => "torus",
             Procedural::Layers(_) => "layers",
+            Procedural::Cube(_) => "cube",
         }
     }
 
@@ -78,6 +86,7 @@ impl Procedural {
             Procedural::Grid(_) => 2,
             Procedural::Torus(_) => 18,
             Procedural::Layers(_) => LAYER_TRIANGLES,
+            Procedural::Cube(_) => 12,
         }
     }
 
@@ -102,14 +111,14 @@ impl fmt::Display for Procedural {
 impl FromStr for Procedural {
     type Err = Error;
 
-    /// Parses `sphere:N`, `grid:N`, `torus:N` (N triangles) or `layers:K` (K layers); the
+    /// Parses `sphere:N`, `grid:N`, `torus:N`, `cube:N` (N triangles) or `layers:K` (K layers); the
     /// number may use `_` separators and a `k` (thousand) or `M` (million) suffix, as in
     /// `sphere:20M` or `grid:1_000`.
     fn from_str(s: &str) -> Result<Self> {
         let bad = || {
             Error::InvalidSetting(format!(
-                "'{s}' is not a procedural mesh; expected sphere:N, grid:N or torus:N with N \
-                 a triangle count such as 5000, 20_000, 50k or 20M, or layers:K"
+                "'{s}' is not a procedural mesh; expected sphere:N, grid:N, torus:N or cube:N with \
+                 N a triangle count such as 5000, 20_000, 50k or 20M, or layers:K"
             ))
         };
         let (shape, count) = s.trim().split_once(':').ok_or_else(bad)?;
@@ -119,6 +128,7 @@ impl FromStr for Procedural {
             "grid" => Procedural::Grid(n),
             "torus" => Procedural::Torus(n),
             "layers" => Procedural::Layers(n),
+            "cube" => Procedural::Cube(n),
             _ => return Err(bad()),
         };
         p.check()?;
@@ -173,6 +183,40 @@ pub fn grid(n: usize) -> Result<Mesh> {
     for j in 0..k {
         for i in 0..k {
             parts.quad([v(i, j), v(i + 1, j), v(i + 1, j + 1), v(i, j + 1)]);
+        }
+    }
+    parts.into_mesh()
+}
+
+/// The cube [-1, 1]³ with each face a `k × k` grid of square quads (diagonals masked), `12k²`
+/// triangles as close to `n` as possible, flat normals: a tessellated CAD part, whose
+/// feature edges are its 12 creases, each made of many small triangles' edges.
+pub fn cube(n: usize) -> Result<Mesh> {
+    Procedural::Cube(n).check()?;
+    let k = ((n as f64 / 12.0).sqrt().round() as usize).max(1);
+    let mut parts = Parts::with_capacity(6 * (k + 1) * (k + 1), 12 * k * k);
+    for axis in 0..3 {
+        for sign in [-1.0f32, 1.0] {
+            // Face normal along `axis`; (u, v, normal) right-handed, so quads face outwards.
+            let mut normal = Vec3::ZERO;
+            normal[axis] = sign;
+            let (mut u, mut v) = (Vec3::ZERO, Vec3::ZERO);
+            u[(axis + 1) % 3] = 1.0;
+            v[(axis + 2) % 3] = sign;
+            let base = parts.positions.len() as u32;
+            for j in 0..=k {
+                for i in 0..=k {
+                    let a = (2.0 * i as f64 / k as f64 - 1.0) as f32;
+                    let b = (2.0 * j as f64 / k as f64 - 1.0) as f32;
+                    parts.vertex(normal + u * a + v * b, normal);
+                }
+            }
+            let at = |i: usize, j: usize| base + (j * (k + 1) + i) as u32;
+            for j in 0..k {
+                for i in 0..k {
+                    parts.quad([at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)]);
+                }
+            }
         }
     }
     parts.into_mesh()
@@ -496,6 +540,26 @@ mod tests {
     }
 
     #[test]
+    fn a_cube_is_closed_and_its_creases_are_its_feature_edges() {
+        let mesh = cube(12 * 16).unwrap();
+        assert_eq!(mesh.triangle_count(), 12 * 16);
+        assert!(mesh
+            .edge_neighbours()
+            .iter()
+            .flatten()
+            .all(|&n| n != crate::mesh::adjacency::NO_NEIGHBOUR));
+        let drawn = |edges| -> u32 { mesh.edge_mask(edges).iter().map(|b| b.count_ones()).sum() };
+        // 12 creases of 4 segments, each drawn from both sides.
+        assert_eq!(drawn(crate::mesh::EdgeSelection::Feature(30.0)), 12 * 4 * 2);
+        assert_eq!(drawn(crate::mesh::EdgeSelection::Polygon), 2 * 12 * 16);
+        // Faces wind outwards: each face normal points away from the centre.
+        for t in mesh.triangles() {
+            let [a, b, c] = t.map(|v| mesh.positions()[v as usize]);
+            assert!((b - a).cross(c - a).dot(a + b + c) > 0.0);
+        }
+    }
+
+    #[test]
     fn parses_procedural_names() {
         let ok = [
             ("sphere:20M", Procedural::Sphere(20_000_000)),
@@ -503,6 +567,7 @@ mod tests {
             ("torus:50k", Procedural::Torus(50_000)),
             (" Sphere:1_5K ", Procedural::Sphere(15_000)),
             ("layers:16", Procedural::Layers(16)),
+            ("cube:2M", Procedural::Cube(2_000_000)),
         ];
         for (s, p) in ok {
             assert_eq!(s.parse::<Procedural>().unwrap(), p, "{s}");
@@ -513,7 +578,8 @@ mod tests {
             "",
             "sphere",
             "sphere:",
-            "cube:100",
+            "box:100",
+            "cube:11",
             "sphere:-5",
             "sphere:1.5M",
             "sphere:12q",
@@ -529,8 +595,8 @@ mod tests {
             let e = s.parse::<Procedural>().unwrap_err();
             assert!(matches!(e, Error::InvalidSetting(_)), "{s}: {e:?}");
         }
-        let e = "cube:100".parse::<Procedural>().unwrap_err().to_string();
-        assert!(e.contains("sphere:N, grid:N or torus:N"), "{e}");
+        let e = "box:100".parse::<Procedural>().unwrap_err().to_string();
+        assert!(e.contains("sphere:N, grid:N, torus:N or cube:N"), "{e}");
         assert!(sphere(7).is_err() && grid(1).is_err() && torus(17).is_err());
         assert!(sphere(8).is_ok() && grid(2).is_ok() && torus(18).is_ok());
     }
