@@ -8,9 +8,11 @@ use crate::gpu::{
     texture_2d, DeferredPass, EdgeLines, ForwardPass, GpuContext, GpuTimer, MeshStore,
     OutputTarget, PassOptions, PreparedFrame, RasterFrame, TwoPass,
 };
+use crate::mesh::EdgeSelection;
 use crate::render::{Shot, Uploaded, World};
 use crate::style::Style;
 use std::collections::BTreeMap;
+use std::sync::Arc;
 use std::time::Instant;
 
 /// Median and spread of one timed quantity, in milliseconds.
@@ -77,17 +79,26 @@ pub struct EdgeShares {
 enum Subject {
     Floor(DeferredPass, PreparedFrame, wgpu::Texture),
     Deferred(DeferredPass, PreparedFrame, wgpu::Texture),
+    /// The deferred method drawing another edge selection, on its own upload of the scene.
+    Edges(
+        EdgeSelection,
+        Box<Uploaded>,
+        DeferredPass,
+        PreparedFrame,
+        wgpu::Texture,
+    ),
     Forward(ForwardPass, RasterFrame, wgpu::Texture),
     TwoPass(TwoPass, RasterFrame, wgpu::Texture),
 }
 
 impl Subject {
-    fn name(&self) -> &'static str {
+    fn name(&self) -> String {
         match self {
-            Subject::Floor(..) => "floor",
-            Subject::Deferred(..) => "deferred",
-            Subject::Forward(..) => "forward",
-            Subject::TwoPass(..) => "two-pass",
+            Subject::Floor(..) => "floor".into(),
+            Subject::Deferred(..) => "deferred".into(),
+            Subject::Edges(edges, ..) => format!("deferred {}", edges_name(*edges)),
+            Subject::Forward(..) => "forward".into(),
+            Subject::TwoPass(..) => "two-pass".into(),
         }
     }
 
@@ -109,6 +120,11 @@ impl Subject {
                 let target = OutputTarget::Shaded(&view);
                 pass.encode_timed(device, encoder, store, frame, target, timer)
             }
+            Subject::Edges(_, up, pass, frame, out) => {
+                let view = out.create_view(&Default::default());
+                let target = OutputTarget::Shaded(&view);
+                pass.encode_timed(device, encoder, &up.store, frame, target, timer)
+            }
             Subject::Forward(pass, frame, out) => {
                 let view = out.create_view(&Default::default());
                 pass.encode_timed(device, encoder, store, frame, &view, timer)
@@ -126,6 +142,7 @@ impl Subject {
         let forward = |t: &wgpu::Texture| 4 * texture(t);
         match self {
             Subject::Floor(p, _, t) | Subject::Deferred(p, _, t) => p.target_bytes() + texture(t),
+            Subject::Edges(_, up, p, _, t) => up.store.gpu_bytes() + p.target_bytes() + texture(t),
             Subject::Forward(_, _, t) => forward(t),
             Subject::TwoPass(_, _, t) => forward(t) + lines.gpu_bytes(),
         }
@@ -133,12 +150,15 @@ impl Subject {
 }
 
 /// How many frames a benchmark times, after how many untimed ones.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct Timing {
     /// Timed frames.
     pub frames: u32,
     /// Untimed frames first.
     pub warmup: u32,
+    /// Edge selections the deferred method also draws, each timed beside the world's own
+    /// (method `deferred edges=…`), so the cost of masked edges shows in one run.
+    pub edges: Vec<EdgeSelection>,
 }
 
 /// Times every method on `world` at `size`, with the framing camera and `style`: see
@@ -168,8 +188,13 @@ pub fn bench_scene(
     ctx: &GpuContext,
     name: &str,
     shot: &Shot<'_>,
-    Timing { frames, warmup }: Timing,
+    timing: Timing,
 ) -> Result<Vec<Run>> {
+    let Timing {
+        frames,
+        warmup,
+        edges,
+    } = timing;
     if frames == 0 {
         return Err(Error::InvalidSetting("--frames must be at least 1".into()));
     }
@@ -213,6 +238,19 @@ pub fn bench_scene(
             Subject::Deferred(pass, frame, storage())
         });
     }
+    for &selection in &edges {
+        let mut world = shot.world.clone();
+        for m in &mut world.meshes {
+            let (mesh, e) = (*m.mesh).clone().resolve_edges(Some(selection));
+            m.mesh = Arc::new(mesh);
+            m.edges = e;
+        }
+        let up = Box::new(Uploaded::new(ctx, &world)?);
+        let scene = up.scene(&world, shot.view);
+        let mut pass = DeferredPass::new(device, PassOptions::default())?;
+        let frame = pass.prepare(device, &up.store, &scene, shot.style, size)?;
+        subjects.push(Subject::Edges(selection, up, pass, frame, storage()));
+    }
     let mut forward = ForwardPass::new(device, forward_options)?;
     let frame = forward.prepare(device, &up.store, &scene, shot.style, size)?;
     subjects.push(Subject::Forward(forward, frame, attachment()));
@@ -255,7 +293,7 @@ pub fn bench_scene(
     let mut shares = Vec::new();
     for subject in &subjects {
         shares.push(match subject {
-            Subject::Deferred(_, frame, _) => {
+            Subject::Deferred(_, frame, _) | Subject::Edges(_, _, _, frame, _) => {
                 let w = frame.edge_work(device, queue)?;
                 Some(EdgeShares {
                     tiles: f64::from(w.tiles) / f64::from(w.all_tiles.max(1)),
@@ -272,7 +310,7 @@ pub fn bench_scene(
             scene: name.to_owned(),
             triangles: shot.world.triangle_count(),
             size: [size.0, size.1],
-            method: subject.name().to_owned(),
+            method: subject.name(),
             passes: gpu[i]
                 .iter()
                 .map(|(name, v)| (name.clone(), Stats::of(v)))
@@ -283,6 +321,58 @@ pub fn bench_scene(
             edge_work: shares[i],
         })
         .collect())
+}
+
+/// How an edge selection is named on the command line: `all`, `polygon`, `feature:30`.
+fn edges_name(e: EdgeSelection) -> String {
+    match e {
+        EdgeSelection::All => "edges=all".into(),
+        EdgeSelection::Polygon => "edges=polygon".into(),
+        EdgeSelection::Feature(d) => format!("edges=feature:{d}"),
+        EdgeSelection::Authored => "edges=authored".into(),
+    }
+}
+
+/// A markdown table of the deferred method's edge and outline passes under each edge
+/// selection timed (`Timing::edges`), relative to the world's own selection (`deferred`) of
+/// the same scene and size; empty when only one was timed.
+pub fn edges_markdown(runs: &[Run]) -> String {
+    let mut out = String::new();
+    let median = |r: &Run, name: &str| r.passes.get(name).map_or(0.0, |s| s.median_ms);
+    for base in runs.iter().filter(|r| r.method == "deferred") {
+        let others: Vec<&Run> = runs
+            .iter()
+            .filter(|r| {
+                r.scene == base.scene && r.size == base.size && r.method.starts_with("deferred ")
+            })
+            .collect();
+        if others.is_empty() {
+            continue;
+        }
+        if out.is_empty() {
+            out += "| scene | size | method | edge ms | ÷ deferred | edge + outline ms | ÷ deferred |\n\
+                    |---|---|---|---:|---:|---:|---:|\n";
+        }
+        let (edge, both) = (
+            median(base, "edge"),
+            median(base, "edge") + median(base, "outline"),
+        );
+        for r in std::iter::once(base).chain(others) {
+            let (e, b) = (median(r, "edge"), median(r, "edge") + median(r, "outline"));
+            out += &format!(
+                "| {} | {}x{} | {} | {:.3} | {:.2}× | {:.3} | {:.2}× |\n",
+                r.scene,
+                r.size[0],
+                r.size[1],
+                r.method,
+                e,
+                e / edge,
+                b,
+                b / both
+            );
+        }
+    }
+    out
 }
 
 /// A markdown table of runs, with each method's total relative to the deferred one of the

@@ -332,6 +332,7 @@ fn gpu_times(ctx: &GpuContext, shot: &Shot<'_>) -> (BTreeMap<String, f64>, Strin
     let timing = crate::bench::Timing {
         frames: TIMED_FRAMES,
         warmup: WARM_UP_FRAMES,
+        edges: Vec::new(),
     };
     match crate::bench::bench_scene(ctx, "compare", shot, timing) {
         Ok(runs) => (

@@ -255,6 +255,10 @@ struct BenchArgs {
     /// the forward baselines draw).
     #[arg(long, default_value = "on", value_parser = parse_switch, action = clap::ArgAction::Set)]
     silhouettes: bool,
+    /// Also time the deferred method drawing these edge selections, comma separated
+    /// (`polygon,feature:30`), each on its own upload, beside --edges in the same run.
+    #[arg(long, value_delimiter = ',', value_parser = parse_edges)]
+    compare_edges: Vec<EdgeSelection>,
 }
 
 fn bench_command(args: &BenchArgs) -> Result<()> {
@@ -296,6 +300,7 @@ fn bench_command(args: &BenchArgs) -> Result<()> {
             let timing = wirepass::bench::Timing {
                 frames: args.frames,
                 warmup: args.warmup,
+                edges: args.compare_edges.clone(),
             };
             runs.extend(wirepass::bench::bench(
                 &ctx, name, &world, size, &style, timing,
@@ -307,6 +312,10 @@ fn bench_command(args: &BenchArgs) -> Result<()> {
     let device = wirepass::bench::DeviceInfo::of(&ctx);
     println!("{}\n", device.describe());
     println!("{}", wirepass::bench::markdown(&runs));
+    let by_edges = wirepass::bench::edges_markdown(&runs);
+    if !by_edges.is_empty() {
+        println!("{by_edges}");
+    }
     wirepass::bench::write_outputs(&args.out, &device, &runs)?;
     eprintln!("wrote {}", args.out.display());
     Ok(())
