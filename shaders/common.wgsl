@@ -172,6 +172,42 @@ fn drawn_distances(raw: vec3<f32>, near: vec3<f32>, mask: u32) -> vec3<f32> {
     return select(raw, vec3<f32>(NO_EDGE), masked | hidden);
 }
 
+// Narrows [range.x, range.y] to the parameters s where f0 + s (f1 - f0) >= 0.
+fn keep_positive(range: vec2<f32>, f0: f32, f1: f32) -> vec2<f32> {
+    var r = range;
+    if f0 < 0.0 && f1 < 0.0 {
+        return vec2<f32>(1.0, 0.0);
+    }
+    if f0 < 0.0 {
+        r.x = max(r.x, f0 / (f0 - f1));
+    } else if f1 < 0.0 {
+        r.y = min(r.y, f0 / (f0 - f1));
+    }
+    return r;
+}
+
+// Twin of edge_math::segment_distance: pixels from `pixel` to the screen segment between the
+// clip-space points ca and cb, cut to its part in front of the near plane (NO_EDGE when none
+// is). Where the nearest point of a drawn edge need not lie between its ends (across
+// undrawn edges), the edge's line passes closer than the edge.
+fn segment_distance(ca: vec4<f32>, cb: vec4<f32>, pixel: vec2<f32>, size: vec2<f32>) -> f32 {
+    let s = keep_positive(vec2<f32>(0.0, 1.0), ca.z, cb.z);
+    if !(s.x <= s.y) {
+        return NO_EDGE;
+    }
+    let pa = pixel_relative(mix(ca, cb, s.x), pixel, size);
+    let pb = pixel_relative(mix(ca, cb, s.y), pixel, size);
+    let a = pa.xy / pa.z;
+    let ab = pb.xy / pb.z - a;
+    let len2 = dot(ab, ab);
+    var k = 0.0;
+    if len2 > 0.0 {
+        k = clamp(-dot(a, ab) / len2, 0.0, 1.0);
+    }
+    let d = length(a + k * ab);
+    return select(NO_EDGE, d, d == d);
+}
+
 // Distance from the origin (the pixel centre) to the screen line l, NO_EDGE when l is no line.
 fn line_distance(l: vec3<f32>) -> f32 {
     let len = length(l.xy);
@@ -262,11 +298,18 @@ struct Cluster {
     spread: f32,
 }
 
+// Whether the cluster holds drawn edges of a large patch, which the outline pass draws
+// whatever the eye: mesh_store::cluster_records stores its spread as -1 - spread.
+fn cluster_splats(c: Cluster) -> bool {
+    return c.spread < 0.0;
+}
+
 // Twin of clusters::may_fold: false when, seen from `eye`, no triangle of the cluster can have
 // an outline edge: every direction from the eye into the sphere (within β of its centre's)
 // makes an angle with every normal (within the spread of the axis) that stays off 90°. An
 // orthographic eye sees along one direction (β = 0).
 fn cluster_may_fold(c: Cluster, eye: vec4<f32>) -> bool {
+    let spread = select(c.spread, -1.0 - c.spread, cluster_splats(c));
     var d = -eye.xyz;
     var beta = 0.0;
     if eye.w != 0.0 {
@@ -278,7 +321,7 @@ fn cluster_may_fold(c: Cluster, eye: vec4<f32>) -> bool {
         beta = asin(c.radius / distance);
     }
     let gamma = atan2(length(cross(d, c.axis)), dot(d, c.axis));
-    let reach = beta + c.spread;
+    let reach = beta + spread;
     let quarter = 1.5707963;
     return !(gamma + reach < quarter || gamma - reach > quarter);
 }

@@ -17,7 +17,8 @@
 // `refine_main`, dispatched indirectly over that list only: the exact coverage search among
 // the neighbourhood's triangles and the walks across edges from them.
 //
-// Flags: OUTLINES (read what the outline pass left), COLORS (instances differ in line
+// Flags: OUTLINES (read what the outline pass left), PATCHES (some instance draws a mesh with
+// undrawn edges: a pixel near one searches its patch, `patch_distance`), COLORS (instances differ in line
 // colour: the outline pass also left which instance's line a pixel holds), HOST (the host's
 // depth seeded the targets: a triangle must also be nearer than it), and the output
 // mode: MODE_SHADE, MODE_OVERLAY, MODE_RESULT (with SHADED: surface and lines, else lines
@@ -132,6 +133,61 @@ fn empty_pixel(xy: vec2<u32>, inst: u32, outlined: bool) -> Pixel {
     return p;
 }
 
+#if PATCHES
+// Most triangles of a patch searched per pixel. Twin of patches::PATCH_TRIANGLES.
+const PATCH_TRIANGLES: u32 = 16u;
+// Bit of `info`: the triangle's patch is larger (its drawn edges come from the outline pass).
+const INFO_LARGE_PATCH: u32 = 2048u;
+
+// Twin of edge_math::patch_distance: pixels from `point` to the nearest drawn edge (as a
+// segment) of the patch around triangle `tri` of `inst`, the triangles reached from it
+// across undrawn edges that are not silhouettes, breadth first; of a large patch, its own
+// drawn edges only.
+fn patch_distance(inst: u32, tri: u32, point: vec2<f32>) -> f32 {
+    let base = instances[slot(inst)].triangle_base;
+    let vbase = instances[slot(inst)].vertex_base;
+    let clip = instances[slot(inst)].clip;
+    let eye = instances[slot(inst)].eye;
+    let large = (info[base + tri] & INFO_LARGE_PATCH) != 0u;
+    var queue: array<u32, PATCH_TRIANGLES>;
+    queue[0] = tri;
+    var count = 1u;
+    var best = NO_EDGE;
+    for (var k = 0u; k < count; k++) {
+        let t = queue[k];
+        let mask = info[base + t] & 7u;
+        let v = corners(base + t) + vbase;
+        let p = array<vec3<f32>, 3>(vertex_at(v.x).xyz, vertex_at(v.y).xyz, vertex_at(v.z).xyz);
+        let c = array<vec4<f32>, 3>(clip * vec4<f32>(p[0], 1.0), clip * vec4<f32>(p[1], 1.0), clip * vec4<f32>(p[2], 1.0));
+        for (var i = 0u; i < 3u; i++) {
+            let j = (i + 1u) % 3u;
+            if (mask & (1u << i)) != 0u {
+                best = min(best, segment_distance(c[i], c[j], point, frame.image_size));
+                continue;
+            }
+            if large || count >= PATCH_TRIANGLES {
+                continue;
+            }
+            let n = neighbour(base + t, i);
+            var seen = n == BACKGROUND_ID;
+            for (var q = 0u; q < count; q++) {
+                seen = seen || queue[q] == n;
+            }
+            if seen {
+                continue;
+            }
+            let w = corners(base + n) + vbase;
+            let d = (vertex_at(w.x).xyz + vertex_at(w.y).xyz + vertex_at(w.z).xyz) / 3.0;
+            if !is_silhouette(p[i], p[j], p[(i + 2u) % 3u], d, eye) {
+                queue[count] = n;
+                count++;
+            }
+        }
+    }
+    return best;
+}
+#endif
+
 // A pixel whose centre triangle `s` covers: the stronger of the triangle's own line and the
 // outline pass's colours it, equal ones going to the nearer.
 fn surface_pixel(xy: vec2<u32>, s: Sample) -> Pixel {
@@ -145,8 +201,16 @@ fn surface_pixel(xy: vec2<u32>, s: Sample) -> Pixel {
     if (flags & INSTANCE_EDGES) == 0u {
         mask = 0u;
     }
-    let d = drawn_distances(s.lines, vec3<f32>(s.clip0.z, s.clip1.z, s.clip2.z), mask);
-    let own = min(d.x, min(d.y, d.z));
+    let near = vec3<f32>(s.clip0.z, s.clip1.z, s.clip2.z);
+    let d = drawn_distances(s.lines, near, mask);
+    var own = min(d.x, min(d.y, d.z));
+#if PATCHES
+    // Where an undrawn edge is within the line's reach, the nearest line may lie beyond it.
+    let u = drawn_distances(s.lines, near, ~mask & 7u);
+    if (flags & INSTANCE_EDGES) != 0u && min(u.x, min(u.y, u.z)) < line_reach(instances[slot(inst)].line_width) {
+        own = patch_distance(inst, s.tri, pixel_centre(xy));
+    }
+#endif
     let b = s.bary;
     let local = b.x * s.v0.xyz + b.y * s.v1.xyz + b.z * s.v2.xyz;
     let view_depth = dot(instances[slot(inst)].fade_row, vec4<f32>(local, 1.0));
@@ -226,6 +290,20 @@ fn classify_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(workgro
 #endif
     if inside && empty {
         store_pixel(xy, empty_pixel(xy, raster, outlined));
+        // Background on the output's border next to foreground in the guard band, which no
+        // listed tile lists: it lists itself. Lanes away from the border never enter the
+        // loop, and a loop no lane enters costs nothing.
+        let q = vec2<i32>(xy);
+        let first = vec2<i32>(frame.output_offset);
+        let last = vec2<i32>(frame.output_offset + frame.output_size) - 1;
+        let border = any(q == first) || any(q == last);
+        for (var i = select(4u, 0u, border); i < 4u; i++) {
+            let n = q + neighbour_offset(i);
+            if (any(n < first) || any(n > last)) && id_at(n).x < HOST_ID {
+                refine_later(xy);
+                break;
+            }
+        }
     }
     // The first foreground pixel of a tile lists it: the tile's mark, after the list, is
     // cleared each frame (a workgroup barrier and vote would cost every tile).
@@ -283,9 +361,9 @@ fn tile_main(@builtin(local_invocation_id) local: vec3<u32>, @builtin(workgroup_
             store_pixel(xy, surface_pixel(xy, s));
         }
         // Pixels for refine_main: bit 4 this one, where the exact test could not decide it;
-        // bits 0-3 the background next to it (left, right, up, down), which may hold a
-        // triangle the rasterizer missed. The targets are the output, with no band around
-        // it, so every foreground neighbour of an output pixel is one of a listed tile's.
+        // bits 0-3 the background next to it (left, right, up, down) in the output, which
+        // may hold a triangle the rasterizer missed (classify_main lists the background
+        // next to foreground in the guard band).
         let q = vec2<i32>(xy);
         let first = vec2<i32>(frame.output_offset);
         let last = vec2<i32>(frame.output_offset + frame.output_size) - 1;

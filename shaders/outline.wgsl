@@ -10,11 +10,16 @@
 // `outline_cull` lists are visited, so the pass reads few triangles beyond those near an
 // outline. Definition (src/outline.rs implements it in f64 for the ground truth): pixel p is
 // at distance d from an outline when d is the distance from p's centre to the visible part of
-// the edge's projection (in front of the near plane, not beyond the far plane, inside the
-// targets, not hidden by another surface). No depth test at p is needed: a nearer surface
+// the edge's projection (in front of the near plane, not beyond the far plane, within the
+// line's reach of the image, not hidden by another surface; the targets' guard band holds
+// the ids of that reach). No depth test at p is needed: a nearer surface
 // between p and a farther edge has its own outline between them, which is nearer to p and
 // wins. Each pixel keeps the line that colours it most (the greatest key) by an atomic max,
 // so nothing is drawn twice.
+//
+// The drawn edges of large patches (the triangles joined across undrawn edges: see
+// src/mesh/patches.rs) are drawn here the same way, as the only lines their pixels get beyond
+// their own triangle's edges.
 //
 // Flags: COLORS (instances differ in line colour: each pixel also keeps the greatest
 // (intensity level, instance) pair, so the edge pass knows whose line it holds).
@@ -72,11 +77,12 @@ fn outline_cull(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
         return;
     }
     let inst = instance_of_cluster(f);
-    if (instances[slot(inst)].flags & INSTANCE_OUTLINES) == 0u {
-        return;
-    }
+    let flags = instances[slot(inst)].flags;
     let c = f - instances[slot(inst)].cluster_first;
-    if !cluster_may_fold(clusters[instances[slot(inst)].cluster_base + c], instances[slot(inst)].eye) {
+    let cluster = clusters[instances[slot(inst)].cluster_base + c];
+    let outlines = (flags & INSTANCE_OUTLINES) != 0u && cluster_may_fold(cluster, instances[slot(inst)].eye);
+    let splats = (flags & INSTANCE_EDGES) != 0u && cluster_splats(cluster);
+    if !outlines && !splats {
         return;
     }
     let k = atomicAdd(&cull_rw.count, 1u);
@@ -112,8 +118,12 @@ fn outline_triangle(inst: u32, t: u32) {
     // their neighboured edges can be a silhouette (Mesh::outline_hints), and they skip the
     // neighbours' vertices. The angle is taken from the triangle's farthest vertex, its least.
     let bits = info[base + t];
-    let boundary = (bits & 8u) != 0u;
-    let allowed = (bits >> 8u) & 7u;
+    let flags = instances[slot(inst)].flags;
+    let outlines = (flags & INSTANCE_OUTLINES) != 0u;
+    let boundary = outlines && (bits & 8u) != 0u;
+    let allowed = select(0u, (bits >> 8u) & 7u, outlines);
+    // Drawn edges of a large patch, drawn here like outlines (mesh_store::EdgeData).
+    let splat = select(0u, (bits >> 12u) & 7u, (flags & INSTANCE_EDGES) != 0u);
     // Decoded as adjacency::fold_bound: 0 flat, 2^(q - 14) with a margin, 15 never skip.
     let q = (bits >> 4u) & 15u;
     var fold_bound = exp2(f32(q) - 14.0) * 1.01 + 1e-6;
@@ -134,18 +144,18 @@ fn outline_triangle(inst: u32, t: u32) {
         // Seen along one direction: the angle to edge-on is the same from every vertex.
         may_fold = !(abs(dot(eye.xyz, normal)) > fold_bound * length(eye.xyz) * length(normal));
     }
-    if !may_fold && !boundary {
+    if !(may_fold && outlines) && !boundary && splat == 0u {
         return;
     }
     for (var i = 0u; i < 3u; i++) {
-        if (allowed & (1u << i)) == 0u {
+        if ((allowed | splat) & (1u << i)) == 0u {
             continue;
         }
         let n = neighbour(base + t, i);
         let a = p[i];
         let b = p[(i + 1u) % 3u];
-        var outline = n == BACKGROUND_ID;
-        if !outline && may_fold && t < n {
+        var outline = (splat & (1u << i)) != 0u || ((allowed & (1u << i)) != 0u && n == BACKGROUND_ID);
+        if !outline && (allowed & (1u << i)) != 0u && may_fold && t < n {
             // Shared edges are drawn by the lower id only.
             let w = corners(base + n) + vbase;
             let d = (vertex_at(w.x).xyz + vertex_at(w.y).xyz + vertex_at(w.z).xyz) / 3.0;
@@ -155,20 +165,6 @@ fn outline_triangle(inst: u32, t: u32) {
             draw_outline(inst, t, n, a, b);
         }
     }
-}
-
-// Narrows [range.x, range.y] to the parameters s where f0 + s (f1 - f0) >= 0.
-fn keep_positive(range: vec2<f32>, f0: f32, f1: f32) -> vec2<f32> {
-    var r = range;
-    if f0 < 0.0 && f1 < 0.0 {
-        return vec2<f32>(1.0, 0.0);
-    }
-    if f0 < 0.0 {
-        r.x = max(r.x, f0 / (f0 - f1));
-    } else if f1 < 0.0 {
-        r.y = min(r.y, f0 / (f0 - f1));
-    }
-    return r;
 }
 
 // Narrows [range.x, range.y] to the parameters u where lo <= p0 + u d <= hi.
@@ -251,10 +247,11 @@ fn draw_outline(inst: u32, t: u32, n: u32, a: vec3<f32>, b: vec3<f32>) {
     let fb = dot(fade_row, hb);
     let p0 = project(mix(ca, cb, s.x), mix(da, db, s.x), mix(fa, fb, s.x));
     let p1 = project(mix(ca, cb, s.y), mix(da, db, s.y), mix(fa, fb, s.y));
-    // Inside the targets.
+    // Inside the image and its guard band (not the targets: a tile then samples and bisects
+    // the same points as the whole image, and computes exactly what the whole image does).
     let d = p1.xy - p0.xy;
-    let lo = frame.target_origin;
-    let hi = frame.target_origin + frame.target_size;
+    let lo = -frame.output_offset;
+    let hi = frame.image_size + frame.output_offset;
     var u = keep_between(vec2<f32>(0.0, 1.0), p0.xy.x, d.x, lo.x, hi.x);
     u = keep_between(u, p0.xy.y, d.y, lo.y, hi.y);
     if !(u.x <= u.y) {
@@ -268,8 +265,18 @@ fn draw_outline(inst: u32, t: u32, n: u32, a: vec3<f32>, b: vec3<f32>) {
     seg.n = n;
     let length_px = length(seg.end.xy - seg.start.xy);
     let pieces = max(u32(ceil(length_px / PIECE_PX)), 1u);
+    // Pieces out of reach of the targets (of a tile) are skipped.
+    let reach = line_reach(instances[slot(inst)].line_width);
+    let first = frame.target_origin - reach;
+    let last = frame.target_origin + frame.target_size + reach;
     for (var piece = 0u; piece < pieces; piece++) {
-        draw_piece(seg, f32(piece) / f32(pieces), f32(piece + 1u) / f32(pieces), length_px);
+        let k0 = f32(piece) / f32(pieces);
+        let k1 = f32(piece + 1u) / f32(pieces);
+        let a = mix(seg.start.xy, seg.end.xy, k0);
+        let b = mix(seg.start.xy, seg.end.xy, k1);
+        if all(max(a, b) >= first) && all(min(a, b) <= last) {
+            draw_piece(seg, k0, k1, length_px);
+        }
     }
 }
 

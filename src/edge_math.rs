@@ -67,6 +67,17 @@ pub fn towards_eye(a: DVec3, eye: DVec4) -> DVec3 {
     eye.truncate() - a * eye.w
 }
 
+/// The homogeneous eye `eye` (world) in the coordinates of a model placed by `model`: a
+/// point with w = 1, or a unit direction towards the viewer with w = 0.
+pub fn local_eye(model: glam::DMat4, eye: DVec4) -> DVec4 {
+    let local = model.inverse() * eye;
+    if local.w != 0.0 {
+        local / local.w
+    } else {
+        local.truncate().normalize_or_zero().extend(0.0)
+    }
+}
+
 /// Twin of `is_silhouette` in common.wgsl: the edge `a → b`, shared by a triangle with third
 /// corner `c` and a neighbour with a point `d` off the edge, is a silhouette seen from `eye`
 /// (homogeneous, as [`towards_eye`] takes it) when both triangles lie on the same side of the
@@ -127,6 +138,96 @@ pub fn host_hides(host: f64, point: f64, distance: f64, slope: f64) -> bool {
 /// and orthographic views alike.
 pub fn nearer(a_near: f64, b_near: f64, b_w: f64) -> bool {
     a_near < b_near - HIDDEN_MARGIN * (b_near.abs() + b_w)
+}
+
+/// Twin of `segment_distance` in common.wgsl: pixels from `pixel` to the screen segment
+/// between the clip-space points `ca` and `cb`, cut to its part in front of the near plane
+/// ([`NO_EDGE`] when none is). Used where the nearest point of a drawn edge need not lie
+/// between its ends: across undrawn edges, an edge's line passes closer than the edge.
+pub fn segment_distance(ca: DVec4, cb: DVec4, pixel: DVec2, size: DVec2) -> f64 {
+    if ca.z < 0.0 && cb.z < 0.0 {
+        return NO_EDGE;
+    }
+    let cut = |k: f64| ca.lerp(cb, k);
+    let (a, b) = if ca.z < 0.0 {
+        (cut(ca.z / (ca.z - cb.z)), cb)
+    } else if cb.z < 0.0 {
+        (ca, cut(ca.z / (ca.z - cb.z)))
+    } else {
+        (ca, cb)
+    };
+    let (pa, pb) = (
+        pixel_relative(a, pixel, size),
+        pixel_relative(b, pixel, size),
+    );
+    let (a, b) = (pa.truncate() / pa.z, pb.truncate() / pb.z);
+    let ab = b - a;
+    let len2 = ab.length_squared();
+    let k = if len2 > 0.0 {
+        (-a.dot(ab) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let d = (a + ab * k).length();
+    if d.is_nan() {
+        NO_EDGE
+    } else {
+        d
+    }
+}
+
+/// What [`patch_distance`] needs to know of one triangle.
+#[derive(Clone, Copy, Debug)]
+pub struct PatchTriangle {
+    /// Corners in the coordinates the eye is given in.
+    pub local: [DVec3; 3],
+    /// Corners in clip space.
+    pub clip: [DVec4; 3],
+    /// Drawn edges (bit `i` for edge `i`).
+    pub mask: u8,
+    /// The triangle across each edge, or `u32::MAX`.
+    pub neighbours: [u32; 3],
+}
+
+/// Twin of `patch_distance` in edge_pass.wgsl: pixels from `pixel` to the nearest drawn edge
+/// (as a segment) of the patch around `start`, the triangles reached from it across undrawn
+/// edges that are not silhouettes from `eye` (beyond a silhouette the surface folds back
+/// under itself, and its edges there are hidden). A search of at most
+/// [`PATCH_TRIANGLES`](crate::mesh::patches::PATCH_TRIANGLES) triangles, breadth first; with
+/// `large`, the start's own drawn edges only.
+pub fn patch_distance(
+    start: u32,
+    large: bool,
+    eye: DVec4,
+    pixel: DVec2,
+    size: DVec2,
+    triangle: impl Fn(u32) -> PatchTriangle,
+) -> f64 {
+    let cap = crate::mesh::patches::PATCH_TRIANGLES;
+    let mut queue = vec![start];
+    let mut best = NO_EDGE;
+    let mut k = 0;
+    while k < queue.len() {
+        let t = triangle(queue[k]);
+        k += 1;
+        for i in 0..3 {
+            let j = (i + 1) % 3;
+            if t.mask & (1 << i) != 0 {
+                best = best.min(segment_distance(t.clip[i], t.clip[j], pixel, size));
+                continue;
+            }
+            let n = t.neighbours[i];
+            if large || queue.len() >= cap || n == u32::MAX || queue.contains(&n) {
+                continue;
+            }
+            let d = triangle(n).local;
+            let d = (d[0] + d[1] + d[2]) / 3.0;
+            if !is_silhouette(t.local[i], t.local[j], t.local[(i + 2) % 3], d, eye) {
+                queue.push(n);
+            }
+        }
+    }
+    best
 }
 
 fn line_distance(l: DVec3, drawn: bool) -> f64 {
@@ -235,6 +336,68 @@ mod tests {
         let e = edge_eval(tri, 0b111, DVec2::new(20.5, 30.5), SIZE);
         assert_eq!(e.distance[0], NO_EDGE);
         assert!(e.distance[1].is_finite() && e.distance[2].is_finite());
+    }
+
+    #[test]
+    fn a_quad_edge_is_found_across_its_diagonal() {
+        // The quad (10, 10) (110, 10) (110, 60) (10, 60) on screen, split along a → c.
+        let screen = [(10.0, 10.0), (110.0, 10.0), (110.0, 60.0), (10.0, 60.0)];
+        let local = screen.map(|(x, y)| DVec3::new(x, y, 0.0));
+        let clip = screen.map(|(x, y)| at(x, y, 1.0));
+        let tris = [
+            ([0, 1, 2], 0b011u8, [u32::MAX, u32::MAX, 1]),
+            ([0, 2, 3], 0b110, [0, u32::MAX, u32::MAX]),
+        ];
+        let triangle = |t: u32| {
+            let (corners, mask, neighbours) = tris[t as usize];
+            PatchTriangle {
+                local: corners.map(|c| local[c]),
+                clip: corners.map(|c| clip[c]),
+                mask,
+                neighbours,
+            }
+        };
+        let eye = DVec4::new(60.0, 35.0, 100.0, 1.0);
+        // Above the diagonal, in the first triangle: its own edges are 44.5 and 9.5 px away,
+        // the quad's bottom edge (the second triangle's) 5.5.
+        let pixel = DVec2::new(100.5, 54.5);
+        let own = edge_eval(triangle(0).clip, 0b011, pixel, SIZE).min_distance();
+        assert!((own - 9.5).abs() < 1e-9);
+        let d = patch_distance(0, false, eye, pixel, SIZE, triangle);
+        assert!((d - 5.5).abs() < 1e-9, "{d}");
+        // A large patch has only its own edges searched.
+        assert!((patch_distance(0, true, eye, pixel, SIZE, triangle) - 9.5).abs() < 1e-9);
+        // Beyond an end of the bottom edge the distance is to its end, not its line.
+        let d = segment_distance(clip[2], clip[3], DVec2::new(113.5, 64.5), SIZE);
+        assert!((d - 3.5f64.hypot(4.5)).abs() < 1e-9, "{d}");
+        // Folded over the first triangle, so that the eye sees the diagonal as a silhouette:
+        // not crossed.
+        let over = DVec3::new(130.0, 20.0, 5.0);
+        let folded = |t: u32| {
+            let mut tri = triangle(t);
+            if t == 1 {
+                tri.local[2] = over;
+            }
+            tri
+        };
+        let centroid = (local[0] + local[2] + over) / 3.0;
+        assert!(is_silhouette(local[2], local[0], local[1], centroid, eye));
+        assert!((patch_distance(0, false, eye, pixel, SIZE, folded) - 9.5).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_segment_behind_the_eye_is_cut_at_the_near_plane() {
+        let mut a = at(50.0, 50.0, 1.0);
+        let mut b = at(150.0, 50.0, 1.0);
+        // b's end behind the near plane: the visible part ends where z crosses 0.
+        b.z = -a.z;
+        let d = segment_distance(a, b, DVec2::new(140.5, 50.5), SIZE);
+        assert!((d - (140.5f64 - 100.0).hypot(0.5)).abs() < 1e-9, "{d}");
+        a.z = -1.0;
+        assert_eq!(
+            segment_distance(a, b, DVec2::new(60.5, 50.5), SIZE),
+            NO_EDGE
+        );
     }
 
     #[test]

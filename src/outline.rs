@@ -4,10 +4,14 @@
 //! ([`edge_math::is_silhouette`]) of an object that draws its outline, among the edges its
 //! mesh allows as outlines. Pixel p lies at distance d from an outline when d is the distance
 //! from p's centre to the *visible part* of an outline edge's projection: the part in front
-//! of the near plane and not beyond the far one, inside the image, and not hidden by another
-//! surface ([`edge_math::nearer`]). Each pixel keeps the line that colours it most
+//! of the near plane and not beyond the far one, within the line's reach of the image (an
+//! edge just outside the image draws its line inside), and not hidden by another surface ([`edge_math::nearer`]). Each pixel keeps the line that colours it most
 //! ([`style::line_key`](crate::style::line_key)): the common profile at the object's width,
 //! times the depth fade of that nearest visible point.
+//!
+//! The same map carries the drawn edges of large patches ([`Patches::splat`]) of objects
+//! that draw their edges, by the same definition: the pixels of a large patch find their
+//! lines here, not among their own triangle's edges.
 //!
 //! Visibility along an edge is found by casting a ray through points every 1/8 pixel of its
 //! projection and bisecting each change to 2⁻³⁰ of the edge. The GPU pass does the same at
@@ -19,6 +23,7 @@
 
 use crate::edge_math;
 use crate::mesh::adjacency::NO_NEIGHBOUR;
+use crate::mesh::patches::Patches;
 use crate::raycast::{HostMap, Line, ObjectStyle, RayCaster, Rays};
 use crate::render::Shot;
 use crate::style::{depth_fade, line_intensity, line_key, line_reach};
@@ -86,6 +91,7 @@ pub(crate) fn outline_map(
     rays: &Rays,
     shot: &Shot<'_>,
     styles: &[ObjectStyle],
+    patches: &[Patches],
     host: Option<&HostMap>,
 ) -> OutlineMap {
     let (width, height) = shot.size;
@@ -106,18 +112,27 @@ pub(crate) fn outline_map(
         .objects
         .iter()
         .enumerate()
-        .filter(|(o, _)| styles[*o].outlines)
+        .filter(|(o, _)| styles[*o].outlines || styles[*o].edges)
         .flat_map(|(o, object)| {
             let mesh = &world.meshes[object.mesh].mesh;
-            let mut local = object.transform.inverse() * eye;
-            local = if local.w != 0.0 {
-                local / local.w
-            } else {
-                local.truncate().normalize_or_zero().extend(0.0)
-            };
+            let local = edge_math::local_eye(object.transform, eye);
             let first = caster.first_ids()[o];
             let width = styles[o].width;
-            outline_edges(mesh, local)
+            let mut edges = Vec::new();
+            if styles[o].outlines {
+                edges = outline_edges(mesh, local);
+            }
+            if styles[o].edges {
+                let splat = &patches[object.mesh].splat;
+                edges.extend(splat.iter().enumerate().flat_map(|(t, &bits)| {
+                    (0..3u32)
+                        .filter(move |i| bits & (1 << i) != 0)
+                        .map(move |i| (t as u32, i))
+                }));
+                edges.sort_unstable();
+                edges.dedup();
+            }
+            edges
                 .into_par_iter()
                 .flat_map_iter(move |(t, i)| {
                     let n = mesh.edge_neighbours()[t as usize][i as usize];
@@ -218,12 +233,13 @@ impl Visibility<'_> {
             self.project(c, f)
         };
         let (p0, p1) = (at(s.0), at(s.1));
-        // Inside the image.
+        // Within reach of the image: an edge just outside it still draws its line inside.
         let size = self.rays.size();
+        let reach = line_reach(width);
         let d = p1.xy - p0.xy;
         let mut u = (0.0, 1.0);
-        keep_between(&mut u, p0.xy.x, d.x, size.x);
-        keep_between(&mut u, p0.xy.y, d.y, size.y);
+        keep_between(&mut u, p0.xy.x, d.x, (-reach, size.x + reach));
+        keep_between(&mut u, p0.xy.y, d.y, (-reach, size.y + reach));
         if !(u.0 <= u.1) {
             return Vec::new();
         }
@@ -346,15 +362,15 @@ fn keep_positive(range: &mut (f64, f64), f0: f64, f1: f64) {
     }
 }
 
-/// Narrows `range` to the parameters u where 0 ≤ p0 + u·d ≤ hi.
-fn keep_between(range: &mut (f64, f64), p0: f64, d: f64, hi: f64) {
+/// Narrows `range` to the parameters u where lo ≤ p0 + u·d ≤ hi.
+fn keep_between(range: &mut (f64, f64), p0: f64, d: f64, (lo, hi): (f64, f64)) {
     if d == 0.0 {
-        if !(0.0..=hi).contains(&p0) {
+        if !(lo..=hi).contains(&p0) {
             *range = (1.0, 0.0);
         }
         return;
     }
-    let (u0, u1) = (-p0 / d, (hi - p0) / d);
+    let (u0, u1) = ((lo - p0) / d, (hi - p0) / d);
     range.0 = range.0.max(u0.min(u1));
     range.1 = range.1.min(u0.max(u1));
 }
@@ -562,7 +578,12 @@ mod tests {
         };
         let rays = Rays::new(&shot.view, size, &world).unwrap();
         let styles = ObjectStyle::of(&world, style);
-        outline_map(&caster, &rays, &shot, &styles, None)
+        let mesh = &world.meshes[0].mesh;
+        let patches = [Patches::new(
+            mesh.edge_neighbours(),
+            &mesh.edge_mask(EdgeSelection::All),
+        )];
+        outline_map(&caster, &rays, &shot, &styles, &patches, None)
     }
 
     #[test]

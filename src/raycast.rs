@@ -24,6 +24,7 @@ use crate::camera::{ClipRows, DepthRange, View};
 use crate::edge_math;
 use crate::error::{Error, Result};
 use crate::gpu::light_world_dir;
+use crate::mesh::{patches::Patches, ALL_EDGES};
 use crate::render::{Frame, Shot, World, BACKGROUND, HOST};
 use crate::style::{self, Color};
 use glam::{DMat3, DMat4, DVec2, DVec3, DVec4, Vec3A};
@@ -589,7 +590,19 @@ pub fn render_raycast_over(shot: &Shot<'_>, host: Option<&HostOccluders<'_>>) ->
         None => None,
     };
     let host_map = host.clone().map(|h| HostMap::new(&caster, &rays, h));
-    let outline = crate::outline::outline_map(&caster, &rays, shot, &styles, host_map.as_ref());
+    let patches: Vec<Patches> = world
+        .meshes
+        .iter()
+        .zip(&masks)
+        .map(|(m, mask)| Patches::new(m.mesh.edge_neighbours(), mask))
+        .collect();
+    let eyes: Vec<DVec4> = world
+        .objects
+        .iter()
+        .map(|o| edge_math::local_eye(o.transform, shot.view.eye()))
+        .collect();
+    let outline =
+        crate::outline::outline_map(&caster, &rays, shot, &styles, &patches, host_map.as_ref());
 
     let pixels = u64::from(width) * u64::from(height);
     let bar = progress_bar(u64::from(height), pixels);
@@ -597,6 +610,8 @@ pub fn render_raycast_over(shot: &Shot<'_>, host: Option<&HostOccluders<'_>>) ->
         caster: &caster,
         rays: &rays,
         masks: &masks,
+        patches: &patches,
+        eyes: &eyes,
         styles: &styles,
         shading: &shading,
     };
@@ -694,6 +709,9 @@ struct Truth<'a> {
     caster: &'a RayCaster<'a>,
     rays: &'a Rays,
     masks: &'a [Vec<u8>],
+    patches: &'a [Patches],
+    /// Each object's eye in its mesh's coordinates.
+    eyes: &'a [DVec4],
     styles: &'a [ObjectStyle],
     shading: &'a Shading,
 }
@@ -738,8 +756,29 @@ impl Truth<'_> {
         } else {
             0
         };
-        let e = edge_math::edge_eval(clip, mask, pixel, self.rays.size());
-        let own = e.min_distance();
+        let size = self.rays.size();
+        let e = edge_math::edge_eval(clip, mask, pixel, size);
+        let mut own = e.min_distance();
+        // Twin of the patch search in `surface_pixel` (edge_pass.wgsl): where an undrawn
+        // edge of the triangle is within the line's reach, the nearest line may lie beyond it.
+        let undrawn = edge_math::edge_eval(clip, !mask & ALL_EDGES, pixel, size).min_distance();
+        if st.edges && undrawn < style::line_reach(st.width) {
+            let first = self.caster.first_ids()[hit.object as usize];
+            let mesh = &wm.mesh;
+            let triangle = |t: u32| {
+                let local =
+                    mesh.triangles()[t as usize].map(|v| mesh.positions()[v as usize].as_dvec3());
+                edge_math::PatchTriangle {
+                    local,
+                    clip: self.caster.corners(first + t).map(|p| self.rays.clip(p)),
+                    mask: self.masks[object.mesh][t as usize],
+                    neighbours: mesh.edge_neighbours()[t as usize],
+                }
+            };
+            let large = self.patches[object.mesh].large[hit.tri as usize];
+            let eye = self.eyes[hit.object as usize];
+            own = edge_math::patch_distance(hit.tri, large, eye, pixel, size, triangle);
+        }
         let c = self.rays.clip(hit.point);
         let depth = (c.z / c.w).clamp(0.0, 1.0);
 

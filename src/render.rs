@@ -8,7 +8,7 @@ use crate::camera::View;
 use crate::error::{Error, Result};
 use crate::gpu::{
     read_texture, texture_2d, Canvas, DeferredPass, EdgeLines, ForwardPass, GpuContext, MeshId,
-    MeshStore, OutputTarget, PassOptions, TwoPass, Window,
+    MeshStore, OutputTarget, PassOptions, TwoPass,
 };
 use crate::mesh::{EdgeSelection, Mesh};
 use crate::scene::{Instance, InstanceStyle, Scene};
@@ -370,7 +370,8 @@ pub fn render_deferred_with(
 }
 
 /// [`render_deferred_with`] onto a canvas of the caller's: over the host's depth buffer, say
-/// (its pixels where the host is in front get the id [`HOST`]).
+/// (its pixels where the host is in front get the id [`HOST`]), or a window of the shot's
+/// image (a tile: the frame is the window's size).
 pub fn render_deferred_on(
     ctx: &GpuContext,
     shot: &Shot<'_>,
@@ -379,10 +380,11 @@ pub fn render_deferred_on(
     canvas: Canvas<'_>,
 ) -> Result<Frame> {
     let device = &ctx.device;
-    if canvas.window != Window::whole(shot.size) {
+    let window = canvas.window;
+    if window.image != shot.size {
         return Err(Error::Misuse(format!(
-            "the canvas is {:?}, not the whole {}x{} image of the shot",
-            canvas.window, shot.size.0, shot.size.1
+            "the canvas is {window:?}, a window of another image than the shot's {}x{}",
+            shot.size.0, shot.size.1
         )));
     }
     let scene = up.scene(shot.world, shot.view);
@@ -391,7 +393,7 @@ pub fn render_deferred_on(
     let output = texture_2d(
         device,
         "wirepass output",
-        shot.size,
+        window.size,
         pass.output_format(),
         usage,
     );
@@ -418,7 +420,8 @@ pub fn render_deferred_on(
         frame.resolved_id_texture().ok_or_else(missing)?,
         frame.diagnostic_texture().ok_or_else(missing)?,
     );
-    read_frame(ctx, shot, up, frame.instance_order(), &output, maps)
+    let out = (window.size, up);
+    read_frame(ctx, shot, out, frame.instance_order(), &output, maps)
 }
 
 /// Reads a rendered frame back: the 8-bit output, the `Rg32Uint` (slot, triangle) ids and
@@ -428,7 +431,7 @@ pub fn render_deferred_on(
 fn read_frame(
     ctx: &GpuContext,
     shot: &Shot<'_>,
-    up: &Uploaded,
+    (size, up): ((u32, u32), &Uploaded),
     order: &[u32],
     output: &wgpu::Texture,
     (ids, diagnostic): (&wgpu::Texture, &wgpu::Texture),
@@ -449,7 +452,7 @@ fn read_frame(
         .map(|w| [w[0], w[1]])
         .collect();
     Ok(Frame {
-        size: shot.size,
+        size,
         rgba,
         ids: up.global_ids(shot.world, order, &raw)?,
         // Reverse depth back to the standard convention.
@@ -492,7 +495,14 @@ pub fn render_forward(ctx: &GpuContext, shot: &Shot<'_>) -> Result<Frame> {
     ctx.queue.submit([encoder.finish()]);
     ctx.finish()?;
     let maps = (frame.id_texture(), frame.diagnostic_texture());
-    read_frame(ctx, shot, &up, frame.instance_order(), &output, maps)
+    read_frame(
+        ctx,
+        shot,
+        (shot.size, &up),
+        frame.instance_order(),
+        &output,
+        maps,
+    )
 }
 
 /// Renders `shot` with the two-pass baseline and reads back the image and maps. It measures
@@ -515,7 +525,14 @@ pub fn render_two_pass(ctx: &GpuContext, shot: &Shot<'_>) -> Result<Frame> {
     ctx.queue.submit([encoder.finish()]);
     ctx.finish()?;
     let maps = (frame.id_texture(), frame.diagnostic_texture());
-    read_frame(ctx, shot, &up, frame.instance_order(), &output, maps)
+    read_frame(
+        ctx,
+        shot,
+        (shot.size, &up),
+        frame.instance_order(),
+        &output,
+        maps,
+    )
 }
 
 /// Writes 8-bit RGBA pixels, row 0 at the top, as a PNG.

@@ -729,3 +729,72 @@ fn hard_cases_are_what_they_claim() {
     let w = find("vertex at w = 0").clip[1].w;
     assert_eq!(w, 0.0);
 }
+
+const SEGMENT_SHADER: &str = r#"
+@group(0) @binding(0) var<storage, read> cases: array<vec4<f32>>;
+@group(0) @binding(1) var<storage, read_write> results: array<vec4<f32>>;
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if 3u * i >= arrayLength(&cases) {
+        return;
+    }
+    let p = cases[3u * i + 2u];
+    results[i] = vec4<f32>(segment_distance(cases[3u * i], cases[3u * i + 1u], p.xy, p.zw), 0.0, 0.0, 0.0);
+}
+"#;
+
+/// `segment_distance` in WGSL against `edge_math::segment_distance`: random segments seen
+/// by a perspective camera, a quarter of them reaching behind the eye (cut at the near
+/// plane), and hand-picked ones: both ends behind, a point, a pixel on the segment, a pixel
+/// beyond an end.
+#[test]
+fn wgsl_segment_distance_matches_rust() {
+    let size = [320f32, 240.0];
+    let m = perspective(DVec3::new(0.3, 0.2, 4.0), DVec3::ZERO, 0.1, size);
+    let mut next = uniform(0x9e37_79b9_7f4a_7c15);
+    let mut segments: Vec<([DVec3; 2], [f32; 2])> = Vec::new();
+    for k in 0..600 {
+        let a = DVec3::new(next(), next(), next()) * 3.0;
+        let mut b = DVec3::new(next(), next(), next()) * 3.0;
+        if k % 4 == 0 {
+            // The eye is at z = 4, looking down -z.
+            b.z = 4.5 + 3.0 * (next() + 1.0);
+        }
+        let pixel = [(next() + 1.0) as f32 * 160.0, (next() + 1.0) as f32 * 120.0];
+        segments.push(([a, b], pixel));
+    }
+    let behind = DVec3::new(0.0, 0.0, 6.0);
+    segments.push(([behind, behind + DVec3::X], [100.5, 100.5]));
+    segments.push(([DVec3::ZERO, DVec3::ZERO], [160.5, 120.5]));
+    let input: Vec<Vec4> = segments
+        .iter()
+        .flat_map(|([a, b], p)| {
+            let clip = |q: DVec3| (m * q.extend(1.0)).as_vec4();
+            [clip(*a), clip(*b), Vec4::new(p[0], p[1], size[0], size[1])]
+        })
+        .collect();
+    let got = run_shader(SEGMENT_SHADER, &input, segments.len());
+    let mut worst: f64 = 0.0;
+    for (k, g) in got.iter().enumerate() {
+        let [ca, cb, p] = [0, 1, 2].map(|j| input[3 * k + j].as_dvec4());
+        let want = edge_math::segment_distance(ca, cb, DVec2::new(p.x, p.y), DVec2::new(p.z, p.w));
+        let g = f64::from(g.x);
+        if !want.is_finite() {
+            assert!(g >= f64::from(NO_EDGE_GPU), "case {k}: {g} for no segment");
+            continue;
+        }
+        let error = (g - want).abs();
+        worst = worst.max(error / (1.0 + want));
+        assert!(error <= 2e-3 + 1e-5 * want, "case {k}: {g} against {want}");
+    }
+    println!("worst relative error {worst:.2e}");
+    assert!(!edge_math::segment_distance(
+        input[3 * 600].as_dvec4(),
+        input[3 * 600 + 1].as_dvec4(),
+        DVec2::ZERO,
+        DVec2::new(320.0, 240.0)
+    )
+    .is_finite());
+}

@@ -50,8 +50,10 @@ fn per_triangle() -> Style {
     }
 }
 
+/// Every triangle edge drawn: then both methods draw the same lines, each pixel's own
+/// triangle's (in the masked modes the deferred method's lines also cross undrawn edges).
 fn draw(mesh: &Mesh, camera: Camera, size: (u32, u32), style: &Style, method: Method) -> Frame {
-    draw_edges(mesh, camera, size, style, EdgeSelection::Polygon, method)
+    draw_edges(mesh, camera, size, style, EdgeSelection::All, method)
 }
 
 fn draw_edges(

@@ -72,8 +72,10 @@ fn outlines_reach_over_the_background_in_deferred_only() {
     assert!(m.distance_error_px.max.unwrap_or(0.0) > 1.0, "{m:?}");
 }
 
-/// With outlines off the deferred pass draws the edge inside its triangles, like the forward
-/// method: no background pixel has a line.
+/// With outlines off the deferred pass draws the edges of small patches (here every edge, a
+/// triangle mesh's polygon edges) inside their triangles, like the forward method: no
+/// background pixel has a line. (Lines of large patches come from the outline pass and reach
+/// over the background where they lie on a silhouette: tests/lines.rs.)
 #[test]
 fn outlines_off_keep_lines_inside_their_triangles() {
     let mesh = load("fandisk.obj");
@@ -82,7 +84,13 @@ fn outlines_off_keep_lines_inside_their_triangles() {
         silhouettes: false,
         ..Style::default()
     };
-    let scene = scene(&mesh, style);
+    let scene = TestScene::new(
+        &mesh,
+        framing(&mesh, SIZE),
+        style,
+        SIZE,
+        EdgeSelection::Polygon,
+    );
     let deferred = draw(&scene, Method::Deferred);
     let truth = draw(&scene, Method::Raycast);
     for f in [&deferred, &truth] {

@@ -84,6 +84,7 @@ enum Mode {
 struct Variant {
     split: bool,
     outlines: bool,
+    patches: bool,
     colors: bool,
     host: bool,
     /// The instance records are bound as a uniform array.
@@ -357,7 +358,7 @@ impl DeferredPass {
     ) -> Result<PreparedFrame> {
         let canvas = canvas.into();
         let window = canvas.window;
-        let data = FrameData::new(device, store, scene, style, window, 0)?;
+        let data = FrameData::new(device, store, scene, style, window, true)?;
         let host = match &canvas.host_depth {
             Some(h) => Some(self.host.prepare(device, h, &scene.view, window.image)?),
             None => None,
@@ -422,6 +423,7 @@ impl DeferredPass {
         Variant {
             split: frame.data.split(),
             outlines: frame.data.outlines,
+            patches: frame.data.patches,
             colors: frame.data.outlines && frame.data.mixed_colors,
             host: frame.host.is_some(),
             uniform_instances: frame.data.uniform_instances,
@@ -483,18 +485,20 @@ impl DeferredPass {
             r.extend_from_slice(&out);
             r
         };
-        let mut classify_res = vec![Res::TilesRw];
+        let mut classify_res = vec![Res::TilesRw, Res::WorkRw];
         if v.outlines {
             classify_res.push(Res::OutlineTiles);
         }
         let classify = Compute::new(device, &module, "classify_main", with(&classify_res), color)?;
-        let tiles = Compute::new(
-            device,
-            &module,
-            "tile_main",
-            with(&[Res::Tiles, Res::WorkRw]),
-            color,
-        )?;
+        let mut tile_res = vec![Res::Tiles, Res::WorkRw];
+        if v.patches {
+            // The patch search walks across undrawn edges.
+            tile_res.push(Res::Neighbours);
+            if v.split {
+                tile_res.push(Res::NeighboursHi);
+            }
+        }
+        let tiles = Compute::new(device, &module, "tile_main", with(&tile_res), color)?;
         let mut refine_res = with(&[Res::Work, Res::Neighbours]);
         if v.split {
             refine_res.push(Res::NeighboursHi);
@@ -858,6 +862,9 @@ fn variant_flags(v: Variant) -> Vec<&'static str> {
     }
     if v.outlines {
         flags.push("OUTLINES");
+    }
+    if v.patches {
+        flags.push("PATCHES");
     }
     if v.colors {
         flags.push("COLORS");

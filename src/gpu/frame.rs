@@ -105,6 +105,21 @@ impl InstanceRecord {
     }
 }
 
+/// Pixels of guard band the deferred pass keeps around its output, from the widest line of
+/// the scene: lines whose edges lie just outside the output reach into it, the outline pass
+/// tests their visibility against the ids one pixel around each point, and the coverage
+/// search reads the ids around each pixel. So the output is the same whether the image is
+/// drawn whole or as tiles ([`Window`]). (An output within a band of the device's largest
+/// texture side gets what room is left.)
+pub fn guard_band(scene: &Scene<'_>, style: &Style) -> u32 {
+    let widest = scene
+        .instances
+        .iter()
+        .filter_map(|i| i.style.line_width)
+        .fold(style.line_width, f32::max);
+    (crate::style::line_reach(f64::from(widest)).ceil() as u32).saturating_add(2)
+}
+
 /// Which part of a full image the targets cover: all of it, or a tile of it, with a guard
 /// band of `guard` pixels around the output on every side (so lines just outside the output
 /// are found). Every pixel is addressed in full-image coordinates, so a tile computes
@@ -214,8 +229,12 @@ pub(crate) struct FrameData {
     pub window: Window,
     /// Pixels of guard band around the output in the targets.
     pub guard: u32,
-    /// Whether any instance draws an outline.
+    /// Whether the outline pass runs: an instance draws outlines, or edges of a mesh with
+    /// large patches.
     pub outlines: bool,
+    /// Whether an instance draws the edges of a mesh with undrawn edges (the edge pass then
+    /// searches patches).
+    pub patches: bool,
     /// Whether instances differ in line colour (the outline pass then keeps, per pixel,
     /// which instance's line it holds).
     pub mixed_colors: bool,
@@ -226,20 +245,27 @@ pub(crate) struct FrameData {
 
 impl FrameData {
     /// Validates the scene, style and window against the device and the store, and builds
-    /// the frame's GPU data.
+    /// the frame's GPU data; with `guarded`, the targets have a guard band ([`guard_band`]).
     pub fn new(
         device: &wgpu::Device,
         store: &MeshStore,
         scene: &Scene<'_>,
         style: &Style,
         window: Window,
-        guard: u32,
+        guarded: bool,
     ) -> Result<FrameData> {
         window.validate()?;
-        let target = (window.size.0 + 2 * guard, window.size.1 + 2 * guard);
-        super::check_size(device, target)?;
         scene.validate()?;
         style.validate()?;
+        super::check_size(device, window.size)?;
+        // Where the device's largest texture leaves no room for the whole band, a narrower one.
+        let room = device.limits().max_texture_dimension_2d - window.size.0.max(window.size.1);
+        let guard = if guarded {
+            guard_band(scene, style).min(room / 2)
+        } else {
+            0
+        };
+        let target = (window.size.0 + 2 * guard, window.size.1 + 2 * guard);
         // Group instances by mesh (stable, so each mesh's instances keep the scene's order),
         // so every mesh is one instanced draw.
         let mut order: Vec<u32> = (0..scene.instances.len() as u32).collect();
@@ -262,17 +288,18 @@ impl FrameData {
         let mut draws: Vec<DrawGroup> = Vec::new();
         let mut clusters = 0u64;
         let mut outlines = false;
+        let mut patches = false;
         for (slot, &i) in order.iter().enumerate() {
             let instance = &scene.instances[i as usize];
             let mesh = store.record(instance.mesh)?;
             let s = &instance.style;
             let draws_outline = s.outlines.unwrap_or(style.silhouettes);
-            outlines |= draws_outline;
-            let flags = if s.edges.unwrap_or(true) {
-                INSTANCE_EDGES
-            } else {
-                0
-            } | if draws_outline { INSTANCE_OUTLINES } else { 0 };
+            let draws_edges = s.edges.unwrap_or(true);
+            // The outline pass also draws the edges of large patches.
+            outlines |= draws_outline || (draws_edges && mesh.lines.splat);
+            patches |= draws_edges && mesh.lines.undrawn;
+            let flags = if draws_edges { INSTANCE_EDGES } else { 0 }
+                | if draws_outline { INSTANCE_OUTLINES } else { 0 };
             let record = instance_record(
                 &view,
                 (eye, fade_row),
@@ -384,6 +411,7 @@ impl FrameData {
             window,
             guard,
             outlines,
+            patches,
             mixed_colors,
             uniform_instances,
         })
@@ -450,12 +478,7 @@ fn instance_record(
         rows.clip *= k;
         rows.depth *= k;
     }
-    let mut local_eye = model.inverse() * eye;
-    local_eye = if local_eye.w != 0.0 {
-        local_eye / local_eye.w
-    } else {
-        local_eye.truncate().normalize_or_zero().extend(0.0)
-    };
+    let local_eye = crate::edge_math::local_eye(model, eye);
     let normal = DMat3::from_mat4(transform).inverse().transpose();
     let row = |m: DMat3, i: usize| m.row(i).as_vec3().extend(0.0).to_array();
     InstanceRecord {
@@ -552,6 +575,8 @@ mod tests {
             scale: 0.25,
             order: vec![].into(),
             bounds: (DVec3::ZERO, DVec3::ZERO),
+            lines: Default::default(),
+            bounds_of_clusters: vec![].into(),
         };
         let transform = DMat4::from_scale_rotation_translation(
             DVec3::new(-1.0, 2.0, 0.5),

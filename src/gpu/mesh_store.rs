@@ -6,7 +6,7 @@
 //! origin keep f32's precision; the model matrix takes the offset and scale back in f64),
 //! and the unit normal packed octahedrally into 32 bits. Per triangle: three vertex indices
 //! (12 bytes, also the index buffer), the triangle across each edge (12 bytes), and 4 bytes
-//! of edge data ([`triangle_info`]). Per cluster of 64 triangles: the outline pass's bounds
+//! of edge data ([`EdgeData`]). Per cluster of 64 triangles: the outline pass's bounds
 //! (32 bytes).
 //!
 //! A mesh's triangles are stored in its clusters' order (a Morton curve through the
@@ -18,7 +18,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 use crate::error::{Error, Result};
-use crate::mesh::{adjacency::NO_NEIGHBOUR, EdgeSelection, Mesh};
+use crate::mesh::{adjacency::NO_NEIGHBOUR, patches::Patches, EdgeSelection, Mesh, ALL_EDGES};
 use glam::{DMat4, DVec3, Vec2, Vec3};
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::sync::Arc;
@@ -65,6 +65,19 @@ pub(crate) struct MeshRecord {
     pub order: Arc<[u32]>,
     /// The mesh's bounds, in its own coordinates.
     pub bounds: (DVec3, DVec3),
+    /// What its edge selection asks of the passes.
+    pub lines: MeshLines,
+    /// Per cluster, its bounds without the splat flag (see [`cluster_records`]).
+    pub bounds_of_clusters: Arc<[[f32; 8]]>,
+}
+
+/// What a mesh's edge selection asks of the passes beyond each triangle's own edges.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct MeshLines {
+    /// Some edge is undrawn: pixels near one search their patch (`patch_distance`).
+    pub undrawn: bool,
+    /// Some drawn edge borders a large patch: the outline pass draws it.
+    pub splat: bool,
 }
 
 impl MeshRecord {
@@ -283,6 +296,8 @@ impl MeshStore {
             scale: data.scale,
             order: data.order,
             bounds: data.bounds,
+            lines: data.lines,
+            bounds_of_clusters: data.bounds_of_clusters,
         };
         let slot = match self.free_slots.pop() {
             Some(s) => s,
@@ -318,7 +333,7 @@ impl MeshStore {
 
     /// Re-uploads which edges of `id` are drawn; `mesh` is the mesh it was inserted from.
     pub fn set_edges(
-        &self,
+        &mut self,
         queue: &wgpu::Queue,
         id: MeshId,
         mesh: &Mesh,
@@ -332,13 +347,26 @@ impl MeshStore {
                 record.triangles
             )));
         }
-        let info = triangle_info(mesh, edges, &record.order);
-        let pool = &self.pools[3].1;
+        let edges = EdgeData::new(mesh, edges, &record.order);
+        let clusters = cluster_records(&record.bounds_of_clusters, &edges.info);
+        let (info, cluster) = (&self.pools[3].1, &self.pools[4].1);
         queue.write_buffer(
-            &pool.buffer,
-            u64::from(record.triangle_base) * pool.stride,
-            bytemuck::cast_slice(&info),
+            &info.buffer,
+            u64::from(record.triangle_base) * info.stride,
+            bytemuck::cast_slice(&edges.info),
         );
+        if !clusters.is_empty() {
+            queue.write_buffer(
+                &cluster.buffer,
+                u64::from(record.cluster_base) * cluster.stride,
+                bytemuck::cast_slice(&clusters),
+            );
+        }
+        let slot = id.slot as usize;
+        if let Some(record) = self.slots[slot].1.as_mut() {
+            record.lines = edges.lines;
+        }
+        self.version += 1;
         Ok(())
     }
 
@@ -578,6 +606,8 @@ struct MeshData {
     neighbours: Vec<[u32; 3]>,
     info: Vec<u32>,
     clusters: Vec<[f32; 8]>,
+    bounds_of_clusters: Arc<[[f32; 8]]>,
+    lines: MeshLines,
     origin: DVec3,
     scale: f64,
     order: Arc<[u32]>,
@@ -625,7 +655,7 @@ impl MeshData {
                 })
             })
             .collect();
-        let bounds = clusters
+        let bounds: Vec<[f32; 8]> = clusters
             .bounds
             .iter()
             .map(|c| {
@@ -636,12 +666,16 @@ impl MeshData {
                 [x, y, z, radius as f32, ax, ay, az, c.spread as f32]
             })
             .collect();
+        let bounds: Arc<[[f32; 8]]> = bounds.into();
+        let edges = EdgeData::new(mesh, edges, &order);
         MeshData {
             vertices,
             indices,
             neighbours,
-            info: triangle_info(mesh, edges, &order),
-            clusters: bounds,
+            clusters: cluster_records(&bounds, &edges.info),
+            bounds_of_clusters: bounds,
+            info: edges.info,
+            lines: edges.lines,
             origin,
             scale,
             order,
@@ -650,18 +684,65 @@ impl MeshData {
     }
 }
 
-/// Per stored triangle, the 4 bytes of edge data the passes read (`triangle_info` in
-/// common.wgsl): bits 0–2 the drawn edges, bit 3 a boundary edge, bits 4–7 the fold code of
-/// [`Mesh::outline_hints`], bits 8–10 the edges that may be drawn as outlines.
-pub(crate) fn triangle_info(mesh: &Mesh, edges: EdgeSelection, order: &[u32]) -> Vec<u32> {
-    let mask = mesh.edge_mask(edges);
-    let hints = mesh.outline_hints();
-    let outline = mesh.outline_mask();
-    order
+/// Bit of [`EdgeData::info`]: the triangle's patch is large ([`Patches::large`]).
+const INFO_LARGE_PATCH: u32 = 1 << 11;
+/// First of the three bits of [`EdgeData::info`] that mark the edges the outline pass draws
+/// for a large patch ([`Patches::splat`]).
+const INFO_SPLAT_SHIFT: u32 = 12;
+
+/// A mesh's edge data under one edge selection, in stored order.
+pub(crate) struct EdgeData {
+    /// Per stored triangle, the 4 bytes the passes read (`triangle_info` in common.wgsl):
+    /// bits 0–2 the drawn edges, bit 3 a boundary edge, bits 4–7 the fold code of
+    /// [`Mesh::outline_hints`], bits 8–10 the edges that may be drawn as outlines, bit 11
+    /// a large patch, bits 12–14 the drawn edges the outline pass draws.
+    pub info: Vec<u32>,
+    pub lines: MeshLines,
+}
+
+impl EdgeData {
+    pub fn new(mesh: &Mesh, edges: EdgeSelection, order: &[u32]) -> EdgeData {
+        let mask = mesh.edge_mask(edges);
+        let patches = Patches::new(mesh.edge_neighbours(), &mask);
+        let hints = mesh.outline_hints();
+        let outline = mesh.outline_mask();
+        let info = order
+            .iter()
+            .map(|&t| {
+                let t = t as usize;
+                let large = if patches.large[t] {
+                    INFO_LARGE_PATCH
+                } else {
+                    0
+                };
+                u32::from(mask[t])
+                    | u32::from(hints[t]) << 3
+                    | u32::from(outline[t]) << 8
+                    | large
+                    | u32::from(patches.splat[t]) << INFO_SPLAT_SHIFT
+            })
+            .collect();
+        let lines = MeshLines {
+            undrawn: mask.iter().any(|&m| m != ALL_EDGES),
+            splat: patches.splat.iter().any(|&b| b != 0),
+        };
+        EdgeData { info, lines }
+    }
+}
+
+/// The cluster records the outline pass reads: `bounds` with the spread of each cluster
+/// holding an edge to splat (`info`, stored order) stored as −1 − spread, so the outline
+/// pass visits it whatever the eye (`cluster_splats` in common.wgsl).
+pub(crate) fn cluster_records(bounds: &[[f32; 8]], info: &[u32]) -> Vec<[f32; 8]> {
+    bounds
         .iter()
-        .map(|&t| {
-            let t = t as usize;
-            u32::from(mask[t]) | u32::from(hints[t]) << 3 | u32::from(outline[t]) << 8
+        .zip(info.chunks(CLUSTER as usize))
+        .map(|(b, tris)| {
+            let mut b = *b;
+            if tris.iter().any(|i| i >> INFO_SPLAT_SHIFT & 7 != 0) {
+                b[7] = -1.0 - b[7];
+            }
+            b
         })
         .collect()
 }

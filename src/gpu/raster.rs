@@ -159,7 +159,7 @@ impl RasterFrame {
         style: &Style,
         size: (u32, u32),
     ) -> Result<RasterFrame> {
-        let data = FrameData::new(device, store, scene, style, Window::whole(size), 0)?;
+        let data = FrameData::new(device, store, scene, style, Window::whole(size), false)?;
         let make = |label, format, usage| texture_2d(device, label, size, format, usage);
         use wgpu::TextureUsages as U;
         Ok(RasterFrame {

@@ -201,6 +201,10 @@ pub fn variants() -> Vec<(String, String)> {
                     if colors {
                         flags.push("COLORS");
                     }
+                    // Patch searches with and without outlines, split or not.
+                    if outlines != host {
+                        flags.push("PATCHES");
+                    }
                     for instances in INSTANCE_FLAGS {
                         let mut flags = flags.clone();
                         flags.extend_from_slice(instances);

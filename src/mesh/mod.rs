@@ -9,6 +9,7 @@ pub mod gltf;
 mod load;
 #[cfg(feature = "formats")]
 mod obj;
+pub mod patches;
 #[cfg(feature = "formats")]
 mod ply;
 #[cfg(feature = "formats")]
@@ -24,7 +25,7 @@ pub use obj::load_obj;
 #[cfg(feature = "formats")]
 pub use ply::load_ply;
 pub use procedural::{
-    default_parts, default_scene, grid, layers, sphere, torus, Procedural, LAYER_TRIANGLES,
+    cube, default_parts, default_scene, grid, layers, sphere, torus, Procedural, LAYER_TRIANGLES,
 };
 #[cfg(feature = "formats")]
 pub use stl::load_stl;

@@ -1,0 +1,151 @@
+//! Patches: the regions of a surface that its undrawn edges join. A pixel's nearest line may
+//! belong to another triangle of its patch (the far side of a quad across its diagonal, a
+//! crease a few sub-pixel triangles away), never to a triangle beyond a drawn edge of it, so
+//! the patch bounds the search for it. Small patches (polygons: a quad is two triangles) are
+//! searched per pixel by the edge pass; the drawn edges of large ones (the faces of a
+//! tessellated CAD part in feature mode) are drawn by the outline pass into every pixel in
+//! reach, like outlines.
+
+use super::adjacency::NO_NEIGHBOUR;
+
+/// Most triangles in a patch that the edge pass searches per pixel: a polygon of up to 18
+/// sides. Larger patches have their drawn edges drawn by the outline pass. Twin of
+/// `PATCH_TRIANGLES` in edge_pass.wgsl.
+pub const PATCH_TRIANGLES: usize = 16;
+
+/// A mesh's patches under one edge mask, as the passes use them.
+#[derive(Clone, Debug, Default)]
+pub struct Patches {
+    /// Per triangle, whether its patch is large ([`large_patches`]).
+    pub large: Vec<bool>,
+    /// Per triangle, the drawn edges the outline pass draws ([`splat_edges`]).
+    pub splat: Vec<u8>,
+}
+
+impl Patches {
+    /// The patches of a mesh with edge neighbours `neighbours` under `mask`.
+    pub fn new(neighbours: &[[u32; 3]], mask: &[u8]) -> Patches {
+        let large = large_patches(neighbours, mask);
+        let splat = splat_edges(neighbours, mask, &large);
+        Patches { large, splat }
+    }
+}
+
+/// Per triangle, whether its patch (the triangles joined to it across undrawn edges, an edge
+/// counting as undrawn when either side leaves it out) has more than [`PATCH_TRIANGLES`]
+/// triangles.
+pub fn large_patches(neighbours: &[[u32; 3]], mask: &[u8]) -> Vec<bool> {
+    let n = neighbours.len();
+    let mut parent: Vec<u32> = (0..n as u32).collect();
+    fn root(parent: &mut [u32], mut t: u32) -> u32 {
+        while parent[t as usize] != t {
+            let up = parent[parent[t as usize] as usize];
+            parent[t as usize] = up;
+            t = up;
+        }
+        t
+    }
+    for (t, across) in neighbours.iter().enumerate() {
+        for (i, &u) in across.iter().enumerate() {
+            if mask[t] & (1 << i) == 0 && u != NO_NEIGHBOUR {
+                let (a, b) = (root(&mut parent, t as u32), root(&mut parent, u));
+                if a != b {
+                    parent[a.max(b) as usize] = a.min(b);
+                }
+            }
+        }
+    }
+    let mut size = vec![0u32; n];
+    let roots: Vec<u32> = (0..n as u32).map(|t| root(&mut parent, t)).collect();
+    for &r in &roots {
+        size[r as usize] += 1;
+    }
+    roots
+        .iter()
+        .map(|&r| size[r as usize] as usize > PATCH_TRIANGLES)
+        .collect()
+}
+
+/// Per triangle, the drawn edges (bit `i` for edge `i`) that the outline pass draws because a
+/// large patch lies on one side: each such edge once, from the side with the lower id when
+/// both sides draw it.
+pub fn splat_edges(neighbours: &[[u32; 3]], mask: &[u8], large: &[bool]) -> Vec<u8> {
+    neighbours
+        .iter()
+        .enumerate()
+        .map(|(t, across)| {
+            let mut bits = 0;
+            for (i, &u) in across.iter().enumerate() {
+                if mask[t] & (1 << i) == 0 {
+                    continue;
+                }
+                let other = (u != NO_NEIGHBOUR).then_some(u as usize);
+                if !large[t] && !other.is_some_and(|u| large[u]) {
+                    continue;
+                }
+                let drawn_there = other.is_some_and(|u| {
+                    neighbours[u]
+                        .iter()
+                        .enumerate()
+                        .any(|(j, &back)| back == t as u32 && mask[u] & (1 << j) != 0)
+                });
+                if !drawn_there || other.is_some_and(|u| t < u) {
+                    bits |= 1 << i;
+                }
+            }
+            bits
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A strip of `n` triangles, each joined to the next across edge 1 (and from it across
+    /// edge 2); `cut` says which joins are drawn.
+    fn strip(n: usize) -> Vec<[u32; 3]> {
+        (0..n)
+            .map(|t| {
+                let next = if t + 1 < n {
+                    t as u32 + 1
+                } else {
+                    NO_NEIGHBOUR
+                };
+                let prev = if t > 0 { t as u32 - 1 } else { NO_NEIGHBOUR };
+                [NO_NEIGHBOUR, next, prev]
+            })
+            .collect()
+    }
+
+    #[test]
+    fn patches_join_across_undrawn_edges_only() {
+        let n = 2 * PATCH_TRIANGLES + 4;
+        let neighbours = strip(n);
+        // Joins undrawn everywhere but between triangles 3 and 4.
+        let mut mask = vec![0b001u8; n];
+        mask[3] |= 0b010;
+        mask[4] |= 0b100;
+        let large = large_patches(&neighbours, &mask);
+        assert!(large[..4].iter().all(|&l| !l));
+        assert!(large[4..].iter().all(|&l| l));
+        let splat = splat_edges(&neighbours, &mask, &large);
+        // The drawn join once, from the lower id; the outer sides of the large patch's
+        // triangles; nothing of the small patch beyond the join.
+        assert_eq!(splat[3], 0b010);
+        assert_eq!(splat[4], 0b001);
+        assert!(splat[..3].iter().all(|&b| b == 0));
+        assert!(splat[5..].iter().all(|&b| b == 0b001));
+    }
+
+    #[test]
+    fn a_side_that_leaves_an_edge_out_joins_it() {
+        let neighbours = strip(PATCH_TRIANGLES + 1);
+        let mut mask = vec![0b111u8; PATCH_TRIANGLES + 1];
+        assert!(large_patches(&neighbours, &mask).iter().all(|&l| !l));
+        for m in &mut mask[..PATCH_TRIANGLES] {
+            *m &= !0b010;
+        }
+        assert!(large_patches(&neighbours, &mask).iter().all(|&l| l));
+    }
+}
