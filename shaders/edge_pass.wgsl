@@ -14,6 +14,9 @@
 // within COVERAGE_MARGIN of the triangle's boundary or outside it) are appended to a list
 // instead, and so is the background next to the tiles' foreground.
 //
+// `border_main`, over the output's border pixels: the background there next to foreground
+// in the guard band joins that list.
+//
 // `refine_main`, dispatched indirectly over that list only: the exact coverage search among
 // the neighbourhood's triangles and the walks across edges from them.
 //
@@ -133,43 +136,136 @@ fn empty_pixel(xy: vec2<u32>, inst: u32, outlined: bool) -> Pixel {
     return p;
 }
 
+// Bits of `info` (mesh_store::EdgeData): the triangle's patch is larger than PATCH_TRIANGLES
+// (its drawn edges come from the outline pass), or is two triangles.
+const INFO_LARGE_PATCH: u32 = 2048u;
+const INFO_QUAD: u32 = 32768u;
+
 #if PATCHES
 // Most triangles of a patch searched per pixel. Twin of patches::PATCH_TRIANGLES.
 const PATCH_TRIANGLES: u32 = 16u;
-// Bit of `info`: the triangle's patch is larger (its drawn edges come from the outline pass).
-const INFO_LARGE_PATCH: u32 = 2048u;
+
+// Corner k of a sampled triangle.
+fn sample_corner(s: Sample, k: u32) -> vec3<f32> {
+    return select(select(s.v2.xyz, s.v1.xyz, k == 1u), s.v0.xyz, k == 0u);
+}
+
+// The least distance from `point` to the drawn edges (mask bits) of a triangle with clip-space
+// corners c0, c1, c2, as segments.
+fn drawn_segments(c0: vec4<f32>, c1: vec4<f32>, c2: vec4<f32>, mask: u32, point: vec2<f32>) -> f32 {
+    var best = NO_EDGE;
+    if (mask & 1u) != 0u {
+        best = min(best, segment_distance(c0, c1, point, frame.image_size));
+    }
+    if (mask & 2u) != 0u {
+        best = min(best, segment_distance(c1, c2, point, frame.image_size));
+    }
+    if (mask & 4u) != 0u {
+        best = min(best, segment_distance(c2, c0, point, frame.image_size));
+    }
+    return best;
+}
 
 // Twin of edge_math::patch_distance: pixels from `point` to the nearest drawn edge (as a
-// segment) of the patch around triangle `tri` of `inst`, the triangles reached from it
-// across undrawn edges that are not silhouettes, breadth first; of a large patch, its own
-// drawn edges only.
-fn patch_distance(inst: u32, tri: u32, point: vec2<f32>) -> f32 {
-    let base = instances[slot(inst)].triangle_base;
-    let vbase = instances[slot(inst)].vertex_base;
-    let clip = instances[slot(inst)].clip;
-    let eye = instances[slot(inst)].eye;
-    let large = (info[base + tri] & INFO_LARGE_PATCH) != 0u;
-    var queue: array<u32, PATCH_TRIANGLES>;
-    queue[0] = tri;
-    var count = 1u;
+// segment) of the (small) patch around the sampled triangle `s`, the triangles reached from it
+// across undrawn edges that are not silhouettes, breadth first. Quads take quad_distance,
+// larger polygons patch_search.
+fn patch_distance(s: Sample, point: vec2<f32>) -> f32 {
+    let bits = info[instances[slot(s.inst)].triangle_base + s.tri];
+    if (bits & INFO_QUAD) != 0u {
+        return quad_distance(s, point);
+    }
+    var best = drawn_segments(s.clip0, s.clip1, s.clip2, bits & 7u, point);
+    // A loop no lane enters is skipped (and so are the search's arrays), while the body of an
+    // `if` runs for every lane.
+    for (var polygon = true; polygon; polygon = false) {
+        best = min(best, patch_search(s, point));
+    }
+    return best;
+}
+
+// patch_distance for a patch of two triangles (a quad): the drawn edges of the sampled one
+// and of the other one, across the undrawn edge that joins them, unless that is a
+// silhouette. What the search finds, without its queue.
+fn quad_distance(s: Sample, point: vec2<f32>) -> f32 {
+    let base = instances[slot(s.inst)].triangle_base;
+    let vbase = instances[slot(s.inst)].vertex_base;
+    let clip = instances[slot(s.inst)].clip;
+    let eye = instances[slot(s.inst)].eye;
+    let bits = info[base + s.tri];
+    var best = drawn_segments(s.clip0, s.clip1, s.clip2, bits & 7u, point);
+    var i = 0u;
+    var n = BACKGROUND_ID;
+    for (var e = 0u; e < 3u; e++) {
+        if (bits & (1u << e)) == 0u {
+            let m = neighbour(base + s.tri, e);
+            if m != BACKGROUND_ID {
+                i = e;
+                n = m;
+            }
+        }
+    }
+    if n != BACKGROUND_ID {
+        let w = corners(base + n) + vbase;
+        let q0 = vertex_at(w.x).xyz;
+        let q1 = vertex_at(w.y).xyz;
+        let q2 = vertex_at(w.z).xyz;
+        let a = sample_corner(s, i);
+        let b = sample_corner(s, (i + 1u) % 3u);
+        let c = sample_corner(s, (i + 2u) % 3u);
+        if !is_silhouette(a, b, c, (q0 + q1 + q2) / 3.0, eye) {
+            let c0 = clip * vec4<f32>(q0, 1.0);
+            let c1 = clip * vec4<f32>(q1, 1.0);
+            let c2 = clip * vec4<f32>(q2, 1.0);
+            best = min(best, drawn_segments(c0, c1, c2, info[base + n] & 7u, point));
+        }
+    }
+    return best;
+}
+
+// The breadth-first search of patch_distance from the sampled triangle `s`, for patches of
+// more than two triangles: the least distance to the drawn edges of the other triangles.
+// Each triangle is read once, when it joins the patch; a triangle's neighbours are read only
+// across its undrawn edges, and its corners again only when one of them is new.
+fn patch_search(s: Sample, point: vec2<f32>) -> f32 {
+    let base = instances[slot(s.inst)].triangle_base;
+    let vbase = instances[slot(s.inst)].vertex_base;
+    let clip = instances[slot(s.inst)].clip;
+    let eye = instances[slot(s.inst)].eye;
     var best = NO_EDGE;
+    var queue: array<u32, PATCH_TRIANGLES>;
+    queue[0] = s.tri;
+    var count = 1u;
     for (var k = 0u; k < count; k++) {
         let t = queue[k];
         let mask = info[base + t] & 7u;
-        let v = corners(base + t) + vbase;
-        let p = array<vec3<f32>, 3>(vertex_at(v.x).xyz, vertex_at(v.y).xyz, vertex_at(v.z).xyz);
-        let c = array<vec4<f32>, 3>(clip * vec4<f32>(p[0], 1.0), clip * vec4<f32>(p[1], 1.0), clip * vec4<f32>(p[2], 1.0));
+        // The triangles across t's undrawn edges not yet in the patch.
+        var next = vec3<u32>(BACKGROUND_ID);
+        var fresh = false;
         for (var i = 0u; i < 3u; i++) {
-            let j = (i + 1u) % 3u;
-            if (mask & (1u << i)) != 0u {
-                best = min(best, segment_distance(c[i], c[j], point, frame.image_size));
-                continue;
+            if (mask & (1u << i)) == 0u {
+                let n = neighbour(base + t, i);
+                var seen = n == BACKGROUND_ID;
+                for (var q = 0u; q < count; q++) {
+                    seen = seen || queue[q] == n;
+                }
+                if !seen {
+                    next[i] = n;
+                    fresh = true;
+                }
             }
-            if large || count >= PATCH_TRIANGLES {
-                continue;
-            }
-            let n = neighbour(base + t, i);
-            var seen = n == BACKGROUND_ID;
+        }
+        if !fresh {
+            continue;
+        }
+        var p = array<vec3<f32>, 3>(s.v0.xyz, s.v1.xyz, s.v2.xyz);
+        if k > 0u {
+            let v = corners(base + t) + vbase;
+            p = array<vec3<f32>, 3>(vertex_at(v.x).xyz, vertex_at(v.y).xyz, vertex_at(v.z).xyz);
+        }
+        for (var i = 0u; i < 3u; i++) {
+            let n = next[i];
+            var seen = n == BACKGROUND_ID || count >= PATCH_TRIANGLES;
             for (var q = 0u; q < count; q++) {
                 seen = seen || queue[q] == n;
             }
@@ -177,10 +273,16 @@ fn patch_distance(inst: u32, tri: u32, point: vec2<f32>) -> f32 {
                 continue;
             }
             let w = corners(base + n) + vbase;
-            let d = (vertex_at(w.x).xyz + vertex_at(w.y).xyz + vertex_at(w.z).xyz) / 3.0;
-            if !is_silhouette(p[i], p[j], p[(i + 2u) % 3u], d, eye) {
+            let q0 = vertex_at(w.x).xyz;
+            let q1 = vertex_at(w.y).xyz;
+            let q2 = vertex_at(w.z).xyz;
+            if !is_silhouette(p[i], p[(i + 1u) % 3u], p[(i + 2u) % 3u], (q0 + q1 + q2) / 3.0, eye) {
                 queue[count] = n;
                 count++;
+                let c0 = clip * vec4<f32>(q0, 1.0);
+                let c1 = clip * vec4<f32>(q1, 1.0);
+                let c2 = clip * vec4<f32>(q2, 1.0);
+                best = min(best, drawn_segments(c0, c1, c2, info[base + n] & 7u, point));
             }
         }
     }
@@ -188,29 +290,51 @@ fn patch_distance(inst: u32, tri: u32, point: vec2<f32>) -> f32 {
 }
 #endif
 
-// A pixel whose centre triangle `s` covers: the stronger of the triangle's own line and the
-// outline pass's colours it, equal ones going to the nearer.
-fn surface_pixel(xy: vec2<u32>, s: Sample) -> Pixel {
-    var p: Pixel;
-    p.inst = s.inst;
-    p.tri = s.tri;
-    let outline = outline_at(xy);
-    let inst = s.inst;
-    let flags = instances[slot(inst)].flags;
-    var mask = info[instances[slot(inst)].triangle_base + s.tri] & 7u;
+// The distance from the sample's point to its triangle's drawn edges (their lines), and
+// whether the pixel's patch must be searched instead (PATCHES): where an undrawn edge is
+// nearer than the line's reach and the drawn edges, the nearest line may lie beyond it (and
+// the line of a drawn edge pass closer than the edge). A large patch's pixels there take
+// their lines from the outline pass, which draws its drawn edges.
+struct Own {
+    distance: f32,
+    search: bool,
+    // The patch is a quad (quad_distance suffices).
+    quad: bool,
+}
+
+fn own_lines(s: Sample) -> Own {
+    let flags = instances[slot(s.inst)].flags;
+    let bits = info[instances[slot(s.inst)].triangle_base + s.tri];
+    var mask = bits & 7u;
     if (flags & INSTANCE_EDGES) == 0u {
         mask = 0u;
     }
     let near = vec3<f32>(s.clip0.z, s.clip1.z, s.clip2.z);
     let d = drawn_distances(s.lines, near, mask);
-    var own = min(d.x, min(d.y, d.z));
-#if PATCHES
-    // Where an undrawn edge is within the line's reach, the nearest line may lie beyond it.
+    var own = Own(min(d.x, min(d.y, d.z)), false, false);
     let u = drawn_distances(s.lines, near, ~mask & 7u);
-    if (flags & INSTANCE_EDGES) != 0u && min(u.x, min(u.y, u.z)) < line_reach(instances[slot(inst)].line_width) {
-        own = patch_distance(inst, s.tri, pixel_centre(xy));
+    let reach = line_reach(instances[slot(s.inst)].line_width);
+    let beyond = (flags & INSTANCE_EDGES) != 0u && min(u.x, min(u.y, u.z)) < min(own.distance, reach);
+    let large = (bits & INFO_LARGE_PATCH) != 0u;
+    if beyond && large {
+        own.distance = NO_EDGE;
     }
+#if PATCHES
+    own.search = beyond && !large;
+    own.quad = (bits & INFO_QUAD) != 0u;
 #endif
+    return own;
+}
+
+// A pixel whose centre triangle `s` covers, `own` pixels from a line of its own triangle or
+// patch: the stronger of that line and the outline pass's colours it, equal ones going to the
+// nearer.
+fn surface_pixel(xy: vec2<u32>, s: Sample, own: f32) -> Pixel {
+    var p: Pixel;
+    p.inst = s.inst;
+    p.tri = s.tri;
+    let outline = outline_at(xy);
+    let inst = s.inst;
     let b = s.bary;
     let local = b.x * s.v0.xyz + b.y * s.v1.xyz + b.z * s.v2.xyz;
     let view_depth = dot(instances[slot(inst)].fade_row, vec4<f32>(local, 1.0));
@@ -290,20 +414,6 @@ fn classify_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(workgro
 #endif
     if inside && empty {
         store_pixel(xy, empty_pixel(xy, raster, outlined));
-        // Background on the output's border next to foreground in the guard band, which no
-        // listed tile lists: it lists itself. Lanes away from the border never enter the
-        // loop, and a loop no lane enters costs nothing.
-        let q = vec2<i32>(xy);
-        let first = vec2<i32>(frame.output_offset);
-        let last = vec2<i32>(frame.output_offset + frame.output_size) - 1;
-        let border = any(q == first) || any(q == last);
-        for (var i = select(4u, 0u, border); i < 4u; i++) {
-            let n = q + neighbour_offset(i);
-            if (any(n < first) || any(n > last)) && id_at(n).x < HOST_ID {
-                refine_later(xy);
-                break;
-            }
-        }
     }
     // The first foreground pixel of a tile lists it: the tile's mark, after the list, is
     // cleared each frame (a workgroup barrier and vote would cost every tile).
@@ -341,6 +451,39 @@ fn refine_later(xy: vec2<u32>) {
     atomicMax(&work_rw.y, size.y);
 }
 
+// The background on the output's border next to foreground in the guard band, which no
+// listed tile lists (tile_main lists the background beside its own foreground): one
+// invocation per border pixel (top row, bottom row, left column, right column) lists it for
+// refine_main.
+@compute @workgroup_size(64)
+fn border_main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let size = vec2<u32>(frame.output_size);
+    let k = gid.x;
+    var at = vec2<u32>(k, 0u);
+    if k >= 2u * (size.x + size.y) {
+        return;
+    } else if k >= 2u * size.x + size.y {
+        at = vec2<u32>(size.x - 1u, k - 2u * size.x - size.y);
+    } else if k >= 2u * size.x {
+        at = vec2<u32>(0u, k - 2u * size.x);
+    } else if k >= size.x {
+        at = vec2<u32>(k - size.x, size.y - 1u);
+    }
+    let q = vec2<i32>(at + vec2<u32>(frame.output_offset));
+    if id_at(q).x < HOST_ID {
+        return;
+    }
+    let first = vec2<i32>(frame.output_offset);
+    let last = vec2<i32>(frame.output_offset + frame.output_size) - 1;
+    for (var i = 0u; i < 4u; i++) {
+        let n = q + neighbour_offset(i);
+        if (any(n < first) || any(n > last)) && id_at(n).x < HOST_ID {
+            refine_later(vec2<u32>(q));
+            return;
+        }
+    }
+}
+
 @compute @workgroup_size(8, 8)
 fn tile_main(@builtin(local_invocation_id) local: vec3<u32>, @builtin(workgroup_id) group: vec3<u32>) {
     let t = list_group(group);
@@ -357,12 +500,30 @@ fn tile_main(@builtin(local_invocation_id) local: vec3<u32>, @builtin(workgroup_
             s = sample(raster.x, raster.y, pixel_centre(xy));
         }
         let certain = foreground && s.covers && s.margin >= COVERAGE_MARGIN;
+        var own = Own(NO_EDGE, false, false);
         if certain {
-            store_pixel(xy, surface_pixel(xy, s));
+            own = own_lines(s);
+#if PATCHES
+            // Near a quad's diagonal the other triangle's edges count too; larger polygons
+            // (rarer, and the search's queue would slow every quad) are searched by
+            // refine_main. Loops, not `if`s: a software rasterizer skips a loop no lane
+            // enters, but runs the body of an `if` for every lane.
+            for (var quad = own.search && own.quad; quad; quad = false) {
+                own.distance = quad_distance(s, pixel_centre(xy));
+            }
+#endif
+            if !own.search || own.quad {
+                store_pixel(xy, surface_pixel(xy, s, own.distance));
+            }
         }
+#if PATCHES
+        for (var later = certain && own.search && !own.quad; later; later = false) {
+            refine_later(xy);
+        }
+#endif
         // Pixels for refine_main: bit 4 this one, where the exact test could not decide it;
         // bits 0-3 the background next to it (left, right, up, down) in the output, which
-        // may hold a triangle the rasterizer missed (classify_main lists the background
+        // may hold a triangle the rasterizer missed (border_main lists the background
         // next to foreground in the guard band).
         let q = vec2<i32>(xy);
         let first = vec2<i32>(frame.output_offset);
@@ -390,7 +551,15 @@ fn tile_main(@builtin(local_invocation_id) local: vec3<u32>, @builtin(workgroup_
 // BACKGROUND_ID or HOST_ID for none).
 fn finish(xy: vec2<u32>, s: Sample) -> Pixel {
     if s.inst < HOST_ID {
-        return surface_pixel(xy, s);
+        var own = own_lines(s);
+#if PATCHES
+        // A loop, not an `if`: a software rasterizer skips a loop no lane enters, but runs
+        // the body of an `if` for every lane.
+        for (var search = own.search; search; search = false) {
+            own.distance = patch_distance(s, pixel_centre(xy));
+        }
+#endif
+        return surface_pixel(xy, s, own.distance);
     }
     return empty_pixel(xy, s.inst, true);
 }

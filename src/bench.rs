@@ -52,7 +52,7 @@ pub struct Run {
     /// Method name.
     pub method: String,
     /// GPU time of each pass, and of each group of passes: `edge` is the sum of its
-    /// dispatches (`edge.classify`, `edge.tiles`, `edge.refine`; the floor's `edge.floor`),
+    /// dispatches (`edge.classify`, `edge.border`, `edge.tiles`, `edge.refine`; the floor's `edge.floor`),
     /// `outline` of `outline.cull` and `outline.draw`.
     pub passes: BTreeMap<String, Stats>,
     /// Median over frames of the sum of the passes.
@@ -259,7 +259,7 @@ pub fn bench_scene(
     subjects.push(Subject::TwoPass(two_pass, frame, attachment()));
     ctx.finish()?;
 
-    let mut timer = GpuTimer::new(device, queue, 6)?;
+    let mut timer = GpuTimer::new(device, queue, 8)?;
     let mut gpu: Vec<BTreeMap<String, Vec<f64>>> = vec![BTreeMap::new(); subjects.len()];
     let mut totals = vec![Vec::new(); subjects.len()];
     let mut cpu = vec![Vec::new(); subjects.len()];

@@ -11,7 +11,7 @@ use crate::scene_file::FileCamera;
 use glam::{DVec3, Vec3};
 use std::path::Path;
 
-/// Loads one mesh from `spec`: a procedural name (`sphere:N`, `grid:N`, `torus:N`,
+/// Loads one mesh from `spec`: a procedural name (`sphere:N`, `grid:N`, `torus:N`, `cube:N`,
 /// `layers:K`), a mesh file (OBJ, STL, PLY or glTF, by extension: see [`mesh::load`]), or,
 /// when `None`, the built-in default scene as one mesh.
 pub fn load_mesh(spec: Option<&str>) -> Result<Mesh> {

@@ -193,11 +193,9 @@ pub struct PatchTriangle {
 /// (as a segment) of the patch around `start`, the triangles reached from it across undrawn
 /// edges that are not silhouettes from `eye` (beyond a silhouette the surface folds back
 /// under itself, and its edges there are hidden). A search of at most
-/// [`PATCH_TRIANGLES`](crate::mesh::patches::PATCH_TRIANGLES) triangles, breadth first; with
-/// `large`, the start's own drawn edges only.
+/// [`PATCH_TRIANGLES`](crate::mesh::patches::PATCH_TRIANGLES) triangles, breadth first.
 pub fn patch_distance(
     start: u32,
-    large: bool,
     eye: DVec4,
     pixel: DVec2,
     size: DVec2,
@@ -217,7 +215,7 @@ pub fn patch_distance(
                 continue;
             }
             let n = t.neighbours[i];
-            if large || queue.len() >= cap || n == u32::MAX || queue.contains(&n) {
+            if queue.len() >= cap || n == u32::MAX || queue.contains(&n) {
                 continue;
             }
             let d = triangle(n).local;
@@ -363,10 +361,8 @@ mod tests {
         let pixel = DVec2::new(100.5, 54.5);
         let own = edge_eval(triangle(0).clip, 0b011, pixel, SIZE).min_distance();
         assert!((own - 9.5).abs() < 1e-9);
-        let d = patch_distance(0, false, eye, pixel, SIZE, triangle);
+        let d = patch_distance(0, eye, pixel, SIZE, triangle);
         assert!((d - 5.5).abs() < 1e-9, "{d}");
-        // A large patch has only its own edges searched.
-        assert!((patch_distance(0, true, eye, pixel, SIZE, triangle) - 9.5).abs() < 1e-9);
         // Beyond an end of the bottom edge the distance is to its end, not its line.
         let d = segment_distance(clip[2], clip[3], DVec2::new(113.5, 64.5), SIZE);
         assert!((d - 3.5f64.hypot(4.5)).abs() < 1e-9, "{d}");
@@ -382,7 +378,7 @@ mod tests {
         };
         let centroid = (local[0] + local[2] + over) / 3.0;
         assert!(is_silhouette(local[2], local[0], local[1], centroid, eye));
-        assert!((patch_distance(0, false, eye, pixel, SIZE, folded) - 9.5).abs() < 1e-9);
+        assert!((patch_distance(0, eye, pixel, SIZE, folded) - 9.5).abs() < 1e-9);
     }
 
     #[test]

@@ -23,7 +23,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Render a scene (a SCENE.json file, a glTF or GLB file, an OBJ, STL or PLY file,
-    /// `sphere:N`, `grid:N`, `torus:N`, `layers:K`, or the built-in scene).
+    /// `sphere:N`, `grid:N`, `torus:N`, `cube:N`, `layers:K`, or the built-in scene).
     Render(RenderArgs),
     /// Render one scene with the CPU ray-cast ground truth and every GPU method, and report
     /// how closely each matches it (images, error maps, sheet.png, report.json).
@@ -44,7 +44,7 @@ fn parse_edges(s: &str) -> std::result::Result<EdgeSelection, String> {
 struct SceneArgs {
     /// Scene file (.json: objects with transforms and styles, and a camera), glTF scene
     /// (.gltf, .glb: its meshes, nodes and cameras), OBJ, STL or PLY file, or procedural
-    /// mesh (`sphere:20000`, `grid:1k`, `torus:5000`); default: the built-in scene.
+    /// mesh (`sphere:20000`, `grid:1k`, `torus:5000`, `cube:2M`); default: the built-in scene.
     mesh: Option<String>,
     /// Image size WIDTHxHEIGHT.
     #[arg(long, default_value = "800x600")]

@@ -759,25 +759,30 @@ impl Truth<'_> {
         let size = self.rays.size();
         let e = edge_math::edge_eval(clip, mask, pixel, size);
         let mut own = e.min_distance();
-        // Twin of the patch search in `surface_pixel` (edge_pass.wgsl): where an undrawn
-        // edge of the triangle is within the line's reach, the nearest line may lie beyond it.
+        // Twin of `own_lines` (edge_pass.wgsl): where an undrawn edge of the triangle is
+        // nearer than the line's reach and the drawn edges, the nearest line may lie beyond
+        // it: in a small patch, the search finds it; a large patch's lines are in the outline
+        // map.
         let undrawn = edge_math::edge_eval(clip, !mask & ALL_EDGES, pixel, size).min_distance();
-        if st.edges && undrawn < style::line_reach(st.width) {
-            let first = self.caster.first_ids()[hit.object as usize];
-            let mesh = &wm.mesh;
-            let triangle = |t: u32| {
-                let local =
-                    mesh.triangles()[t as usize].map(|v| mesh.positions()[v as usize].as_dvec3());
-                edge_math::PatchTriangle {
-                    local,
-                    clip: self.caster.corners(first + t).map(|p| self.rays.clip(p)),
-                    mask: self.masks[object.mesh][t as usize],
-                    neighbours: mesh.edge_neighbours()[t as usize],
-                }
+        if st.edges && undrawn < style::line_reach(st.width).min(own) {
+            own = if self.patches[object.mesh].large[hit.tri as usize] {
+                edge_math::NO_EDGE
+            } else {
+                let first = self.caster.first_ids()[hit.object as usize];
+                let mesh = &wm.mesh;
+                let triangle = |t: u32| {
+                    let local = mesh.triangles()[t as usize]
+                        .map(|v| mesh.positions()[v as usize].as_dvec3());
+                    edge_math::PatchTriangle {
+                        local,
+                        clip: self.caster.corners(first + t).map(|p| self.rays.clip(p)),
+                        mask: self.masks[object.mesh][t as usize],
+                        neighbours: mesh.edge_neighbours()[t as usize],
+                    }
+                };
+                let eye = self.eyes[hit.object as usize];
+                edge_math::patch_distance(hit.tri, eye, pixel, size, triangle)
             };
-            let large = self.patches[object.mesh].large[hit.tri as usize];
-            let eye = self.eyes[hit.object as usize];
-            own = edge_math::patch_distance(hit.tri, large, eye, pixel, size, triangle);
         }
         let c = self.rays.clip(hit.point);
         let depth = (c.z / c.w).clamp(0.0, 1.0);

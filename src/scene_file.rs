@@ -13,7 +13,7 @@
 //! ```
 //!
 //! - `mesh`: a path relative to the scene file, or a procedural mesh (`sphere:N`, `grid:N`,
-//!   `torus:N`, `layers:K`). Objects naming the same mesh with the same edges share it.
+//!   `torus:N`, `cube:N`, `layers:K`). Objects naming the same mesh with the same edges share it.
 //! - `transform`: 16 numbers, column-major, or `{"translate", "rotate_deg", "scale"}` (each
 //!   optional): `rotate_deg` turns about X, then Y, then Z (R = Rz·Ry·Rx), `scale` is three
 //!   numbers or one, and the transform is T·R·S.

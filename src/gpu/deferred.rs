@@ -95,6 +95,7 @@ struct Variant {
 
 struct EdgePipelines {
     classify: Compute,
+    border: Compute,
     tiles: Compute,
     refine: Compute,
 }
@@ -485,30 +486,31 @@ impl DeferredPass {
             r.extend_from_slice(&out);
             r
         };
-        let mut classify_res = vec![Res::TilesRw, Res::WorkRw];
+        let mut classify_res = vec![Res::TilesRw];
         if v.outlines {
             classify_res.push(Res::OutlineTiles);
         }
         let classify = Compute::new(device, &module, "classify_main", with(&classify_res), color)?;
+        let border = Compute::new(device, &module, "border_main", with(&[Res::WorkRw]), color)?;
         let mut tile_res = vec![Res::Tiles, Res::WorkRw];
+        let mut neighbours = vec![Res::Neighbours];
+        if v.split {
+            neighbours.push(Res::NeighboursHi);
+        }
         if v.patches {
-            // The patch search walks across undrawn edges.
-            tile_res.push(Res::Neighbours);
-            if v.split {
-                tile_res.push(Res::NeighboursHi);
-            }
+            // A quad's search crosses its diagonal.
+            tile_res.extend_from_slice(&neighbours);
         }
         let tiles = Compute::new(device, &module, "tile_main", with(&tile_res), color)?;
-        let mut refine_res = with(&[Res::Work, Res::Neighbours]);
-        if v.split {
-            refine_res.push(Res::NeighboursHi);
-        }
+        let mut refine_res = with(&[Res::Work]);
+        refine_res.extend_from_slice(&neighbours);
         let refine = Compute::new(device, &module, "refine_main", refine_res, color)?;
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(Error::Device(format!("building the edge pass: {e}")));
         }
         let p = Arc::new(EdgePipelines {
             classify,
+            border,
             tiles,
             refine,
         });
@@ -576,7 +578,7 @@ impl DeferredPass {
 
     /// [`encode`](Self::encode) with GPU timestamps around each pass, named
     /// `"visibility"`, `"outline.cull"` and `"outline.draw"` (when outlines are drawn), and
-    /// `"edge.classify"`, `"edge.tiles"` and `"edge.refine"`, in `timer`.
+    /// `"edge.classify"`, `"edge.border"`, `"edge.tiles"` and `"edge.refine"`, in `timer`.
     pub fn encode_timed(
         &self,
         device: &wgpu::Device,
@@ -723,9 +725,39 @@ impl DeferredPass {
             let n = self.results.fetch_add(1, Ordering::Relaxed) + 1;
             frame.encoded.store(n, Ordering::Relaxed);
         }
-        let classify = edge.classify.bind(device, &sources)?;
-        let tiles = edge.tiles.bind(device, &sources)?;
-        let refine = edge.refine.bind(device, &sources)?;
+        /// How a dispatch is sized: over the output in 8×8 tiles, over the output's border
+        /// pixels, or by a list the dispatch before it wrote.
+        enum Size<'b> {
+            Tiles,
+            Border,
+            List(&'b wgpu::Buffer),
+        }
+        let dispatches = [
+            (
+                "wirepass edge classify",
+                "edge.classify",
+                &edge.classify,
+                Size::Tiles,
+            ),
+            (
+                "wirepass edge border",
+                "edge.border",
+                &edge.border,
+                Size::Border,
+            ),
+            (
+                "wirepass edge tiles",
+                "edge.tiles",
+                &edge.tiles,
+                Size::List(&t.tiles),
+            ),
+            (
+                "wirepass edge refine",
+                "edge.refine",
+                &edge.refine,
+                Size::List(&t.work),
+            ),
+        ];
         encoder.clear_buffer(&t.tiles, 0, None);
         encoder.copy_buffer_to_buffer(&self.reset, 0, &t.tiles, 0, LIST_HEADER);
         let marks = LIST_HEADER + 4 * u64::from(t.size.0) * u64::from(t.size.1);
@@ -733,45 +765,18 @@ impl DeferredPass {
         encoder.copy_buffer_to_buffer(&self.reset, 0, &t.work, 0, LIST_HEADER);
         // Each dispatch is a pass of its own, timed on its own (the benchmark sums the
         // `edge.*` spans into the edge pass).
-        let dispatches: [(
-            &str,
-            &str,
-            &Compute,
-            &wgpu::BindGroup,
-            Option<&wgpu::Buffer>,
-        ); 3] = [
-            (
-                "wirepass edge classify",
-                "edge.classify",
-                &edge.classify,
-                &classify,
-                None,
-            ),
-            (
-                "wirepass edge tiles",
-                "edge.tiles",
-                &edge.tiles,
-                &tiles,
-                Some(&t.tiles),
-            ),
-            (
-                "wirepass edge refine",
-                "edge.refine",
-                &edge.refine,
-                &refine,
-                Some(&t.work),
-            ),
-        ];
-        for (label, span, pipeline, group, indirect) in dispatches {
+        for (label, span, pipeline, size) in dispatches {
+            let group = pipeline.bind(device, &sources)?;
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some(label),
                 timestamp_writes: timer.as_deref_mut().and_then(|t| t.compute_span(span)),
             });
             pass.set_pipeline(&pipeline.pipeline);
-            pass.set_bind_group(0, group, &[]);
-            match indirect {
-                Some(list) => pass.dispatch_workgroups_indirect(list, 0),
-                None => pass.dispatch_workgroups(w.div_ceil(TILE), h.div_ceil(TILE), 1),
+            pass.set_bind_group(0, &group, &[]);
+            match size {
+                Size::Tiles => pass.dispatch_workgroups(w.div_ceil(TILE), h.div_ceil(TILE), 1),
+                Size::Border => pass.dispatch_workgroups((2 * (w + h)).div_ceil(64), 1, 1),
+                Size::List(list) => pass.dispatch_workgroups_indirect(list, 0),
             }
         }
         Ok(())

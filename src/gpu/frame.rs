@@ -232,8 +232,8 @@ pub(crate) struct FrameData {
     /// Whether the outline pass runs: an instance draws outlines, or edges of a mesh with
     /// large patches.
     pub outlines: bool,
-    /// Whether an instance draws the edges of a mesh with undrawn edges (the edge pass then
-    /// searches patches).
+    /// Whether an instance draws the edges of a mesh with small patches (the edge pass then
+    /// searches them).
     pub patches: bool,
     /// Whether instances differ in line colour (the outline pass then keeps, per pixel,
     /// which instance's line it holds).
@@ -297,7 +297,7 @@ impl FrameData {
             let draws_edges = s.edges.unwrap_or(true);
             // The outline pass also draws the edges of large patches.
             outlines |= draws_outline || (draws_edges && mesh.lines.splat);
-            patches |= draws_edges && mesh.lines.undrawn;
+            patches |= draws_edges && mesh.lines.small_patches;
             let flags = if draws_edges { INSTANCE_EDGES } else { 0 }
                 | if draws_outline { INSTANCE_OUTLINES } else { 0 };
             let record = instance_record(

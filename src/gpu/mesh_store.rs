@@ -18,7 +18,11 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 use crate::error::{Error, Result};
-use crate::mesh::{adjacency::NO_NEIGHBOUR, patches::Patches, EdgeSelection, Mesh, ALL_EDGES};
+use crate::mesh::{
+    adjacency::NO_NEIGHBOUR,
+    patches::{self, Patches},
+    EdgeSelection, Mesh, ALL_EDGES,
+};
 use glam::{DMat4, DVec3, Vec2, Vec3};
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::sync::Arc;
@@ -74,8 +78,9 @@ pub(crate) struct MeshRecord {
 /// What a mesh's edge selection asks of the passes beyond each triangle's own edges.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub(crate) struct MeshLines {
-    /// Some edge is undrawn: pixels near one search their patch (`patch_distance`).
-    pub undrawn: bool,
+    /// Some triangle of a small patch has an undrawn edge: pixels near one search their
+    /// patch (`patch_distance`).
+    pub small_patches: bool,
     /// Some drawn edge borders a large patch: the outline pass draws it.
     pub splat: bool,
 }
@@ -689,13 +694,17 @@ const INFO_LARGE_PATCH: u32 = 1 << 11;
 /// First of the three bits of [`EdgeData::info`] that mark the edges the outline pass draws
 /// for a large patch ([`Patches::splat`]).
 const INFO_SPLAT_SHIFT: u32 = 12;
+/// Bit of [`EdgeData::info`]: the triangle's patch is a quad (two triangles), which the edge
+/// pass searches without a queue.
+const INFO_QUAD: u32 = 1 << 15;
 
 /// A mesh's edge data under one edge selection, in stored order.
 pub(crate) struct EdgeData {
     /// Per stored triangle, the 4 bytes the passes read (`triangle_info` in common.wgsl):
     /// bits 0–2 the drawn edges, bit 3 a boundary edge, bits 4–7 the fold code of
     /// [`Mesh::outline_hints`], bits 8–10 the edges that may be drawn as outlines, bit 11
-    /// a large patch, bits 12–14 the drawn edges the outline pass draws.
+    /// a large patch, bits 12–14 the drawn edges the outline pass draws, bit 15 a patch of
+    /// two triangles.
     pub info: Vec<u32>,
     pub lines: MeshLines,
 }
@@ -703,7 +712,17 @@ pub(crate) struct EdgeData {
 impl EdgeData {
     pub fn new(mesh: &Mesh, edges: EdgeSelection, order: &[u32]) -> EdgeData {
         let mask = mesh.edge_mask(edges);
-        let patches = Patches::new(mesh.edge_neighbours(), &mask);
+        let neighbours = mesh.edge_neighbours();
+        let mut patches = Patches::new(neighbours, &mask);
+        // Each edge splatted from the side with the lower stored id, the side the outline
+        // pass draws a silhouette from.
+        let mut stored = vec![0u32; order.len()];
+        for (s, &t) in order.iter().enumerate() {
+            stored[t as usize] = s as u32;
+        }
+        patches.splat = patches::splat_edges_by(neighbours, &mask, &patches.large, |t, u| {
+            stored[t] < stored[u]
+        });
         let hints = mesh.outline_hints();
         let outline = mesh.outline_mask();
         let info = order
@@ -715,15 +734,20 @@ impl EdgeData {
                 } else {
                     0
                 };
+                let quad = if patches.size[t] == 2 { INFO_QUAD } else { 0 };
                 u32::from(mask[t])
                     | u32::from(hints[t]) << 3
                     | u32::from(outline[t]) << 8
                     | large
                     | u32::from(patches.splat[t]) << INFO_SPLAT_SHIFT
+                    | quad
             })
             .collect();
         let lines = MeshLines {
-            undrawn: mask.iter().any(|&m| m != ALL_EDGES),
+            small_patches: mask
+                .iter()
+                .zip(&patches.large)
+                .any(|(&m, &large)| m != ALL_EDGES && !large),
             splat: patches.splat.iter().any(|&b| b != 0),
         };
         EdgeData { info, lines }

@@ -18,6 +18,9 @@ pub const PATCH_TRIANGLES: usize = 16;
 pub struct Patches {
     /// Per triangle, whether its patch is large ([`large_patches`]).
     pub large: Vec<bool>,
+    /// Per triangle, the triangles in its patch, up to [`PATCH_TRIANGLES`] + 1 (for any
+    /// large patch).
+    pub size: Vec<u8>,
     /// Per triangle, the drawn edges the outline pass draws ([`splat_edges`]).
     pub splat: Vec<u8>,
 }
@@ -25,9 +28,13 @@ pub struct Patches {
 impl Patches {
     /// The patches of a mesh with edge neighbours `neighbours` under `mask`.
     pub fn new(neighbours: &[[u32; 3]], mask: &[u8]) -> Patches {
-        let large = large_patches(neighbours, mask);
+        let size = patch_sizes(neighbours, mask);
+        let large: Vec<bool> = size
+            .iter()
+            .map(|&n| usize::from(n) > PATCH_TRIANGLES)
+            .collect();
         let splat = splat_edges(neighbours, mask, &large);
-        Patches { large, splat }
+        Patches { large, size, splat }
     }
 }
 
@@ -35,6 +42,15 @@ impl Patches {
 /// counting as undrawn when either side leaves it out) has more than [`PATCH_TRIANGLES`]
 /// triangles.
 pub fn large_patches(neighbours: &[[u32; 3]], mask: &[u8]) -> Vec<bool> {
+    patch_sizes(neighbours, mask)
+        .iter()
+        .map(|&n| usize::from(n) > PATCH_TRIANGLES)
+        .collect()
+}
+
+/// Per triangle, how many triangles its patch has (see [`large_patches`]), counted up to
+/// [`PATCH_TRIANGLES`] + 1.
+pub fn patch_sizes(neighbours: &[[u32; 3]], mask: &[u8]) -> Vec<u8> {
     let n = neighbours.len();
     let mut parent: Vec<u32> = (0..n as u32).collect();
     fn root(parent: &mut [u32], mut t: u32) -> u32 {
@@ -62,7 +78,7 @@ pub fn large_patches(neighbours: &[[u32; 3]], mask: &[u8]) -> Vec<bool> {
     }
     roots
         .iter()
-        .map(|&r| size[r as usize] as usize > PATCH_TRIANGLES)
+        .map(|&r| size[r as usize].min(PATCH_TRIANGLES as u32 + 1) as u8)
         .collect()
 }
 
@@ -70,6 +86,18 @@ pub fn large_patches(neighbours: &[[u32; 3]], mask: &[u8]) -> Vec<bool> {
 /// large patch lies on one side: each such edge once, from the side with the lower id when
 /// both sides draw it.
 pub fn splat_edges(neighbours: &[[u32; 3]], mask: &[u8], large: &[bool]) -> Vec<u8> {
+    splat_edges_by(neighbours, mask, large, |t, u| t < u)
+}
+
+/// [`splat_edges`], drawing an edge both sides draw from side `t` where `before(t, u)`: the
+/// GPU's outline pass orders triangles as it stores them, so that an edge that is also a
+/// silhouette is drawn once, by the side that draws the silhouette.
+pub fn splat_edges_by(
+    neighbours: &[[u32; 3]],
+    mask: &[u8],
+    large: &[bool],
+    before: impl Fn(usize, usize) -> bool,
+) -> Vec<u8> {
     neighbours
         .iter()
         .enumerate()
@@ -89,7 +117,7 @@ pub fn splat_edges(neighbours: &[[u32; 3]], mask: &[u8], large: &[bool]) -> Vec<
                         .enumerate()
                         .any(|(j, &back)| back == t as u32 && mask[u] & (1 << j) != 0)
                 });
-                if !drawn_there || other.is_some_and(|u| t < u) {
+                if !drawn_there || other.is_some_and(|u| before(t, u)) {
                     bits |= 1 << i;
                 }
             }
@@ -127,6 +155,11 @@ mod tests {
         mask[3] |= 0b010;
         mask[4] |= 0b100;
         let large = large_patches(&neighbours, &mask);
+        let size = patch_sizes(&neighbours, &mask);
+        assert!(size[..4].iter().all(|&n| n == 4));
+        assert!(size[4..]
+            .iter()
+            .all(|&n| usize::from(n) == PATCH_TRIANGLES + 1));
         assert!(large[..4].iter().all(|&l| !l));
         assert!(large[4..].iter().all(|&l| l));
         let splat = splat_edges(&neighbours, &mask, &large);
