@@ -5,13 +5,14 @@
 //! mesh allows as outlines. Pixel p lies at distance d from an outline when d is the distance
 //! from p's centre to the *visible part* of an outline edge's projection: the part in front
 //! of the near plane and not beyond the far one, within the line's reach of the image (an
-//! edge just outside the image draws its line inside), and not hidden by another surface ([`edge_math::nearer`]). Each pixel keeps the line that colours it most
+//! edge just outside the image draws its line inside), and not hidden by another surface
+//! ([`edge_math::nearer`]). Each pixel keeps the line that colours it most
 //! ([`style::line_key`](crate::style::line_key)): the common profile at the object's width,
 //! times the depth fade of that nearest visible point.
 //!
 //! The same map carries the drawn edges of large patches ([`Patches::splat`]) of objects
-//! that draw their edges, by the same definition: the pixels of a large patch find their
-//! lines here, not among their own triangle's edges.
+//! that draw their edges, by the same definition: the pixels of a large patch near an
+//! undrawn edge find their lines here.
 //!
 //! Visibility along an edge is found by casting a ray through points every 1/8 pixel of its
 //! projection and bisecting each change to 2⁻³⁰ of the edge. The GPU pass does the same at

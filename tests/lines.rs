@@ -413,3 +413,47 @@ fn an_edge_just_outside_the_image_draws_its_line_inside() {
         );
     }
 }
+
+#[test]
+fn set_edges_redraws_a_stored_mesh_as_a_fresh_upload_would() {
+    // Uploaded drawing every edge, switched to polygon edges (quads searched per pixel) and
+    // to feature edges (large patches, lines from the outline pass): each frame equals that of
+    // a mesh uploaded with the selection in the first place.
+    let mesh = load("suzanne.obj");
+    let size = (160, 120);
+    let camera = framing(&mesh, size);
+    let style = Style {
+        line_width: 3.0,
+        ..Style::default()
+    };
+    let view = camera.to_view(f64::from(size.0) / f64::from(size.1));
+    let ctx = common::gpu();
+    let all = World::single(mesh.clone(), EdgeSelection::All);
+    let mut switched = Uploaded::new(ctx, &all).unwrap_or_else(|e| panic!("{e}"));
+    for edges in [EdgeSelection::Polygon, EdgeSelection::Feature(30.0)] {
+        let world = World::single(mesh.clone(), edges);
+        let shot = Shot {
+            world: &world,
+            view,
+            style: &style,
+            size,
+        };
+        let id = switched.ids[0];
+        switched
+            .store
+            .set_edges(&ctx.queue, id, &mesh, edges)
+            .unwrap_or_else(|e| panic!("{e}"));
+        let fresh = Uploaded::new(ctx, &world).unwrap_or_else(|e| panic!("{e}"));
+        let a = render_window(&shot, &switched, Window::whole(size));
+        let b = render_window(&shot, &fresh, Window::whole(size));
+        assert_eq!(a.ids, b.ids, "{edges:?}");
+        assert!(
+            a.edge_distance
+                .iter()
+                .zip(&b.edge_distance)
+                .all(|(x, y)| x.to_bits() == y.to_bits()),
+            "{edges:?}: distances differ"
+        );
+        assert_eq!(a.rgba, b.rgba, "{edges:?}");
+    }
+}

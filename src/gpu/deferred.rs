@@ -758,6 +758,11 @@ impl DeferredPass {
                 Size::List(&t.work),
             ),
         ];
+        // Bound before anything is recorded, so a failure leaves the encoder as it was.
+        let groups = dispatches
+            .iter()
+            .map(|d| d.2.bind(device, &sources))
+            .collect::<Result<Vec<_>>>()?;
         encoder.clear_buffer(&t.tiles, 0, None);
         encoder.copy_buffer_to_buffer(&self.reset, 0, &t.tiles, 0, LIST_HEADER);
         let marks = LIST_HEADER + 4 * u64::from(t.size.0) * u64::from(t.size.1);
@@ -765,8 +770,7 @@ impl DeferredPass {
         encoder.copy_buffer_to_buffer(&self.reset, 0, &t.work, 0, LIST_HEADER);
         // Each dispatch is a pass of its own, timed on its own (the benchmark sums the
         // `edge.*` spans into the edge pass).
-        for (label, span, pipeline, size) in dispatches {
-            let group = pipeline.bind(device, &sources)?;
+        for ((label, span, pipeline, size), group) in dispatches.into_iter().zip(groups) {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some(label),
                 timestamp_writes: timer.as_deref_mut().and_then(|t| t.compute_span(span)),

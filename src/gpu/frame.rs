@@ -442,8 +442,8 @@ impl FrameData {
     pub fn check_store(&self, store: &MeshStore) -> Result<()> {
         if (store.store_id(), store.version()) != self.store_version {
             return Err(Error::Misuse(
-                "the mesh store is another one, or had a mesh removed, since this frame was \
-                 prepared: prepare the frame again"
+                "the mesh store is another one, or had a mesh removed or its edges changed, \
+                 since this frame was prepared: prepare the frame again"
                     .into(),
             ));
         }

@@ -337,6 +337,8 @@ impl MeshStore {
     }
 
     /// Re-uploads which edges of `id` are drawn; `mesh` is the mesh it was inserted from.
+    /// Frames prepared before this call must be prepared again (encode reports one that is
+    /// not as an error): the selection decides which pipelines draw the mesh.
     pub fn set_edges(
         &mut self,
         queue: &wgpu::Queue,
