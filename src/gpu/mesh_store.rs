@@ -18,11 +18,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 use crate::error::{Error, Result};
-use crate::mesh::{
-    adjacency::NO_NEIGHBOUR,
-    patches::{self, Patches},
-    EdgeSelection, Mesh, ALL_EDGES,
-};
+use crate::mesh::{adjacency::NO_NEIGHBOUR, patches::Patches, EdgeSelection, Mesh, ALL_EDGES};
 use glam::{DMat4, DVec3, Vec2, Vec3};
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::sync::Arc;
@@ -715,16 +711,13 @@ impl EdgeData {
     pub fn new(mesh: &Mesh, edges: EdgeSelection, order: &[u32]) -> EdgeData {
         let mask = mesh.edge_mask(edges);
         let neighbours = mesh.edge_neighbours();
-        let mut patches = Patches::new(neighbours, &mask);
         // Each edge splatted from the side with the lower stored id, the side the outline
         // pass draws a silhouette from.
         let mut stored = vec![0u32; order.len()];
         for (s, &t) in order.iter().enumerate() {
             stored[t as usize] = s as u32;
         }
-        patches.splat = patches::splat_edges_by(neighbours, &mask, &patches.large, |t, u| {
-            stored[t] < stored[u]
-        });
+        let patches = Patches::ordered(neighbours, &mask, |t, u| stored[t] < stored[u]);
         let hints = mesh.outline_hints();
         let outline = mesh.outline_mask();
         let info = order

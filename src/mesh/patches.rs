@@ -16,39 +16,40 @@ pub const PATCH_TRIANGLES: usize = 16;
 /// A mesh's patches under one edge mask, as the passes use them.
 #[derive(Clone, Debug, Default)]
 pub struct Patches {
-    /// Per triangle, whether its patch is large ([`large_patches`]).
+    /// Per triangle, whether its patch has more than [`PATCH_TRIANGLES`] triangles.
     pub large: Vec<bool>,
-    /// Per triangle, the triangles in its patch, up to [`PATCH_TRIANGLES`] + 1 (for any
-    /// large patch).
+    /// Per triangle, the triangles in its patch ([`patch_sizes`]).
     pub size: Vec<u8>,
     /// Per triangle, the drawn edges the outline pass draws ([`splat_edges`]).
     pub splat: Vec<u8>,
 }
 
 impl Patches {
-    /// The patches of a mesh with edge neighbours `neighbours` under `mask`.
+    /// The patches of a mesh with edge neighbours `neighbours` under `mask`; an edge both
+    /// sides draw is splatted from the side with the lower id.
     pub fn new(neighbours: &[[u32; 3]], mask: &[u8]) -> Patches {
+        Patches::ordered(neighbours, mask, |t, u| t < u)
+    }
+
+    /// [`Patches::new`], splatting an edge both sides draw from side `t` where `before(t, u)`
+    /// (see [`splat_edges`]).
+    pub fn ordered(
+        neighbours: &[[u32; 3]],
+        mask: &[u8],
+        before: impl Fn(usize, usize) -> bool,
+    ) -> Patches {
         let size = patch_sizes(neighbours, mask);
         let large: Vec<bool> = size
             .iter()
             .map(|&n| usize::from(n) > PATCH_TRIANGLES)
             .collect();
-        let splat = splat_edges(neighbours, mask, &large);
+        let splat = splat_edges(neighbours, mask, &large, before);
         Patches { large, size, splat }
     }
 }
 
-/// Per triangle, whether its patch (the triangles joined to it across undrawn edges, an edge
-/// counting as undrawn when either side leaves it out) has more than [`PATCH_TRIANGLES`]
-/// triangles.
-pub fn large_patches(neighbours: &[[u32; 3]], mask: &[u8]) -> Vec<bool> {
-    patch_sizes(neighbours, mask)
-        .iter()
-        .map(|&n| usize::from(n) > PATCH_TRIANGLES)
-        .collect()
-}
-
-/// Per triangle, how many triangles its patch has (see [`large_patches`]), counted up to
+/// Per triangle, how many triangles its patch has (the triangles joined to it across undrawn
+/// edges, an edge counting as undrawn when either side leaves it out), counted up to
 /// [`PATCH_TRIANGLES`] + 1.
 pub fn patch_sizes(neighbours: &[[u32; 3]], mask: &[u8]) -> Vec<u8> {
     let n = neighbours.len();
@@ -83,16 +84,11 @@ pub fn patch_sizes(neighbours: &[[u32; 3]], mask: &[u8]) -> Vec<u8> {
 }
 
 /// Per triangle, the drawn edges (bit `i` for edge `i`) that the outline pass draws because a
-/// large patch lies on one side: each such edge once, from the side with the lower id when
-/// both sides draw it.
-pub fn splat_edges(neighbours: &[[u32; 3]], mask: &[u8], large: &[bool]) -> Vec<u8> {
-    splat_edges_by(neighbours, mask, large, |t, u| t < u)
-}
-
-/// [`splat_edges`], drawing an edge both sides draw from side `t` where `before(t, u)`: the
-/// GPU's outline pass orders triangles as it stores them, so that an edge that is also a
-/// silhouette is drawn once, by the side that draws the silhouette.
-pub fn splat_edges_by(
+/// large patch lies on one side: each such edge once, from side `t` where `before(t, u)`
+/// when both sides draw it. The GPU's outline pass orders triangles as it stores them, so
+/// that an edge that is also a silhouette is drawn once, by the side that draws the
+/// silhouette.
+pub fn splat_edges(
     neighbours: &[[u32; 3]],
     mask: &[u8],
     large: &[bool],
@@ -154,15 +150,13 @@ mod tests {
         let mut mask = vec![0b001u8; n];
         mask[3] |= 0b010;
         mask[4] |= 0b100;
-        let large = large_patches(&neighbours, &mask);
-        let size = patch_sizes(&neighbours, &mask);
+        let Patches { large, size, splat } = Patches::new(&neighbours, &mask);
         assert!(size[..4].iter().all(|&n| n == 4));
         assert!(size[4..]
             .iter()
             .all(|&n| usize::from(n) == PATCH_TRIANGLES + 1));
         assert!(large[..4].iter().all(|&l| !l));
         assert!(large[4..].iter().all(|&l| l));
-        let splat = splat_edges(&neighbours, &mask, &large);
         // The drawn join once, from the lower id; the outer sides of the large patch's
         // triangles; nothing of the small patch beyond the join.
         assert_eq!(splat[3], 0b010);
@@ -175,10 +169,10 @@ mod tests {
     fn a_side_that_leaves_an_edge_out_joins_it() {
         let neighbours = strip(PATCH_TRIANGLES + 1);
         let mut mask = vec![0b111u8; PATCH_TRIANGLES + 1];
-        assert!(large_patches(&neighbours, &mask).iter().all(|&l| !l));
+        assert!(Patches::new(&neighbours, &mask).large.iter().all(|&l| !l));
         for m in &mut mask[..PATCH_TRIANGLES] {
             *m &= !0b010;
         }
-        assert!(large_patches(&neighbours, &mask).iter().all(|&l| l));
+        assert!(Patches::new(&neighbours, &mask).large.iter().all(|&l| l));
     }
 }
