@@ -149,7 +149,56 @@ impl Subject {
     }
 }
 
-/// How many frames a benchmark times, after how many untimed ones.
+/// A method the benchmark can time.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Timed {
+    /// The floor: the visibility pass and a compute pass that reads the id and writes a
+    /// flat colour.
+    Floor,
+    /// The deferred method (visibility, outline and edge passes).
+    Deferred,
+    /// The forward single-pass method.
+    Forward,
+    /// The two-pass method (biased fill, then lines).
+    TwoPass,
+}
+
+impl Timed {
+    /// Every method, in the order they are timed within a frame.
+    pub const ALL: [Timed; 4] = [
+        Timed::Floor,
+        Timed::Deferred,
+        Timed::Forward,
+        Timed::TwoPass,
+    ];
+
+    /// The method's name in tables and `bench.json`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Timed::Floor => "floor",
+            Timed::Deferred => "deferred",
+            Timed::Forward => "forward",
+            Timed::TwoPass => "two-pass",
+        }
+    }
+}
+
+impl std::str::FromStr for Timed {
+    type Err = Error;
+
+    fn from_str(s: &str) -> Result<Timed> {
+        Timed::ALL
+            .into_iter()
+            .find(|m| m.name() == s.trim())
+            .ok_or_else(|| {
+                Error::InvalidSetting(format!(
+                    "unknown method {s:?}: floor, deferred, forward or two-pass"
+                ))
+            })
+    }
+}
+
+/// How many frames a benchmark times, after how many untimed ones, and of which methods.
 #[derive(Clone, Debug)]
 pub struct Timing {
     /// Timed frames.
@@ -159,6 +208,9 @@ pub struct Timing {
     /// Edge selections the deferred method also draws, each timed beside the world's own
     /// (method `deferred edges=…`), so the cost of masked edges shows in one run.
     pub edges: Vec<EdgeSelection>,
+    /// The methods timed (each of `Timed::ALL` when empty); the edge selections above are
+    /// timed whatever this holds.
+    pub methods: Vec<Timed>,
 }
 
 /// Times every method on `world` at `size`, with the framing camera and `style`: see
@@ -194,10 +246,12 @@ pub fn bench_scene(
         frames,
         warmup,
         edges,
+        methods,
     } = timing;
     if frames == 0 {
         return Err(Error::InvalidSetting("--frames must be at least 1".into()));
     }
+    let timed = |m: Timed| methods.is_empty() || methods.contains(&m);
     let device = &ctx.device;
     let queue = &ctx.queue;
     let size = shot.size;
@@ -230,6 +284,9 @@ pub fn bench_scene(
     };
     let mut subjects = Vec::new();
     for floor in [true, false] {
+        if !timed(if floor { Timed::Floor } else { Timed::Deferred }) {
+            continue;
+        }
         let mut pass = DeferredPass::new(device, PassOptions::default())?;
         let frame = pass.prepare(device, &up.store, &scene, shot.style, size)?;
         subjects.push(if floor {
@@ -251,12 +308,16 @@ pub fn bench_scene(
         let frame = pass.prepare(device, &up.store, &scene, shot.style, size)?;
         subjects.push(Subject::Edges(selection, up, pass, frame, storage()));
     }
-    let mut forward = ForwardPass::new(device, forward_options)?;
-    let frame = forward.prepare(device, &up.store, &scene, shot.style, size)?;
-    subjects.push(Subject::Forward(forward, frame, attachment()));
-    let mut two_pass = TwoPass::new(device, forward_options)?;
-    let frame = two_pass.prepare(device, &up.store, &scene, shot.style, size)?;
-    subjects.push(Subject::TwoPass(two_pass, frame, attachment()));
+    if timed(Timed::Forward) {
+        let mut forward = ForwardPass::new(device, forward_options)?;
+        let frame = forward.prepare(device, &up.store, &scene, shot.style, size)?;
+        subjects.push(Subject::Forward(forward, frame, attachment()));
+    }
+    if timed(Timed::TwoPass) {
+        let mut two_pass = TwoPass::new(device, forward_options)?;
+        let frame = two_pass.prepare(device, &up.store, &scene, shot.style, size)?;
+        subjects.push(Subject::TwoPass(two_pass, frame, attachment()));
+    }
     ctx.finish()?;
 
     let mut timer = GpuTimer::new(device, queue, 8)?;

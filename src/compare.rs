@@ -333,6 +333,7 @@ fn gpu_times(ctx: &GpuContext, shot: &Shot<'_>) -> (BTreeMap<String, f64>, Strin
         frames: TIMED_FRAMES,
         warmup: WARM_UP_FRAMES,
         edges: Vec::new(),
+        methods: Vec::new(),
     };
     match crate::bench::bench_scene(ctx, "compare", shot, timing) {
         Ok(runs) => (

@@ -259,6 +259,14 @@ struct BenchArgs {
     /// (`polygon,feature:30`), each on its own upload, beside --edges in the same run.
     #[arg(long, value_delimiter = ',', value_parser = parse_edges)]
     compare_edges: Vec<EdgeSelection>,
+    /// Time only these methods, comma separated: floor, deferred, forward, two-pass
+    /// [default: all of them].
+    #[arg(long, value_delimiter = ',', value_parser = parse_timed)]
+    methods: Vec<wirepass::bench::Timed>,
+}
+
+fn parse_timed(s: &str) -> std::result::Result<wirepass::bench::Timed, String> {
+    s.parse().map_err(|e: wirepass::Error| e.to_string())
 }
 
 fn bench_command(args: &BenchArgs) -> Result<()> {
@@ -301,6 +309,7 @@ fn bench_command(args: &BenchArgs) -> Result<()> {
                 frames: args.frames,
                 warmup: args.warmup,
                 edges: args.compare_edges.clone(),
+                methods: args.methods.clone(),
             };
             runs.extend(wirepass::bench::bench(
                 &ctx, name, &world, size, &style, timing,

@@ -118,6 +118,43 @@ fn bad_settings_give_one_clear_line() {
 }
 
 #[test]
+fn bench_times_only_the_methods_asked_for() {
+    let out = temp("bench-methods");
+    let (ok, err) = wirepass(&[
+        "bench",
+        "sphere:2000",
+        "--size",
+        "64x48",
+        "--frames",
+        "2",
+        "--warmup",
+        "0",
+        "--methods",
+        "floor,deferred",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("bench.json")).unwrap()).unwrap();
+    let methods: Vec<_> = json["runs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r["method"].as_str().unwrap().to_owned())
+        .collect();
+    assert_eq!(methods, ["floor", "deferred"]);
+
+    let (ok, err) = wirepass(&["bench", "--methods", "deferred,fast", "--out", "x"]);
+    assert!(!ok);
+    let first = err.lines().next().unwrap_or_default();
+    assert!(
+        first.contains("\"fast\"") && first.contains("two-pass"),
+        "{err}"
+    );
+}
+
+#[test]
 fn bench_writes_table_json_csv_and_plots() {
     let out = temp("bench");
     let (ok, err) = wirepass(&[
