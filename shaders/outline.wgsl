@@ -4,9 +4,10 @@
 // A triangle only colours its own pixels, so the edge pass alone draws an outline edge (a
 // boundary, or a silhouette: see `is_silhouette`) at half width. Outline triangles are nearly
 // edge-on and often own no pixel centre at all, so they cannot be found from the ids around a
-// pixel; instead one invocation per triangle finds its outline edges, the visible runs of each
-// (points every 1/4 px tested, changes bisected), and writes into every pixel within the line's
-// reach the key (`line_key`) of the nearest visible run. Only triangles of the clusters that
+// pixel; instead one invocation per triangle finds its outline edges and lists their pieces
+// (up to 16 px each), and then one invocation per piece finds its visible runs (points every
+// 1/4 px tested, changes bisected) and writes into every pixel within the line's reach the
+// key (`line_key`) of the nearest visible run. Only triangles of the clusters that
 // `outline_cull` lists are visited, so the pass reads few triangles beyond those near an
 // outline. Definition (src/outline.rs implements it in f64 for the ground truth): pixel p is
 // at distance d from an outline when d is the distance from p's centre to the visible part of
@@ -49,6 +50,24 @@ struct OutlineListRead {
     items: array<vec2<u32>>,
 }
 @group(0) @binding(14) var<storage, read> cull: OutlineListRead;
+
+// After the lines in `acc_rw`, the pieces of outline edges that `outline_main` lists for
+// `outline_pieces_main`: a header (indirect dispatch size x, y, z, then the count; the
+// encoder copies it to where the piece dispatch reads its size) and PIECE_WORDS words per
+// piece. A lane of the piece dispatch draws one piece, where a lane of `outline_main` would
+// draw every piece of its triangle's outline edges while the other lanes of its cluster,
+// most of them without any, wait for it.
+fn piece_list() -> u32 {
+    let pixels = u32(frame.target_size.x) * u32(frame.target_size.y);
+#if COLORS
+    return 2u * pixels;
+#else
+    return pixels;
+#endif
+}
+
+// Words per listed piece: instance slot, triangle, edge, and piece | pieces << 16.
+const PIECE_WORDS: u32 = 4u;
 
 // The instance whose clusters hold the cull's flat cluster index f: the last with
 // cluster_first <= f (instances are in the order of their cluster_first).
@@ -95,7 +114,7 @@ fn outline_cull(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
 // Triangles per cluster, and invocations per workgroup of both entry points.
 const CLUSTER_TRIANGLES: u32 = 64u;
 
-// One invocation per triangle of each listed cluster.
+// One invocation per triangle of each listed cluster: lists the pieces of its outline edges.
 @compute @workgroup_size(64)
 fn outline_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
     let k = list_group(group);
@@ -105,6 +124,26 @@ fn outline_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocati
         if t < instances[slot(item.x)].triangles {
             outline_triangle(item.x, t);
         }
+    }
+}
+
+// One invocation per listed piece: draws it.
+@compute @workgroup_size(64)
+fn outline_pieces_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+    let k = list_group(group) * 64u + lane;
+    let list = piece_list();
+    if k < atomicLoad(&acc_rw[list + 3u]) {
+        let at = list + 4u + PIECE_WORDS * k;
+        let inst = atomicLoad(&acc_rw[at]);
+        let t = atomicLoad(&acc_rw[at + 1u]);
+        let i = atomicLoad(&acc_rw[at + 2u]);
+        let piece = atomicLoad(&acc_rw[at + 3u]) & 0xffffu;
+        let base = instances[slot(inst)].triangle_base;
+        let v = corners(base + t) + instances[slot(inst)].vertex_base;
+        let a = vertex_at(v[i]).xyz;
+        let b = vertex_at(v[(i + 1u) % 3u]).xyz;
+        let c = clip_outline(inst, t, neighbour(base + t, i), a, b);
+        draw_piece(c.seg, f32(piece) / f32(c.pieces), f32(piece + 1u) / f32(c.pieces), c.length_px);
     }
 }
 
@@ -162,7 +201,7 @@ fn outline_triangle(inst: u32, t: u32) {
             outline = is_silhouette(a, b, p[(i + 2u) % 3u], d, eye);
         }
         if outline {
-            draw_outline(inst, t, n, a, b);
+            list_outline(inst, t, i, n, a, b);
         }
     }
 }
@@ -225,9 +264,20 @@ fn seg_visible(s: Segment, k: f32) -> bool {
     return visible_at(q.xy, q.near_w * w, w, q.reverse, s.inst, s.t, s.n);
 }
 
-// Writes edge a -> b (of triangle t of `inst`, with neighbour n) into every pixel within reach
-// of its visible part.
-fn draw_outline(inst: u32, t: u32, n: u32, a: vec3<f32>, b: vec3<f32>) {
+// Edge a -> b of triangle t of `inst` (with neighbour n) on screen: its segment in front of
+// the near plane, not beyond the far one, and inside the image and its guard band (not the
+// targets: a tile then samples and bisects the same points as the whole image, and computes
+// exactly what the whole image does), its length, and the pieces it is drawn in (0 when
+// nothing is left of it).
+struct Clipped {
+    seg: Segment,
+    length_px: f32,
+    pieces: u32,
+}
+
+fn clip_outline(inst: u32, t: u32, n: u32, a: vec3<f32>, b: vec3<f32>) -> Clipped {
+    var c: Clipped;
+    c.pieces = 0u;
     let clip = instances[slot(inst)].clip;
     let ha = vec4<f32>(a, 1.0);
     let hb = vec4<f32>(b, 1.0);
@@ -235,11 +285,10 @@ fn draw_outline(inst: u32, t: u32, n: u32, a: vec3<f32>, b: vec3<f32>) {
     let cb = clip * hb;
     let depth_row = instances[slot(inst)].depth_row;
     let fade_row = instances[slot(inst)].fade_row;
-    // In front of the near plane and not beyond the far one.
     var s = keep_positive(vec2<f32>(0.0, 1.0), ca.z, cb.z);
     s = keep_positive(s, dot(depth_row, ha), dot(depth_row, hb));
     if !(s.x <= s.y) {
-        return;
+        return c;
     }
     let da = dot(depth_row, ha);
     let db = dot(depth_row, hb);
@@ -247,35 +296,54 @@ fn draw_outline(inst: u32, t: u32, n: u32, a: vec3<f32>, b: vec3<f32>) {
     let fb = dot(fade_row, hb);
     let p0 = project(mix(ca, cb, s.x), mix(da, db, s.x), mix(fa, fb, s.x));
     let p1 = project(mix(ca, cb, s.y), mix(da, db, s.y), mix(fa, fb, s.y));
-    // Inside the image and its guard band (not the targets: a tile then samples and bisects
-    // the same points as the whole image, and computes exactly what the whole image does).
     let d = p1.xy - p0.xy;
     let lo = -frame.output_offset;
     let hi = frame.image_size + frame.output_offset;
     var u = keep_between(vec2<f32>(0.0, 1.0), p0.xy.x, d.x, lo.x, hi.x);
     u = keep_between(u, p0.xy.y, d.y, lo.y, hi.y);
     if !(u.x <= u.y) {
-        return;
+        return c;
     }
-    var seg: Segment;
-    seg.start = lerp_projected(p0, p1, u.x);
-    seg.end = lerp_projected(p0, p1, u.y);
-    seg.inst = inst;
-    seg.t = t;
-    seg.n = n;
-    let length_px = length(seg.end.xy - seg.start.xy);
-    let pieces = max(u32(ceil(length_px / PIECE_PX)), 1u);
-    // Pieces out of reach of the targets (of a tile) are skipped.
+    c.seg.start = lerp_projected(p0, p1, u.x);
+    c.seg.end = lerp_projected(p0, p1, u.y);
+    c.seg.inst = inst;
+    c.seg.t = t;
+    c.seg.n = n;
+    c.length_px = length(c.seg.end.xy - c.seg.start.xy);
+    c.pieces = max(u32(ceil(c.length_px / PIECE_PX)), 1u);
+    return c;
+}
+
+// Lists the pieces of edge i (a -> b) of triangle t of `inst`, with neighbour n, that lie
+// within reach of the targets (of a tile) for outline_pieces_main. Where the list is full
+// the piece is drawn here.
+fn list_outline(inst: u32, t: u32, i: u32, n: u32, a: vec3<f32>, b: vec3<f32>) {
+    let c = clip_outline(inst, t, n, a, b);
     let reach = line_reach(instances[slot(inst)].line_width);
     let first = frame.target_origin - reach;
     let last = frame.target_origin + frame.target_size + reach;
-    for (var piece = 0u; piece < pieces; piece++) {
-        let k0 = f32(piece) / f32(pieces);
-        let k1 = f32(piece + 1u) / f32(pieces);
-        let a = mix(seg.start.xy, seg.end.xy, k0);
-        let b = mix(seg.start.xy, seg.end.xy, k1);
-        if all(max(a, b) >= first) && all(min(a, b) <= last) {
-            draw_piece(seg, k0, k1, length_px);
+    let list = piece_list();
+    let capacity = (arrayLength(&acc_rw) - list - 4u) / PIECE_WORDS;
+    for (var piece = 0u; piece < c.pieces; piece++) {
+        let k0 = f32(piece) / f32(c.pieces);
+        let k1 = f32(piece + 1u) / f32(c.pieces);
+        let p = mix(c.seg.start.xy, c.seg.end.xy, k0);
+        let q = mix(c.seg.start.xy, c.seg.end.xy, k1);
+        if !(all(max(p, q) >= first) && all(min(p, q) <= last)) {
+            continue;
+        }
+        let k = atomicAdd(&acc_rw[list + 3u], 1u);
+        if k < capacity && c.pieces <= 0xffffu {
+            let at = list + 4u + PIECE_WORDS * k;
+            atomicStore(&acc_rw[at], inst);
+            atomicStore(&acc_rw[at + 1u], t);
+            atomicStore(&acc_rw[at + 2u], i);
+            atomicStore(&acc_rw[at + 3u], piece | (c.pieces << 16u));
+            let size = list_size(k, 64u);
+            atomicMax(&acc_rw[list], size.x);
+            atomicMax(&acc_rw[list + 1u], size.y);
+        } else {
+            draw_piece(c.seg, k0, k1, c.length_px);
         }
     }
 }

@@ -53,7 +53,7 @@ pub struct Run {
     pub method: String,
     /// GPU time of each pass, and of each group of passes: `edge` is the sum of its
     /// dispatches (`edge.classify`, `edge.border`, `edge.tiles`, `edge.refine`; the floor's `edge.floor`),
-    /// `outline` of `outline.cull` and `outline.draw`.
+    /// `outline` of `outline.cull`, `outline.draw` and `outline.pieces`.
     pub passes: BTreeMap<String, Stats>,
     /// Median over frames of the sum of the passes.
     pub total_median_ms: f64,
@@ -73,6 +73,9 @@ pub struct EdgeShares {
     pub tiles: f64,
     /// Pixels refined among all output pixels.
     pub refined: f64,
+    /// Pieces of outline edges the outline pass's piece dispatch drew (or found beyond its
+    /// list's room).
+    pub outline_pieces: u32,
 }
 
 /// A method being measured: its pass, prepared frame and output.
@@ -320,7 +323,7 @@ pub fn bench_scene(
     }
     ctx.finish()?;
 
-    let mut timer = GpuTimer::new(device, queue, 8)?;
+    let mut timer = GpuTimer::new(device, queue, 12)?;
     let mut gpu: Vec<BTreeMap<String, Vec<f64>>> = vec![BTreeMap::new(); subjects.len()];
     let mut totals = vec![Vec::new(); subjects.len()];
     let mut cpu = vec![Vec::new(); subjects.len()];
@@ -359,6 +362,7 @@ pub fn bench_scene(
                 Some(EdgeShares {
                     tiles: f64::from(w.tiles) / f64::from(w.all_tiles.max(1)),
                     refined: f64::from(w.refined) / f64::from(w.pixels.max(1)),
+                    outline_pieces: w.outline_pieces,
                 })
             }
             _ => None,
@@ -462,9 +466,10 @@ pub fn markdown(runs: &[Run]) -> String {
             .collect();
         if let Some(w) = r.edge_work {
             other.push(format!(
-                "tiles {:.1} %, refined {:.2} % of pixels",
+                "tiles {:.1} %, refined {:.2} % of pixels, {} outline pieces",
                 100.0 * w.tiles,
-                100.0 * w.refined
+                100.0 * w.refined,
+                w.outline_pieces
             ));
         }
         out += &format!(

@@ -363,7 +363,7 @@ fn timer_reports_every_pass() {
     let frame = pass
         .prepare(device, &store, &scene, &Style::default(), (64, 64))
         .unwrap();
-    let mut timer = wirepass::gpu::GpuTimer::new(device, &ctx.queue, 8)
+    let mut timer = wirepass::gpu::GpuTimer::new(device, &ctx.queue, 12)
         .expect("software adapters expose TIMESTAMP_QUERY");
     for _ in 0..2 {
         let mut encoder = device.create_command_encoder(&Default::default());
@@ -386,6 +386,7 @@ fn timer_reports_every_pass() {
                 "visibility",
                 "outline.cull",
                 "outline.draw",
+                "outline.pieces",
                 "edge.classify",
                 "edge.border",
                 "edge.tiles",

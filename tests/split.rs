@@ -5,13 +5,13 @@
 mod common;
 
 use common::gpu;
-use glam::{DMat4, Vec3};
-use std::sync::{Mutex, MutexGuard};
+use glam::{DMat4, DVec3, Vec3};
+use std::sync::{Arc, Mutex, MutexGuard};
 use wirepass::cli::CameraArgs;
 use wirepass::gpu::{DeferredPass, GpuContext, MeshStore, OutputTarget, PassOptions};
 use wirepass::mesh::Procedural;
-use wirepass::render::{render, Method, Shot, World, BACKGROUND};
-use wirepass::{EdgeSelection, Error, Instance, Scene, Style};
+use wirepass::render::{render, Method, Object, Shot, Uploaded, World, WorldMesh, BACKGROUND};
+use wirepass::{Color, EdgeSelection, Error, Instance, InstanceStyle, Scene, Style};
 
 /// 64 KiB: 5440 triangles of indices in the first binding (a multiple of 64 triangles, so
 /// the second binding's offset is 256-byte aligned).
@@ -189,5 +189,93 @@ fn an_image_past_the_outline_buffer_limit_is_a_clear_error() {
         msg.contains("outline buffer") && msg.contains("max_storage_buffer_binding_size = 65536"),
         "{msg}"
     );
+    small.finish().unwrap();
+}
+
+/// The outline pass lists the pieces of outline edges after the lines in its buffer; where
+/// the buffer has no room left for them, it draws them where it finds them, to the same
+/// image.
+#[test]
+fn outline_pieces_past_the_list_s_room_are_drawn_where_they_are_found() {
+    let (small, _turn) = small_device();
+    let mesh = Arc::new(Procedural::Sphere(2000).build().unwrap());
+    // Two spheres with lines of different colours keep two words a target pixel: at 82 × 82
+    // (90 × 90 with the guard band) the lines take 64 800 of the 65 536 bytes.
+    let size = (82, 82);
+    let object = |x: f64, color: &str| Object {
+        mesh: 0,
+        transform: DMat4::from_translation(DVec3::new(x, 0.0, 0.0)),
+        style: InstanceStyle {
+            wire_color: Some(Color::from_hex(color).unwrap()),
+            ..InstanceStyle::default()
+        },
+    };
+    let world = World {
+        meshes: vec![WorldMesh {
+            mesh,
+            edges: EdgeSelection::All,
+            name: "sphere".into(),
+        }],
+        objects: vec![object(-1.05, "#c03020"), object(1.05, "#2030c0")],
+    };
+    let camera = CameraArgs::default().camera(world.bounds(), size).unwrap();
+    let style = Style::default();
+    let shot = Shot {
+        world: &world,
+        view: camera.to_view(1.0),
+        style: &style,
+        size,
+    };
+    // What the outline pass listed on the small device, and its room.
+    let up = Uploaded::new(&small, &world).unwrap();
+    let mut pass = DeferredPass::new(&small.device, PassOptions::default()).unwrap();
+    let frame = pass
+        .prepare(
+            &small.device,
+            &up.store,
+            &up.scene(&world, shot.view),
+            &style,
+            size,
+        )
+        .unwrap();
+    let output = wirepass::gpu::texture_2d(
+        &small.device,
+        "output",
+        size,
+        pass.output_format(),
+        wgpu::TextureUsages::STORAGE_BINDING,
+    );
+    let view = output.create_view(&Default::default());
+    let mut encoder = small.device.create_command_encoder(&Default::default());
+    pass.encode(
+        &small.device,
+        &mut encoder,
+        &up.store,
+        &frame,
+        OutputTarget::Shaded(&view),
+    )
+    .unwrap();
+    small.queue.submit([encoder.finish()]);
+    let work = frame.edge_work(&small.device, &small.queue).unwrap();
+    assert!(
+        work.piece_room < 64 && work.outline_pieces > 2 * work.piece_room,
+        "{work:?}"
+    );
+
+    let whole = render(gpu(), &shot, Method::Deferred).unwrap();
+    let cramped = render(&small, &shot, Method::Deferred).unwrap();
+    let lines = whole.edge_distance.iter().filter(|&&d| d < 2.0).count();
+    assert!(lines > 1500, "{lines} pixels near a line");
+    let differ = |a: &[u8], b: &[u8]| a.iter().zip(b).filter(|(x, y)| x != y).count();
+    assert_eq!(
+        differ(&whole.rgba, &cramped.rgba),
+        0,
+        "image bytes that differ"
+    );
+    assert!(whole.ids == cramped.ids, "ids differ");
+    let same = |a: f32, b: f32| a == b || (a.is_nan() && b.is_nan());
+    let distances = whole.edge_distance.iter().zip(&cramped.edge_distance);
+    let off = distances.filter(|(&a, &b)| !same(a, b)).count();
+    assert_eq!(off, 0, "distances that differ");
     small.finish().unwrap();
 }

@@ -102,7 +102,16 @@ struct EdgePipelines {
 
 struct OutlinePipelines {
     cull: Compute,
+    /// Lists the pieces of the listed clusters' outline edges.
     draw: Compute,
+    /// Draws the listed pieces, one a lane.
+    pieces: Compute,
+}
+
+/// Where the piece dispatch's size lies in a frame's cluster list buffer: after the cluster
+/// list (header, then two words per cluster).
+fn piece_size_at(data: &FrameData) -> u64 {
+    LIST_HEADER + 8 * u64::from(data.uniforms_clusters().max(1))
 }
 
 /// A frame ready to encode: its scene data on the GPU and the targets it draws with.
@@ -133,23 +142,35 @@ pub struct EdgeWork {
     pub refined: u32,
     /// Output pixels in all.
     pub pixels: u32,
+    /// Pieces (up to 16 px) of outline edges the outline pass found, 0 where it did not run.
+    pub outline_pieces: u32,
+    /// How many of them its piece list has room for; it draws the others where it finds
+    /// them.
+    pub piece_room: u32,
 }
 
 impl PreparedFrame {
-    /// What the edge pass's tile and refine dispatches took on in the last encode of this
-    /// frame, read back from the GPU (it waits for the work submitted so far): for tools and
-    /// benchmarks.
+    /// What the outline pass and the edge pass's tile and refine dispatches took on in the
+    /// last encode of this frame, read back from the GPU (it waits for the work submitted so
+    /// far): for tools, tests and benchmarks.
     pub fn edge_work(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<EdgeWork> {
-        let count = |buffer: &wgpu::Buffer| -> Result<u32> {
-            let bytes = super::readback::read_buffer(device, queue, buffer, 12, 4)?;
+        let count = |buffer: &wgpu::Buffer, at: u64| -> Result<u32> {
+            let bytes = super::readback::read_buffer(device, queue, buffer, at + 12, 4)?;
             Ok(u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]))
         };
         let (w, h) = self.targets.output;
+        let t = &self.targets;
         Ok(EdgeWork {
-            tiles: count(&self.targets.tiles)?,
+            tiles: count(&t.tiles, 0)?,
             all_tiles: w.div_ceil(TILE) * h.div_ceil(TILE),
-            refined: count(&self.targets.work)?,
+            refined: count(&t.work, 0)?,
             pixels: w * h,
+            outline_pieces: if self.data.outlines {
+                count(&t.acc, t.acc_pieces)?
+            } else {
+                0
+            },
+            piece_room: t.piece_room(),
         })
     }
 
@@ -375,7 +396,8 @@ impl DeferredPass {
         if self.targets.as_ref().map(Targets::spec) != Some(spec) {
             self.targets = Some(Targets::new(device, spec)?);
         }
-        let cull_bytes = LIST_HEADER + 8 * u64::from(data.uniforms_clusters().max(1));
+        // The cluster list, then the piece dispatch's size.
+        let cull_bytes = piece_size_at(&data) + LIST_HEADER;
         if self.cull.as_ref().map_or(0, wgpu::Buffer::size) < cull_bytes {
             let limit = device.limits().max_storage_buffer_binding_size;
             if cull_bytes > limit {
@@ -549,15 +571,23 @@ impl DeferredPass {
             self.format,
         )?;
         let mut draw_res = store_resources(v.split, true, v.uniform_instances);
-        draw_res.extend([Res::Ids, Res::Cull, Res::AccRw, Res::OutlineTilesRw]);
+        draw_res.extend([Res::Ids, Res::AccRw, Res::OutlineTilesRw]);
         if v.host {
             draw_res.push(Res::HostDepth);
         }
+        let pieces = Compute::new(
+            device,
+            &module,
+            "outline_pieces_main",
+            draw_res.clone(),
+            self.format,
+        )?;
+        draw_res.push(Res::Cull);
         let draw = Compute::new(device, &module, "outline_main", draw_res, self.format)?;
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(Error::Device(format!("building the outline pass: {e}")));
         }
-        let p = Arc::new(OutlinePipelines { cull, draw });
+        let p = Arc::new(OutlinePipelines { cull, draw, pieces });
         cache.insert(v, p.clone());
         Ok(p)
     }
@@ -577,8 +607,9 @@ impl DeferredPass {
     }
 
     /// [`encode`](Self::encode) with GPU timestamps around each pass, named
-    /// `"visibility"`, `"outline.cull"` and `"outline.draw"` (when outlines are drawn), and
-    /// `"edge.classify"`, `"edge.border"`, `"edge.tiles"` and `"edge.refine"`, in `timer`.
+    /// `"visibility"`, `"outline.cull"`, `"outline.draw"` and `"outline.pieces"` (when outlines
+    /// are drawn), and `"edge.classify"`, `"edge.border"`, `"edge.tiles"` and `"edge.refine"`,
+    /// in `timer`.
     pub fn encode_timed(
         &self,
         device: &wgpu::Device,
@@ -824,7 +855,8 @@ impl DeferredPass {
     /// The outline pass: `outline_cull` lists the (instance, cluster) pairs that may hold
     /// an outline edge, on a 2D grid of workgroups (huge scenes need more than one dimension
     /// allows); `outline_main` then visits their triangles, dispatched indirectly with the
-    /// size the cull leaves.
+    /// size the cull leaves, and lists the pieces (up to 16 px) of their outline edges;
+    /// `outline_pieces_main` draws those, one a lane.
     fn outline_pass(
         &self,
         device: &wgpu::Device,
@@ -837,7 +869,10 @@ impl DeferredPass {
         let p = self.outline_pipelines(device, variant)?;
         let cull = p.cull.bind(device, sources)?;
         let draw = p.draw.bind(device, sources)?;
-        encoder.clear_buffer(&frame.targets.acc, 0, None);
+        let pieces = p.pieces.bind(device, sources)?;
+        let t = &frame.targets;
+        encoder.clear_buffer(&t.acc, 0, Some(t.acc_pieces));
+        encoder.copy_buffer_to_buffer(&self.reset, 0, &t.acc, t.acc_pieces, LIST_HEADER);
         encoder.copy_buffer_to_buffer(&self.reset, 0, &frame.cull, 0, LIST_HEADER);
         let groups = frame.data.uniforms_clusters().div_ceil(GROUP);
         let max = device.limits().max_compute_workgroups_per_dimension.max(1);
@@ -853,13 +888,27 @@ impl DeferredPass {
             pass.set_bind_group(0, &cull, &[]);
             pass.dispatch_workgroups(x, y, 1);
         }
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("wirepass outline pass"),
+                timestamp_writes: timer
+                    .as_deref_mut()
+                    .and_then(|t| t.compute_span("outline.draw")),
+            });
+            pass.set_pipeline(&p.draw.pipeline);
+            pass.set_bind_group(0, &draw, &[]);
+            pass.dispatch_workgroups_indirect(&frame.cull, 0);
+        }
+        // The piece dispatch's size, where no pass binding `acc` for writing reads it.
+        let size_at = piece_size_at(&frame.data);
+        encoder.copy_buffer_to_buffer(&t.acc, t.acc_pieces, &frame.cull, size_at, LIST_HEADER);
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("wirepass outline pass"),
-            timestamp_writes: timer.and_then(|t| t.compute_span("outline.draw")),
+            label: Some("wirepass outline pieces"),
+            timestamp_writes: timer.and_then(|t| t.compute_span("outline.pieces")),
         });
-        pass.set_pipeline(&p.draw.pipeline);
-        pass.set_bind_group(0, &draw, &[]);
-        pass.dispatch_workgroups_indirect(&frame.cull, 0);
+        pass.set_pipeline(&p.pieces.pipeline);
+        pass.set_bind_group(0, &pieces, &[]);
+        pass.dispatch_workgroups_indirect(&frame.cull, size_at);
         Ok(())
     }
 }

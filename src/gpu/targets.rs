@@ -26,6 +26,13 @@ pub const RESULT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 /// Size of the header (indirect dispatch size x, y, z, then a count) of the outline and
 /// refine lists.
 pub(crate) const LIST_HEADER: u64 = 16;
+/// Room in the outline pass's piece list: a piece per this many target pixels, and at least
+/// MIN_PIECES (a piece is at most 16 px of an outline edge; a 1280×720 view of a 2 M-triangle
+/// sphere lists about 3 000).
+const PIXELS_PER_PIECE: u64 = 8;
+const MIN_PIECES: u64 = 1 << 16;
+/// Bytes per listed piece (outline.wgsl, PIECE_WORDS).
+const PIECE_BYTES: u64 = 16;
 /// Format of [`Targets::outline_tiles`].
 pub(crate) const OUTLINE_TILES_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 
@@ -37,8 +44,10 @@ pub(crate) struct Targets {
     pub output: (u32, u32),
     pub ids: wgpu::Texture,
     pub depth: wgpu::Texture,
-    /// One u32 per target pixel, or two where instances differ in line colour.
+    /// One u32 per target pixel, or two where instances differ in line colour; then the
+    /// outline pass's piece list, from byte `acc_pieces`.
     pub acc: wgpu::Buffer,
+    pub acc_pieces: u64,
     pub acc_colors: bool,
     /// The refine list: header, then one packed pixel per entry.
     pub work: wgpu::Buffer,
@@ -75,20 +84,32 @@ impl Targets {
         }
     }
 
+    /// Pieces the outline pass's list has room for (outline.wgsl, `list_outline`).
+    pub fn piece_room(&self) -> u32 {
+        let room = (self.acc.size() - self.acc_pieces - LIST_HEADER) / PIECE_BYTES;
+        u32::try_from(room).unwrap_or(u32::MAX)
+    }
+
     /// Targets for `spec`, after checking them against the device's limits.
     pub fn new(device: &wgpu::Device, spec: TargetSpec) -> Result<Targets> {
         let (w, h) = spec.size;
         let pixels = u64::from(w) * u64::from(h);
         let binding = device.limits().max_storage_buffer_binding_size;
-        let acc_bytes = pixels * 4 * if spec.acc_colors { 2 } else { 1 };
-        if acc_bytes > binding {
+        // The lines, then the outline pass's piece list: its header, then room for
+        // PIECE_CAPACITY_PER_PIXEL pieces a pixel (or at least MIN_PIECES), fewer where the
+        // binding limit leaves less (the outline pass draws pieces it has no room for
+        // itself).
+        let acc_pieces = pixels * 4 * if spec.acc_colors { 2 } else { 1 };
+        if acc_pieces + LIST_HEADER > binding {
             return Err(Error::OverLimit {
                 what: format!("the outline buffer for a {w}x{h} target, in bytes"),
-                value: acc_bytes,
+                value: acc_pieces + LIST_HEADER,
                 limit_name: "max_storage_buffer_binding_size",
                 limit: binding,
             });
         }
+        let pieces = (pixels / PIXELS_PER_PIECE).max(MIN_PIECES);
+        let acc_bytes = (acc_pieces + LIST_HEADER + PIECE_BYTES * pieces).min(binding / 4 * 4);
         // The list, then a mark bit per target pixel.
         let work_bytes = LIST_HEADER + 4 * pixels + 4 * pixels.div_ceil(32);
         if work_bytes > binding {
@@ -134,8 +155,9 @@ impl Targets {
             acc: buffer(
                 "wirepass outline lines",
                 acc_bytes,
-                wgpu::BufferUsages::empty(),
+                wgpu::BufferUsages::COPY_SRC,
             ),
+            acc_pieces,
             acc_colors: spec.acc_colors,
             // Read back by PreparedFrame::edge_work.
             work: buffer(
