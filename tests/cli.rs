@@ -117,11 +117,20 @@ fn bad_settings_give_one_clear_line() {
     }
 }
 
+/// Runs `wirepass bench ARGS --out OUT` and returns its bench.json.
+fn bench_json(args: &[&str], out: &std::path::Path) -> serde_json::Value {
+    let mut all = vec!["bench"];
+    all.extend_from_slice(args);
+    all.extend(["--out", out.to_str().unwrap()]);
+    let (ok, err) = wirepass(&all);
+    assert!(ok, "{err}");
+    serde_json::from_slice(&std::fs::read(out.join("bench.json")).unwrap()).unwrap()
+}
+
 #[test]
 fn bench_times_only_the_methods_asked_for() {
     let out = temp("bench-methods");
-    let (ok, err) = wirepass(&[
-        "bench",
+    let args = [
         "sphere:2000",
         "--size",
         "64x48",
@@ -129,14 +138,11 @@ fn bench_times_only_the_methods_asked_for() {
         "2",
         "--warmup",
         "0",
-        "--methods",
-        "floor,deferred",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(ok, "{err}");
-    let json: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(out.join("bench.json")).unwrap()).unwrap();
+    ];
+    let json = bench_json(
+        &[&args[..], &["--methods", "floor,deferred"]].concat(),
+        &out,
+    );
     let methods: Vec<_> = json["runs"]
         .as_array()
         .unwrap()
@@ -157,22 +163,11 @@ fn bench_times_only_the_methods_asked_for() {
 #[test]
 fn bench_writes_table_json_csv_and_plots() {
     let out = temp("bench");
-    let (ok, err) = wirepass(&[
-        "bench",
-        "sphere:2000",
-        "grid:500",
-        "--size",
-        "64x48,96x64",
-        "--frames",
-        "2",
-        "--warmup",
-        "1",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(ok, "{err}");
-    let json: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(out.join("bench.json")).unwrap()).unwrap();
+    let args = ["sphere:2000", "grid:500", "--size", "64x48,96x64"];
+    let json = bench_json(
+        &[&args[..], &["--frames", "2", "--warmup", "1"]].concat(),
+        &out,
+    );
     assert!(json["device"]["name"].is_string());
     let runs = json["runs"].as_array().unwrap();
     // 2 scenes × 2 sizes × (floor, deferred, forward, two-pass).

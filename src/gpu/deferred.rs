@@ -731,13 +731,9 @@ impl DeferredPass {
         let (w, h) = t.output;
         let Some(mode) = mode else {
             let group = self.floor.bind(device, &sources)?;
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("wirepass floor"),
-                timestamp_writes: timer.and_then(|t| t.compute_span("edge.floor")),
-            });
-            pass.set_pipeline(&self.floor.pipeline);
-            pass.set_bind_group(0, &group, &[]);
-            pass.dispatch_workgroups(w.div_ceil(TILE), h.div_ceil(TILE), 1);
+            let names = ("wirepass floor", "edge.floor");
+            let size = Size::Grid(w.div_ceil(TILE), h.div_ceil(TILE));
+            dispatch(encoder, timer, names, (&self.floor, &group), size);
             return Ok(());
         };
         let variant = self.variant(frame);
@@ -756,37 +752,30 @@ impl DeferredPass {
             let n = self.results.fetch_add(1, Ordering::Relaxed) + 1;
             frame.encoded.store(n, Ordering::Relaxed);
         }
-        /// How a dispatch is sized: over the output in 8×8 tiles, over the output's border
-        /// pixels, or by a list the dispatch before it wrote.
-        enum Size<'b> {
-            Tiles,
-            Border,
-            List(&'b wgpu::Buffer),
-        }
         let dispatches = [
             (
                 "wirepass edge classify",
                 "edge.classify",
                 &edge.classify,
-                Size::Tiles,
+                Size::Grid(w.div_ceil(TILE), h.div_ceil(TILE)),
             ),
             (
                 "wirepass edge border",
                 "edge.border",
                 &edge.border,
-                Size::Border,
+                Size::Grid((2 * (w + h)).div_ceil(64), 1),
             ),
             (
                 "wirepass edge tiles",
                 "edge.tiles",
                 &edge.tiles,
-                Size::List(&t.tiles),
+                Size::Indirect(&t.tiles, 0),
             ),
             (
                 "wirepass edge refine",
                 "edge.refine",
                 &edge.refine,
-                Size::List(&t.work),
+                Size::Indirect(&t.work, 0),
             ),
         ];
         // Bound before anything is recorded, so a failure leaves the encoder as it was.
@@ -802,17 +791,8 @@ impl DeferredPass {
         // Each dispatch is a pass of its own, timed on its own (the benchmark sums the
         // `edge.*` spans into the edge pass).
         for ((label, span, pipeline, size), group) in dispatches.into_iter().zip(groups) {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some(label),
-                timestamp_writes: timer.as_deref_mut().and_then(|t| t.compute_span(span)),
-            });
-            pass.set_pipeline(&pipeline.pipeline);
-            pass.set_bind_group(0, &group, &[]);
-            match size {
-                Size::Tiles => pass.dispatch_workgroups(w.div_ceil(TILE), h.div_ceil(TILE), 1),
-                Size::Border => pass.dispatch_workgroups((2 * (w + h)).div_ceil(64), 1, 1),
-                Size::List(list) => pass.dispatch_workgroups_indirect(list, 0),
-            }
+            let timer = timer.as_deref_mut();
+            dispatch(encoder, timer, (label, span), (pipeline, &group), size);
         }
         Ok(())
     }
@@ -877,39 +857,47 @@ impl DeferredPass {
         let groups = frame.data.uniforms_clusters().div_ceil(GROUP);
         let max = device.limits().max_compute_workgroups_per_dimension.max(1);
         let (x, y) = (groups.clamp(1, max), groups.div_ceil(max).max(1));
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("wirepass outline cull"),
-                timestamp_writes: timer
-                    .as_deref_mut()
-                    .and_then(|t| t.compute_span("outline.cull")),
-            });
-            pass.set_pipeline(&p.cull.pipeline);
-            pass.set_bind_group(0, &cull, &[]);
-            pass.dispatch_workgroups(x, y, 1);
-        }
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("wirepass outline pass"),
-                timestamp_writes: timer
-                    .as_deref_mut()
-                    .and_then(|t| t.compute_span("outline.draw")),
-            });
-            pass.set_pipeline(&p.draw.pipeline);
-            pass.set_bind_group(0, &draw, &[]);
-            pass.dispatch_workgroups_indirect(&frame.cull, 0);
-        }
+        let names = ("wirepass outline cull", "outline.cull");
+        let size = Size::Grid(x, y);
+        dispatch(encoder, timer.as_deref_mut(), names, (&p.cull, &cull), size);
+        let names = ("wirepass outline pass", "outline.draw");
+        let size = Size::Indirect(&frame.cull, 0);
+        dispatch(encoder, timer.as_deref_mut(), names, (&p.draw, &draw), size);
         // The piece dispatch's size, where no pass binding `acc` for writing reads it.
         let size_at = piece_size_at(&frame.data);
         encoder.copy_buffer_to_buffer(&t.acc, t.acc_pieces, &frame.cull, size_at, LIST_HEADER);
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("wirepass outline pieces"),
-            timestamp_writes: timer.and_then(|t| t.compute_span("outline.pieces")),
-        });
-        pass.set_pipeline(&p.pieces.pipeline);
-        pass.set_bind_group(0, &pieces, &[]);
-        pass.dispatch_workgroups_indirect(&frame.cull, size_at);
+        let names = ("wirepass outline pieces", "outline.pieces");
+        let size = Size::Indirect(&frame.cull, size_at);
+        dispatch(encoder, timer, names, (&p.pieces, &pieces), size);
         Ok(())
+    }
+}
+
+/// How a dispatch is sized: a grid of workgroups, or by the size an earlier dispatch left in
+/// a buffer, at a byte offset.
+enum Size<'b> {
+    Grid(u32, u32),
+    Indirect(&'b wgpu::Buffer, u64),
+}
+
+/// Records one dispatch as a compute pass of its own, labelled `names.0` and timed as the
+/// span `names.1`.
+fn dispatch(
+    encoder: &mut wgpu::CommandEncoder,
+    timer: Option<&mut GpuTimer>,
+    names: (&str, &'static str),
+    (pipeline, group): (&Compute, &wgpu::BindGroup),
+    size: Size<'_>,
+) {
+    let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+        label: Some(names.0),
+        timestamp_writes: timer.and_then(|t| t.compute_span(names.1)),
+    });
+    pass.set_pipeline(&pipeline.pipeline);
+    pass.set_bind_group(0, group, &[]);
+    match size {
+        Size::Grid(x, y) => pass.dispatch_workgroups(x, y, 1),
+        Size::Indirect(buffer, offset) => pass.dispatch_workgroups_indirect(buffer, offset),
     }
 }
 
