@@ -69,6 +69,11 @@ fn piece_list() -> u32 {
 // Words per listed piece: instance slot, triangle, edge, and piece | pieces << 16.
 const PIECE_WORDS: u32 = 4u;
 
+// How many pieces the list has room for, after its header at word `list`.
+fn piece_room(list: u32) -> u32 {
+    return (arrayLength(&acc_rw) - list - 4u) / PIECE_WORDS;
+}
+
 // The instance whose clusters hold the cull's flat cluster index f: the last with
 // cluster_first <= f (instances are in the order of their cluster_first).
 fn instance_of_cluster(f: u32) -> u32 {
@@ -132,7 +137,9 @@ fn outline_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocati
 fn outline_pieces_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
     let k = list_group(group) * 64u + lane;
     let list = piece_list();
-    if k < atomicLoad(&acc_rw[list + 3u]) {
+    // The count includes the pieces found beyond the list's room, which were drawn where
+    // they were found.
+    if k < min(atomicLoad(&acc_rw[list + 3u]), piece_room(list)) {
         let at = list + 4u + PIECE_WORDS * k;
         let inst = atomicLoad(&acc_rw[at]);
         let t = atomicLoad(&acc_rw[at + 1u]);
@@ -323,7 +330,9 @@ fn list_outline(inst: u32, t: u32, i: u32, n: u32, a: vec3<f32>, b: vec3<f32>) {
     let first = frame.target_origin - reach;
     let last = frame.target_origin + frame.target_size + reach;
     let list = piece_list();
-    let capacity = (arrayLength(&acc_rw) - list - 4u) / PIECE_WORDS;
+    let room = piece_room(list);
+    // An item holds the piece count in 16 bits; a longer edge is drawn here whole.
+    let listable = c.pieces <= 0xffffu;
     for (var piece = 0u; piece < c.pieces; piece++) {
         let k0 = f32(piece) / f32(c.pieces);
         let k1 = f32(piece + 1u) / f32(c.pieces);
@@ -332,8 +341,11 @@ fn list_outline(inst: u32, t: u32, i: u32, n: u32, a: vec3<f32>, b: vec3<f32>) {
         if !(all(max(p, q) >= first) && all(min(p, q) <= last)) {
             continue;
         }
-        let k = atomicAdd(&acc_rw[list + 3u], 1u);
-        if k < capacity && c.pieces <= 0xffffu {
+        var k = room;
+        if listable {
+            k = atomicAdd(&acc_rw[list + 3u], 1u);
+        }
+        if k < room {
             let at = list + 4u + PIECE_WORDS * k;
             atomicStore(&acc_rw[at], inst);
             atomicStore(&acc_rw[at + 1u], t);

@@ -142,7 +142,8 @@ pub struct EdgeWork {
     pub refined: u32,
     /// Output pixels in all.
     pub pixels: u32,
-    /// Pieces (up to 16 px) of outline edges the outline pass found, 0 where it did not run.
+    /// Pieces (up to 16 px) of outline edges the outline pass listed or found beyond its
+    /// list's room, 0 where it did not run.
     pub outline_pieces: u32,
     /// How many of them its piece list has room for; it draws the others where it finds
     /// them.
