@@ -28,7 +28,7 @@ pub const RESULT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 pub(crate) const LIST_HEADER: u64 = 16;
 /// Room in the outline pass's piece list: a piece per this many target pixels, and at least
 /// MIN_PIECES (a piece is at most 16 px of an outline edge; a 1280×720 view of a 2 M-triangle
-/// sphere lists about 3 000).
+/// sphere lists about 2 600).
 const PIXELS_PER_PIECE: u64 = 8;
 const MIN_PIECES: u64 = 1 << 16;
 /// Bytes per listed piece (outline.wgsl, PIECE_WORDS).
@@ -84,7 +84,7 @@ impl Targets {
         }
     }
 
-    /// Pieces the outline pass's list has room for (outline.wgsl, `list_outline`).
+    /// Pieces the outline pass's list has room for (outline.wgsl, `piece_room`).
     pub fn piece_room(&self) -> u32 {
         let room = (self.acc.size() - self.acc_pieces - LIST_HEADER) / PIECE_BYTES;
         u32::try_from(room).unwrap_or(u32::MAX)
@@ -95,10 +95,9 @@ impl Targets {
         let (w, h) = spec.size;
         let pixels = u64::from(w) * u64::from(h);
         let binding = device.limits().max_storage_buffer_binding_size;
-        // The lines, then the outline pass's piece list: its header, then room for
-        // PIECE_CAPACITY_PER_PIXEL pieces a pixel (or at least MIN_PIECES), fewer where the
-        // binding limit leaves less (the outline pass draws pieces it has no room for
-        // itself).
+        // The lines, then the outline pass's piece list: its header, then room for a piece
+        // per PIXELS_PER_PIECE target pixels (at least MIN_PIECES), less where the binding
+        // limit leaves less (the outline pass draws the pieces it has no room for itself).
         let acc_pieces = pixels * 4 * if spec.acc_colors { 2 } else { 1 };
         if acc_pieces + LIST_HEADER > binding {
             return Err(Error::OverLimit {
