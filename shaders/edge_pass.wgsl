@@ -184,14 +184,36 @@ fn patch_distance(s: Sample, point: vec2<f32>) -> f32 {
     return best;
 }
 
+// Triangle n of the sampled instance, across edge a -> b of a patch triangle whose third
+// corner is c: whether it joins the patch (that edge is no silhouette), and if so the
+// distance from `point` to its drawn edges (NO_EDGE otherwise).
+struct Across {
+    joins: bool,
+    distance: f32,
+}
+
+fn across(s: Sample, n: u32, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>, point: vec2<f32>) -> Across {
+    let base = instances[slot(s.inst)].triangle_base;
+    let clip = instances[slot(s.inst)].clip;
+    let w = corners(base + n) + instances[slot(s.inst)].vertex_base;
+    let q0 = vertex_at(w.x).xyz;
+    let q1 = vertex_at(w.y).xyz;
+    let q2 = vertex_at(w.z).xyz;
+    var out = Across(!is_silhouette(a, b, c, (q0 + q1 + q2) / 3.0, instances[slot(s.inst)].eye), NO_EDGE);
+    if out.joins {
+        let c0 = clip * vec4<f32>(q0, 1.0);
+        let c1 = clip * vec4<f32>(q1, 1.0);
+        let c2 = clip * vec4<f32>(q2, 1.0);
+        out.distance = drawn_segments(c0, c1, c2, info[base + n] & 7u, point);
+    }
+    return out;
+}
+
 // patch_distance for a patch of two triangles (a quad): the drawn edges of the sampled one
 // and of the other one, across the undrawn edge that joins them, unless that is a
 // silhouette. What the search finds, without its queue.
 fn quad_distance(s: Sample, point: vec2<f32>) -> f32 {
     let base = instances[slot(s.inst)].triangle_base;
-    let vbase = instances[slot(s.inst)].vertex_base;
-    let clip = instances[slot(s.inst)].clip;
-    let eye = instances[slot(s.inst)].eye;
     let bits = info[base + s.tri];
     var best = drawn_segments(s.clip0, s.clip1, s.clip2, bits & 7u, point);
     var i = 0u;
@@ -206,19 +228,10 @@ fn quad_distance(s: Sample, point: vec2<f32>) -> f32 {
         }
     }
     if n != BACKGROUND_ID {
-        let w = corners(base + n) + vbase;
-        let q0 = vertex_at(w.x).xyz;
-        let q1 = vertex_at(w.y).xyz;
-        let q2 = vertex_at(w.z).xyz;
         let a = sample_corner(s, i);
         let b = sample_corner(s, (i + 1u) % 3u);
         let c = sample_corner(s, (i + 2u) % 3u);
-        if !is_silhouette(a, b, c, (q0 + q1 + q2) / 3.0, eye) {
-            let c0 = clip * vec4<f32>(q0, 1.0);
-            let c1 = clip * vec4<f32>(q1, 1.0);
-            let c2 = clip * vec4<f32>(q2, 1.0);
-            best = min(best, drawn_segments(c0, c1, c2, info[base + n] & 7u, point));
-        }
+        best = min(best, across(s, n, a, b, c, point).distance);
     }
     return best;
 }
@@ -230,8 +243,6 @@ fn quad_distance(s: Sample, point: vec2<f32>) -> f32 {
 fn patch_search(s: Sample, point: vec2<f32>) -> f32 {
     let base = instances[slot(s.inst)].triangle_base;
     let vbase = instances[slot(s.inst)].vertex_base;
-    let clip = instances[slot(s.inst)].clip;
-    let eye = instances[slot(s.inst)].eye;
     var best = NO_EDGE;
     var queue: array<u32, PATCH_TRIANGLES>;
     queue[0] = s.tri;
@@ -272,17 +283,11 @@ fn patch_search(s: Sample, point: vec2<f32>) -> f32 {
             if seen {
                 continue;
             }
-            let w = corners(base + n) + vbase;
-            let q0 = vertex_at(w.x).xyz;
-            let q1 = vertex_at(w.y).xyz;
-            let q2 = vertex_at(w.z).xyz;
-            if !is_silhouette(p[i], p[(i + 1u) % 3u], p[(i + 2u) % 3u], (q0 + q1 + q2) / 3.0, eye) {
+            let joined = across(s, n, p[i], p[(i + 1u) % 3u], p[(i + 2u) % 3u], point);
+            if joined.joins {
                 queue[count] = n;
                 count++;
-                let c0 = clip * vec4<f32>(q0, 1.0);
-                let c1 = clip * vec4<f32>(q1, 1.0);
-                let c2 = clip * vec4<f32>(q2, 1.0);
-                best = min(best, drawn_segments(c0, c1, c2, info[base + n] & 7u, point));
+                best = min(best, joined.distance);
             }
         }
     }
