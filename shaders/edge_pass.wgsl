@@ -173,7 +173,7 @@ fn drawn_segments(c0: vec4<f32>, c1: vec4<f32>, c2: vec4<f32>, mask: u32, point:
 fn patch_distance(s: Sample, point: vec2<f32>) -> f32 {
     let bits = info[instances[slot(s.inst)].triangle_base + s.tri];
     if (bits & INFO_QUAD) != 0u {
-        return quad_distance(s, point);
+        return quad_distance(s, bits, point);
     }
     var best = drawn_segments(s.clip0, s.clip1, s.clip2, bits & 7u, point);
     // A loop no lane enters is skipped (and so are the search's arrays), while the body of an
@@ -184,56 +184,60 @@ fn patch_distance(s: Sample, point: vec2<f32>) -> f32 {
     return best;
 }
 
-// Triangle n of the sampled instance, across edge a -> b of a patch triangle whose third
-// corner is c: whether it joins the patch (that edge is no silhouette), and if so the
-// distance from `point` to its drawn edges (NO_EDGE otherwise).
+// The triangle with corners q0, q1, q2 (in its own order) and drawn edges `mask`, across
+// edge a -> b of a patch triangle whose third corner is c: whether it joins the patch (that
+// edge is no silhouette), and if so the distance from `point` to its drawn edges (NO_EDGE
+// otherwise).
 struct Across {
     joins: bool,
     distance: f32,
 }
 
-fn across(s: Sample, n: u32, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>, point: vec2<f32>) -> Across {
-    let base = instances[slot(s.inst)].triangle_base;
+fn across(s: Sample, q0: vec3<f32>, q1: vec3<f32>, q2: vec3<f32>, mask: u32, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>, point: vec2<f32>) -> Across {
     let clip = instances[slot(s.inst)].clip;
-    let w = corners(base + n) + instances[slot(s.inst)].vertex_base;
-    let q0 = vertex_at(w.x).xyz;
-    let q1 = vertex_at(w.y).xyz;
-    let q2 = vertex_at(w.z).xyz;
     var out = Across(!is_silhouette(a, b, c, (q0 + q1 + q2) / 3.0, instances[slot(s.inst)].eye), NO_EDGE);
     if out.joins {
         let c0 = clip * vec4<f32>(q0, 1.0);
         let c1 = clip * vec4<f32>(q1, 1.0);
         let c2 = clip * vec4<f32>(q2, 1.0);
-        out.distance = drawn_segments(c0, c1, c2, info[base + n] & 7u, point);
+        out.distance = drawn_segments(c0, c1, c2, mask, point);
     }
     return out;
 }
 
+// Bits of a quad triangle's `info` (INFO_QUAD; mesh_store::quad_bits) that describe the
+// other triangle without reading it: the diagonal (this triangle's undrawn edge, bits
+// 16-17), the other triangle's corner off the diagonal (18-19), whether its next corner is
+// the diagonal's start (bit 20) or its end, and its drawn edges (21-23).
+const QUAD_EDGE_SHIFT: u32 = 16u;
+const QUAD_CORNER_SHIFT: u32 = 18u;
+const QUAD_SAME: u32 = 1048576u;
+const QUAD_MASK_SHIFT: u32 = 21u;
+
 // patch_distance for a patch of two triangles (a quad): the drawn edges of the sampled one
-// and of the other one, across the undrawn edge that joins them, unless that is a
-// silhouette. What the search finds, without its queue.
-fn quad_distance(s: Sample, point: vec2<f32>) -> f32 {
+// and of the other one, across the diagonal that joins them, unless that is a silhouette.
+// What the search finds, without its queue, from three reads: the other triangle's id, its
+// fourth corner's index and position (the diagonal's corners are the sample's own).
+fn quad_distance(s: Sample, bits: u32, point: vec2<f32>) -> f32 {
     let base = instances[slot(s.inst)].triangle_base;
-    let bits = info[base + s.tri];
     var best = drawn_segments(s.clip0, s.clip1, s.clip2, bits & 7u, point);
-    var i = 0u;
-    var n = BACKGROUND_ID;
-    for (var e = 0u; e < 3u; e++) {
-        if (bits & (1u << e)) == 0u {
-            let m = neighbour(base + s.tri, e);
-            if m != BACKGROUND_ID {
-                i = e;
-                n = m;
-            }
-        }
-    }
-    if n != BACKGROUND_ID {
-        let a = sample_corner(s, i);
-        let b = sample_corner(s, (i + 1u) % 3u);
-        let c = sample_corner(s, (i + 2u) % 3u);
-        best = min(best, across(s, n, a, b, c, point).distance);
-    }
-    return best;
+    let i = (bits >> QUAD_EDGE_SHIFT) & 3u;
+    let k = (bits >> QUAD_CORNER_SHIFT) & 3u;
+    let n = neighbour(base + s.tri, i);
+    let a = sample_corner(s, i);
+    let b = sample_corner(s, (i + 1u) % 3u);
+    let c = sample_corner(s, (i + 2u) % 3u);
+    let d = vertex_at(corner(base + n, k) + instances[slot(s.inst)].vertex_base).xyz;
+    // The other triangle's corners in its own order: d at k, then the diagonal's ends (the
+    // start first where QUAD_SAME says so).
+    let same = (bits & QUAD_SAME) != 0u;
+    let x = select(b, a, same);
+    let y = select(a, b, same);
+    let q0 = select(select(y, x, k == 2u), d, k == 0u);
+    let q1 = select(select(x, y, k == 2u), d, k == 1u);
+    let q2 = select(select(x, y, k == 0u), d, k == 2u);
+    let mask = (bits >> QUAD_MASK_SHIFT) & 7u;
+    return min(best, across(s, q0, q1, q2, mask, a, b, c, point).distance);
 }
 
 // The breadth-first search of patch_distance from the sampled triangle `s`, for patches of
@@ -283,7 +287,11 @@ fn patch_search(s: Sample, point: vec2<f32>) -> f32 {
             if seen {
                 continue;
             }
-            let joined = across(s, n, p[i], p[(i + 1u) % 3u], p[(i + 2u) % 3u], point);
+            let w = corners(base + n) + vbase;
+            let q0 = vertex_at(w.x).xyz;
+            let q1 = vertex_at(w.y).xyz;
+            let q2 = vertex_at(w.z).xyz;
+            let joined = across(s, q0, q1, q2, info[base + n] & 7u, p[i], p[(i + 1u) % 3u], p[(i + 2u) % 3u], point);
             if joined.joins {
                 queue[count] = n;
                 count++;
@@ -305,6 +313,8 @@ struct Own {
     search: bool,
     // The patch is a quad (quad_distance suffices).
     quad: bool,
+    // The triangle's `info`.
+    info: u32,
 }
 
 fn own_lines(s: Sample) -> Own {
@@ -316,7 +326,7 @@ fn own_lines(s: Sample) -> Own {
     }
     let near = vec3<f32>(s.clip0.z, s.clip1.z, s.clip2.z);
     let d = drawn_distances(s.lines, near, mask);
-    var own = Own(min(d.x, min(d.y, d.z)), false, false);
+    var own = Own(min(d.x, min(d.y, d.z)), false, false, bits);
     let u = drawn_distances(s.lines, near, ~mask & 7u);
     let reach = line_reach(instances[slot(s.inst)].line_width);
     let beyond = (flags & INSTANCE_EDGES) != 0u && min(u.x, min(u.y, u.z)) < min(own.distance, reach);
@@ -505,7 +515,7 @@ fn tile_main(@builtin(local_invocation_id) local: vec3<u32>, @builtin(workgroup_
             s = sample(raster.x, raster.y, pixel_centre(xy));
         }
         let certain = foreground && s.covers && s.margin >= COVERAGE_MARGIN;
-        var own = Own(NO_EDGE, false, false);
+        var own = Own(NO_EDGE, false, false, 0u);
         if certain {
             own = own_lines(s);
 #if PATCHES
@@ -514,7 +524,7 @@ fn tile_main(@builtin(local_invocation_id) local: vec3<u32>, @builtin(workgroup_
             // refine_main. Loops, not `if`s: a software rasterizer skips a loop no lane
             // enters, but runs the body of an `if` for every lane.
             for (var quad = own.search && own.quad; quad; quad = false) {
-                own.distance = quad_distance(s, pixel_centre(xy));
+                own.distance = quad_distance(s, own.info, pixel_centre(xy));
             }
 #endif
             if !own.search || own.quad {

@@ -59,7 +59,8 @@ fn slot(i: u32) -> u32 {
 @group(0) @binding(7) var<storage, read> neighbours_hi: array<u32>;
 #endif
 // Per triangle (src/gpu/mesh_store.rs, triangle_info): bits 0-2 the drawn edges, bit 3 a
-// boundary edge, bits 4-7 the fold code, bits 8-10 the edges that may be outlines.
+// boundary edge, bits 4-7 the fold code, bits 8-10 the edges that may be outlines, bits
+// 11-23 what the edge pass needs of its patch (mesh_store::EdgeData::info).
 @group(0) @binding(8) var<storage, read> info: array<u32>;
 // (instance slot, triangle of its mesh) per target pixel; BACKGROUND_ID or HOST_ID in x.
 @group(0) @binding(10) var ids: texture_2d<u32>;
@@ -87,6 +88,16 @@ fn corners(t: u32) -> vec3<u32> {
     }
 #endif
     return vec3<u32>(indices[3u * t], indices[3u * t + 1u], indices[3u * t + 2u]);
+}
+
+// Vertex index of corner k of the store's triangle t (relative to its mesh's first vertex).
+fn corner(t: u32, k: u32) -> u32 {
+#if SPLIT
+    if t >= frame.triangle_split {
+        return indices_hi[3u * (t - frame.triangle_split) + k];
+    }
+#endif
+    return indices[3u * t + k];
 }
 
 // The triangle across edge i of the store's triangle t (relative to its mesh).

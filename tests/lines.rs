@@ -274,6 +274,68 @@ fn concave_and_folded_polygons_are_drawn_whole() {
 }
 
 #[test]
+fn quads_in_any_corner_order_and_winding_are_drawn_whole() {
+    // A curved sheet of quads, each split along one diagonal, whose triangles list their
+    // corners from any of the three, half of the second triangles wound the other way and
+    // some sharing the diagonal's positions, not its vertices: the edge pass reads each
+    // quad's other triangle from what the upload recorded about it.
+    let (nx, ny) = (9, 7);
+    let at = |i: usize, j: usize| {
+        let (x, y) = (i as f32 / 3.0 - 1.5, j as f32 / 3.0 - 1.0);
+        Vec3::new(x, y, 0.3 * (1.7 * x).sin() * (1.3 * y).cos())
+    };
+    let mut positions: Vec<Vec3> = (0..=ny)
+        .flat_map(|j| (0..=nx).map(move |i| (i, j)))
+        .map(|(i, j)| at(i, j))
+        .collect();
+    let (mut triangles, mut masks) = (Vec::new(), Vec::new());
+    for j in 0..ny {
+        for i in 0..nx {
+            let q = j * nx + i;
+            let v = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
+            let (a, b, c, d) = (v(i, j), v(i + 1, j), v(i + 1, j + 1), v(i, j + 1));
+            let (mut a2, mut c2) = (a, c);
+            if q % 4 == 1 {
+                positions.extend([positions[a as usize], positions[c as usize]]);
+                a2 = positions.len() as u32 - 2;
+                c2 = a2 + 1;
+            }
+            let second = if q % 2 == 1 { [a2, d, c2] } else { [a2, c2, d] };
+            for (k, mut t) in [[a, b, c], second].into_iter().enumerate() {
+                t.rotate_left((q + k) % 3);
+                let diagonal = |x: u32, y: u32| {
+                    let p = [x, y].map(|v| positions[v as usize]);
+                    p.contains(&positions[a as usize]) && p.contains(&positions[c as usize])
+                };
+                masks.push((0..3).fold(0u8, |m, e| {
+                    m | u8::from(!diagonal(t[e], t[(e + 1) % 3])) << e
+                }));
+                triangles.push(t);
+            }
+        }
+    }
+    let mesh = Mesh::new(positions, None, triangles, Some(masks)).unwrap();
+    let size = (320, 240);
+    for (name, eye) in [
+        ("front", DVec3::new(0.2, 0.1, 4.5)),
+        ("oblique", DVec3::new(2.5, -2.0, 2.5)),
+        ("behind", DVec3::new(-1.0, 0.5, -4.0)),
+    ] {
+        let camera = looking(eye, DVec3::ZERO);
+        for width in [1.5, 5.0] {
+            check(
+                &format!("quads {name} {width} px"),
+                &mesh,
+                camera,
+                size,
+                EdgeSelection::Polygon,
+                width,
+            );
+        }
+    }
+}
+
+#[test]
 fn quads_of_a_dense_sphere_are_drawn_whole() {
     // Quads of about half a pixel: the line of a quad edge crosses many diagonals.
     let mesh = wirepass::mesh::sphere(200_000).unwrap();

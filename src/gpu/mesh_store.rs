@@ -696,13 +696,52 @@ const INFO_SPLAT_SHIFT: u32 = 12;
 /// pass searches without a queue.
 const INFO_QUAD: u32 = 1 << 15;
 
+/// First bit of [`EdgeData::info`] of a quad: its diagonal (edge 0–2, two bits), then the
+/// other triangle's corner off the diagonal (two bits), whether that triangle's next corner
+/// is the diagonal's start (one bit) and its drawn edges (three bits): `quad_distance` in
+/// edge_pass.wgsl measures the other triangle from these, its id and one corner's position.
+const QUAD_SHIFT: u32 = 16;
+
+/// [`INFO_QUAD`] and the bits after [`QUAD_SHIFT`] for triangle `t` of a two-triangle patch
+/// under edge mask `mask`, or 0 (the triangle is then searched as any small patch is) where
+/// the other triangle does not meet it across the diagonal at bit-identical positions, so
+/// that the diagonal's ends read from either triangle are the same numbers.
+fn quad_bits(mesh: &Mesh, mask: &[u8], t: usize) -> u32 {
+    let neighbours = mesh.edge_neighbours();
+    let (tris, positions) = (mesh.triangles(), mesh.positions());
+    let at = |v: u32| positions[v as usize].to_array().map(f32::to_bits);
+    // The last undrawn edge with a neighbour, as the search would take it.
+    let Some(e) = (0..3)
+        .rev()
+        .find(|&e| mask[t] & (1 << e) == 0 && neighbours[t][e] != NO_NEIGHBOUR)
+    else {
+        return 0;
+    };
+    let n = neighbours[t][e] as usize;
+    let (a, b) = (at(tris[t][e]), at(tris[t][(e + 1) % 3]));
+    let shared = (0..3).find_map(|j| {
+        let (p, q) = (at(tris[n][j]), at(tris[n][(j + 1) % 3]));
+        let back = neighbours[n][j] as usize == t;
+        (back && ((p, q) == (a, b) || (p, q) == (b, a))).then_some((j, p == a))
+    });
+    let Some((j, same)) = shared else {
+        return 0;
+    };
+    let k = (j + 2) % 3;
+    INFO_QUAD
+        | (e as u32) << QUAD_SHIFT
+        | (k as u32) << (QUAD_SHIFT + 2)
+        | u32::from(same) << (QUAD_SHIFT + 4)
+        | u32::from(mask[n] & ALL_EDGES) << (QUAD_SHIFT + 5)
+}
+
 /// A mesh's edge data under one edge selection, in stored order.
 pub(crate) struct EdgeData {
     /// Per stored triangle, the 4 bytes the passes read (`triangle_info` in common.wgsl):
     /// bits 0–2 the drawn edges, bit 3 a boundary edge, bits 4–7 the fold code of
     /// [`Mesh::outline_hints`], bits 8–10 the edges that may be drawn as outlines, bit 11
     /// a large patch, bits 12–14 the drawn edges the outline pass draws, bit 15 a patch of
-    /// two triangles.
+    /// two triangles, bits 16–23 that quad's other triangle ([`quad_bits`]).
     pub info: Vec<u32>,
     pub lines: MeshLines,
 }
@@ -729,7 +768,11 @@ impl EdgeData {
                 } else {
                     0
                 };
-                let quad = if patches.size[t] == 2 { INFO_QUAD } else { 0 };
+                let quad = if patches.size[t] == 2 {
+                    quad_bits(mesh, &mask, t)
+                } else {
+                    0
+                };
                 u32::from(mask[t])
                     | u32::from(hints[t]) << 3
                     | u32::from(outline[t]) << 8
@@ -816,6 +859,60 @@ mod tests {
         assert_eq!(f.used(), 20);
         f.grow(200);
         assert_eq!(f.free, vec![(20, 200)]);
+    }
+
+    /// The quad (0,0)-(1,0)-(1,1)-(0,1) split along 0-2, the second triangle's corners
+    /// given by `second` over positions `p`, with the diagonal undrawn on both sides.
+    fn quad_info(p: Vec<Vec3>, second: [u32; 3]) -> [u32; 2] {
+        let shared = (0..3)
+            .find(|&j| {
+                let e = [second[j], second[(j + 1) % 3]].map(|v| p[v as usize]);
+                e.contains(&p[0]) && e.contains(&p[2])
+            })
+            .unwrap();
+        let mask = vec![0b011, ALL_EDGES & !(1 << shared)];
+        let mesh = Mesh::new(p, None, vec![[0, 1, 2], second], Some(mask)).unwrap();
+        let mask = mesh.edge_mask(EdgeSelection::Polygon);
+        [0, 1].map(|t| quad_bits(&mesh, &mask, t))
+    }
+
+    fn square() -> Vec<Vec3> {
+        [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
+            .map(|(x, y)| Vec3::new(x, y, 0.0))
+            .to_vec()
+    }
+
+    /// Decodes quad_bits as quad_distance does: the diagonal, the other triangle's corner
+    /// off it, whether its next corner is the diagonal's start, its drawn edges.
+    fn decode(bits: u32) -> (u32, u32, bool, u32) {
+        assert_ne!(bits & INFO_QUAD, 0);
+        let b = bits >> QUAD_SHIFT;
+        (b & 3, b >> 2 & 3, b >> 4 & 1 == 1, b >> 5 & 7)
+    }
+
+    #[test]
+    fn quad_bits_name_the_other_triangle_s_fourth_corner() {
+        // Consistently wound: the diagonal is edge 2 (2 -> 0) of the first triangle and
+        // edge 0 (0 -> 2) of the second, whose corner off it is 3 (corner 2).
+        let [first, second] = quad_info(square(), [0, 2, 3]);
+        assert_eq!(decode(first), (2, 2, false, 0b110));
+        assert_eq!(decode(second), (0, 1, false, 0b011));
+        // The second triangle wound the other way (its next corner after 3 is the first
+        // triangle's diagonal start, 2), and with split vertices at the same positions.
+        let mut p = square();
+        p.extend([p[0], p[2]]);
+        let [first, second] = quad_info(p, [3, 5, 4]);
+        assert_eq!(decode(first), (2, 0, true, 0b101));
+        assert_eq!(decode(second), (1, 1, true, 0b011));
+    }
+
+    #[test]
+    fn quads_joined_at_unequal_bits_are_searched_instead() {
+        // 0.0 and -0.0 weld into one edge, but read from the two triangles they would be
+        // different numbers: the triangles are left to the patch search.
+        let mut p = square();
+        p.extend([Vec3::new(-0.0, 0.0, 0.0), p[2]]);
+        assert_eq!(quad_info(p, [4, 5, 3]), [0, 0]);
     }
 
     #[test]
