@@ -197,8 +197,13 @@ fn segment_distance(ca: vec4<f32>, cb: vec4<f32>, pixel: vec2<f32>, size: vec2<f
     }
     let pa = pixel_relative(mix(ca, cb, s.x), pixel, size);
     let pb = pixel_relative(mix(ca, cb, s.y), pixel, size);
-    let a = pa.xy / pa.z;
-    let ab = pb.xy / pb.z - a;
+    return screen_segment_distance(pa.xy / pa.z, pb.xy / pb.z);
+}
+
+// The length of the shortest vector from the origin to the screen segment a -> b (a and b
+// in pixels from the pixel centre); NO_EDGE where that is not a number.
+fn screen_segment_distance(a: vec2<f32>, b: vec2<f32>) -> f32 {
+    let ab = b - a;
     let len2 = dot(ab, ab);
     var k = 0.0;
     if len2 > 0.0 {

@@ -240,6 +240,60 @@ fn quad_distance(s: Sample, bits: u32, point: vec2<f32>) -> f32 {
     return min(best, across(s, q0, q1, q2, mask, a, b, c, point).distance);
 }
 
+// quad_distance for a pixel of tile_main, where the centre lies inside its own triangle, and
+// only where the quad's four corners lie in front of the near plane (`front`; elsewhere
+// refine_main measures it with quad_distance's clipping): each corner is projected once and
+// each drawn edge measured as segment_distance measures it unclipped, the same arithmetic.
+struct QuadFront {
+    distance: f32,
+    front: bool,
+}
+
+fn quad_front(s: Sample, bits: u32, point: vec2<f32>) -> QuadFront {
+    let base = instances[slot(s.inst)].triangle_base;
+    let i = (bits >> QUAD_EDGE_SHIFT) & 3u;
+    let k = (bits >> QUAD_CORNER_SHIFT) & 3u;
+    let n = neighbour(base + s.tri, i);
+    let d = vertex_at(corner(base + n, k) + instances[slot(s.inst)].vertex_base).xyz;
+    let cd = instances[slot(s.inst)].clip * vec4<f32>(d, 1.0);
+    let size = frame.image_size;
+    let h0 = pixel_relative(s.clip0, point, size);
+    let h1 = pixel_relative(s.clip1, point, size);
+    let h2 = pixel_relative(s.clip2, point, size);
+    let hd = pixel_relative(cd, point, size);
+    let p0 = h0.xy / h0.z;
+    let p1 = h1.xy / h1.z;
+    let p2 = h2.xy / h2.z;
+    let pd = hd.xy / hd.z;
+    let own = vec3<f32>(screen_segment_distance(p0, p1), screen_segment_distance(p1, p2), screen_segment_distance(p2, p0));
+    let drawn = (vec3<u32>(bits) & vec3<u32>(1u, 2u, 4u)) != vec3<u32>(0u);
+    let mine = select(vec3<f32>(NO_EDGE), own, drawn);
+    var best = min(mine.x, min(mine.y, mine.z));
+    // The other triangle: d at corner k, then the diagonal's ends; its edges k (d -> x) and
+    // k + 2 (y -> d), the diagonal k + 1 being undrawn on both sides (mesh_store::quad_bits).
+    let same = (bits & QUAD_SAME) != 0u;
+    let a = sample_corner(s, i);
+    let b = sample_corner(s, (i + 1u) % 3u);
+    let x = select(b, a, same);
+    let y = select(a, b, same);
+    let pa = select(select(p2, p1, i == 1u), p0, i == 0u);
+    let pb = select(select(p0, p2, i == 1u), p1, i == 0u);
+    let px = select(pb, pa, same);
+    let py = select(pa, pb, same);
+    let mask = (bits >> QUAD_MASK_SHIFT) & 7u;
+    let first = select(NO_EDGE, screen_segment_distance(pd, px), (mask & (1u << k)) != 0u);
+    let last = select(NO_EDGE, screen_segment_distance(py, pd), (mask & (1u << ((k + 2u) % 3u))) != 0u);
+    let q0 = select(select(y, x, k == 2u), d, k == 0u);
+    let q1 = select(select(x, y, k == 2u), d, k == 1u);
+    let q2 = select(select(x, y, k == 0u), d, k == 2u);
+    let joins = !is_silhouette(a, b, sample_corner(s, (i + 2u) % 3u), (q0 + q1 + q2) / 3.0, instances[slot(s.inst)].eye);
+    if joins {
+        best = min(best, min(first, last));
+    }
+    let front = min(min(s.clip0.z, s.clip1.z), min(s.clip2.z, cd.z)) >= 0.0;
+    return QuadFront(best, front);
+}
+
 // The breadth-first search of patch_distance from the sampled triangle `s`, for patches of
 // more than two triangles: the least distance to the drawn edges of the other triangles.
 // Each triangle is read once, when it joins the patch; a triangle's neighbours are read only
@@ -521,21 +575,18 @@ fn tile_main(@builtin(local_invocation_id) local: vec3<u32>, @builtin(workgroup_
 #if PATCHES
             // Near a quad's diagonal the other triangle's edges count too; larger polygons
             // (rarer, and the search's queue would slow every quad) are searched by
-            // refine_main. Loops, not `if`s: a software rasterizer skips a loop no lane
-            // enters, but runs the body of an `if` for every lane.
-            for (var quad = own.search && own.quad; quad; quad = false) {
-                own.distance = quad_distance(s, own.info, pixel_centre(xy));
+            // refine_main.
+            if own.search && own.quad {
+                let quad = quad_front(s, own.info, pixel_centre(xy));
+                own.distance = quad.distance;
+                // Cut by the near plane: refine_main clips.
+                own.quad = quad.front;
             }
 #endif
             if !own.search || own.quad {
                 store_pixel(xy, surface_pixel(xy, s, own.distance));
             }
         }
-#if PATCHES
-        for (var later = certain && own.search && !own.quad; later; later = false) {
-            refine_later(xy);
-        }
-#endif
         // Pixels for refine_main: bit 4 this one, where the exact test could not decide it;
         // bits 0-3 the background next to it (left, right, up, down) in the output, which
         // may hold a triangle the rasterizer missed (border_main lists the background
@@ -543,7 +594,7 @@ fn tile_main(@builtin(local_invocation_id) local: vec3<u32>, @builtin(workgroup_
         let q = vec2<i32>(xy);
         let first = vec2<i32>(frame.output_offset);
         let last = vec2<i32>(frame.output_offset + frame.output_size) - 1;
-        var pending = select(0u, 16u, foreground && !certain);
+        var pending = select(0u, 16u, foreground && (!certain || (own.search && !own.quad)));
         for (var i = 0u; i < 4u; i++) {
             let n = q + neighbour_offset(i);
             if all(n >= first) && all(n <= last) && id_at(n).x >= HOST_ID {

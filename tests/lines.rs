@@ -336,6 +336,39 @@ fn quads_in_any_corner_order_and_winding_are_drawn_whole() {
 }
 
 #[test]
+fn a_quad_cut_by_the_near_plane_is_drawn_whole() {
+    let size = (320, 240);
+    // One quad, folded, whose near corner lies behind the eye: the other triangle's pixels
+    // beside the diagonal measure edges cut by the near plane (measured uncut, those edges
+    // would run through them).
+    let quad = Mesh::new(
+        [
+            (-1.5, 0.0, -1.0),
+            (1.5, 0.0, -1.0),
+            (0.0, 2.0, 4.0),
+            (0.0, 0.0, -5.0),
+        ]
+        .map(|(x, y, z)| Vec3::new(x, y, z))
+        .to_vec(),
+        None,
+        vec![[0, 1, 2], [1, 0, 3]],
+        Some(vec![0b110, 0b110]),
+    )
+    .unwrap();
+    let camera = looking(DVec3::new(0.3, 1.5, 2.0), DVec3::new(0.0, 0.0, -2.0));
+    for width in [1.5, 5.0] {
+        check(
+            &format!("a quad cut by the near plane {width} px"),
+            &quad,
+            camera,
+            size,
+            EdgeSelection::Polygon,
+            width,
+        );
+    }
+}
+
+#[test]
 fn quads_of_a_dense_sphere_are_drawn_whole() {
     // Quads of about half a pixel: the line of a quad edge crosses many diagonals.
     let mesh = wirepass::mesh::sphere(200_000).unwrap();

@@ -704,8 +704,9 @@ const QUAD_SHIFT: u32 = 16;
 
 /// [`INFO_QUAD`] and the bits after [`QUAD_SHIFT`] for triangle `t` of a two-triangle patch
 /// under edge mask `mask`, or 0 (the triangle is then searched as any small patch is) where
-/// the other triangle does not meet it across the diagonal at bit-identical positions, so
-/// that the diagonal's ends read from either triangle are the same numbers.
+/// the other triangle does not meet it across the diagonal at bit-identical positions (so
+/// that the diagonal's ends read from either triangle are the same numbers) or draws the
+/// diagonal from its side.
 fn quad_bits(mesh: &Mesh, mask: &[u8], t: usize) -> u32 {
     let neighbours = mesh.edge_neighbours();
     let (tris, positions) = (mesh.triangles(), mesh.positions());
@@ -721,7 +722,7 @@ fn quad_bits(mesh: &Mesh, mask: &[u8], t: usize) -> u32 {
     let (a, b) = (at(tris[t][e]), at(tris[t][(e + 1) % 3]));
     let shared = (0..3).find_map(|j| {
         let (p, q) = (at(tris[n][j]), at(tris[n][(j + 1) % 3]));
-        let back = neighbours[n][j] as usize == t;
+        let back = neighbours[n][j] as usize == t && mask[n] & (1 << j) == 0;
         (back && ((p, q) == (a, b) || (p, q) == (b, a))).then_some((j, p == a))
     });
     let Some((j, same)) = shared else {
