@@ -34,10 +34,8 @@ struct Frame {
     clusters: u32,
     // Host depth: 1 when the id target was seeded from the host's depth.
     host_depth: u32,
-    // This frame's own nonzero value: the outline pass marks the output tiles its lines
-    // reach with it, so no clear of the marks is needed between frames.
-    stamp: u32,
-    _pad: u32,
+    _pad0: u32,
+    _pad1: u32,
 }
 
 // Per instance (src/gpu/frame.rs, InstanceRecord). "Local" coordinates are the mesh

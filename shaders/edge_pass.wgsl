@@ -3,9 +3,13 @@
 // both sides of every branch, and a loop until its last lane is done; it skips only the
 // memory reads of masked lanes):
 //
-// `classify_main`, one invocation per output pixel: background and host pixels are finished
-// here (the outline pass's line, if any, over the background); the 8×8 tiles that hold
-// foreground are listed.
+// `classify_main`, one invocation per output pixel: background and host pixels are written
+// here, without lines; the 8×8 tiles that hold foreground are marked.
+//
+// `tile_list_main`, one invocation per output tile: the marked tiles are listed.
+//
+// `outlined_main`, dispatched indirectly over the tiles the outline pass listed (those its
+// lines reach): their background and host pixels get the outline pass's line, if any.
 //
 // `tile_main`, dispatched indirectly over the listed tiles: the triangle the rasterizer gave
 // a pixel is tested exactly at the centre; where it covers the centre with room to spare
@@ -28,10 +32,9 @@
 // only), MODE_DIAGNOSTIC.
 #if OUTLINES
 // What the outline pass left per target pixel: the greatest `line_key` (and, with COLORS,
-// the greatest (level, instance) pair after it).
+// the greatest (level, instance) pair after it); then the tiles its lines reach
+// (`outline_tile_marks`).
 @group(0) @binding(12) var<storage, read> acc: array<u32>;
-// Per 8×8 output tile, the stamp of the last frame whose outline lines may reach it.
-@group(0) @binding(27) var outline_tiles: texture_2d<u32>;
 #endif
 
 // A list one dispatch appends to and the next is dispatched over: the indirect dispatch
@@ -56,7 +59,8 @@ struct ListRead {
 @group(0) @binding(15) var<storage, read_write> work_rw: List;
 @group(0) @binding(16) var<storage, read> work: ListRead;
 
-// The tiles `classify_main` leaves to `tile_main`, with a mark per output tile.
+// The tiles `tile_list_main` lists for `tile_main`, then the mark per output tile that
+// `classify_main` sets.
 @group(0) @binding(24) var<storage, read_write> tiles_rw: List;
 @group(0) @binding(25) var<storage, read> tiles: ListRead;
 
@@ -110,19 +114,14 @@ fn outline_at(xy: vec2<u32>) -> vec2<u32> {
 }
 
 // A pixel whose centre no triangle covers (`inst` is BACKGROUND_ID or HOST_ID): only the
-// outline pass's line colours it. Without `outlined` no line reaches it.
-fn empty_pixel(xy: vec2<u32>, inst: u32, outlined: bool) -> Pixel {
+// outline pass's line colours it, `outline` as outline_at gives it (0 for no line).
+fn empty_pixel(xy: vec2<u32>, inst: u32, outline: vec2<u32>) -> Pixel {
     var p: Pixel;
     p.inst = inst;
     p.tri = 0u;
     p.depth = 0.0;
     if inst == HOST_ID {
         p.depth = host_at(vec2<i32>(xy));
-    }
-    // Behind the condition, lanes of tiles no line reaches skip the read.
-    var outline = vec2<u32>(0u);
-    if outlined {
-        outline = outline_at(xy);
     }
     if outline.x == 0u {
         p.distance = NO_EDGE;
@@ -476,28 +475,50 @@ fn classify_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(workgro
     let raster = textureLoad(ids, xy, 0).x;
     let empty = raster >= HOST_ID;
     // Background next to foreground is written here too; tile_main lists it again for
-    // refine_main, which decides it.
-    var outlined = false;
-#if OUTLINES
-    outlined = textureLoad(outline_tiles, group.xy, 0).x == frame.stamp;
-#endif
+    // refine_main, which decides it. Lines over the background are outlined_main's.
     if inside && empty {
-        store_pixel(xy, empty_pixel(xy, raster, outlined));
+        store_pixel(xy, empty_pixel(xy, raster, vec2<u32>(0u)));
     }
-    // The first foreground pixel of a tile lists it: the tile's mark, after the list, is
-    // cleared each frame (a workgroup barrier and vote would cost every tile).
+    // Foreground marks its tile (the marks, after the list, are cleared each frame): one
+    // store, where listing the tile here would cost every pixel the list's atomics (and a
+    // workgroup barrier and vote would cost every tile).
     if inside && !empty {
-        let tile = group.x | (group.y << 16u);
-        let marks = groups.x * groups.y;
-        if atomicExchange(&tiles_rw.items[marks + group.y * groups.x + group.x], 1u) == 0u {
-            let k = atomicAdd(&tiles_rw.count, 1u);
-            atomicStore(&tiles_rw.items[k], tile);
-            let size = list_size(k, 1u);
-            atomicMax(&tiles_rw.x, size.x);
-            atomicMax(&tiles_rw.y, size.y);
+        atomicStore(&tiles_rw.items[groups.x * groups.y + group.y * groups.x + group.x], 1u);
+    }
+}
+
+// Lists the output tiles classify_main marked, one invocation per tile.
+@compute @workgroup_size(64)
+fn tile_list_main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let size = vec2<u32>(frame.output_size);
+    let columns = (size.x + 7u) / 8u;
+    let count = columns * ((size.y + 7u) / 8u);
+    let t = gid.x;
+    if t < count && atomicLoad(&tiles_rw.items[count + t]) != 0u {
+        let k = atomicAdd(&tiles_rw.count, 1u);
+        atomicStore(&tiles_rw.items[k], (t % columns) | ((t / columns) << 16u));
+        let size = list_size(k, 1u);
+        atomicMax(&tiles_rw.x, size.x);
+        atomicMax(&tiles_rw.y, size.y);
+    }
+}
+
+#if OUTLINES
+@compute @workgroup_size(8, 8)
+fn outlined_main(@builtin(local_invocation_id) local: vec3<u32>, @builtin(workgroup_id) group: vec3<u32>) {
+    let list = outline_tile_list();
+    let t = list_group(group);
+    if t < acc[list + 3u] {
+        let tile = acc[list + 4u + t];
+        let at = vec2<u32>(tile & 0xffffu, tile >> 16u) * 8u + local.xy;
+        let xy = at + vec2<u32>(frame.output_offset);
+        let raster = textureLoad(ids, xy, 0).x;
+        if all(vec2<f32>(at) < frame.output_size) && raster >= HOST_ID {
+            store_pixel(xy, empty_pixel(xy, raster, outline_at(xy)));
         }
     }
 }
+#endif
 
 // Edge-adjacent pixel i (left, right, up, down) of a pixel, as an offset.
 fn neighbour_offset(i: u32) -> vec2<i32> {
@@ -627,7 +648,7 @@ fn finish(xy: vec2<u32>, s: Sample) -> Pixel {
 #endif
         return surface_pixel(xy, s, own.distance);
     }
-    return empty_pixel(xy, s.inst, true);
+    return empty_pixel(xy, s.inst, outline_at(xy));
 }
 
 // The triangle whose surface the centre of target pixel `xy` sees, for a pixel `tile_main`

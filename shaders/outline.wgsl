@@ -26,10 +26,9 @@
 // (intensity level, instance) pair, so the edge pass knows whose line it holds).
 
 @group(0) @binding(9) var<storage, read> clusters: array<Cluster>;
+// The outline buffer (`outline_tile_marks` in scene.wgsl): the lines, and the output tiles
+// they reach, which the edge pass visits for their background.
 @group(0) @binding(11) var<storage, read_write> acc_rw: array<atomic<u32>>;
-// Per 8×8 output tile, the stamp of the last frame whose outline lines may reach it: the
-// edge pass reads `acc` for the background only in tiles marked for its own frame.
-@group(0) @binding(26) var outline_tiles_rw: texture_storage_2d<r32uint, write>;
 
 // The (instance, cluster) pairs that `outline_cull` finds may hold an outline edge, and the
 // indirect dispatch size for visiting them; starts as (0, 1, 1, 0).
@@ -51,19 +50,14 @@ struct OutlineListRead {
 }
 @group(0) @binding(14) var<storage, read> cull: OutlineListRead;
 
-// After the lines in `acc_rw`, the pieces of outline edges that `outline_main` lists for
-// `outline_pieces_main`: a header (indirect dispatch size x, y, z, then the count; the
-// encoder copies it to where the piece dispatch reads its size) and PIECE_WORDS words per
-// piece. A lane of the piece dispatch draws one piece, where a lane of `outline_main` would
-// draw every piece of its triangle's outline edges while the other lanes of its cluster,
-// most of them without any, wait for it.
+// After the lines and the tiles in `acc_rw`, the pieces of outline edges that `outline_main`
+// lists for `outline_pieces_main`: a header (indirect dispatch size x, y, z, then the count;
+// the encoder copies it to where the piece dispatch reads its size) and PIECE_WORDS words
+// per piece. A lane of the piece dispatch draws one piece, where a lane of `outline_main`
+// would draw every piece of its triangle's outline edges while the other lanes of its
+// cluster, most of them without any, wait for it.
 fn piece_list() -> u32 {
-    let pixels = u32(frame.target_size.x) * u32(frame.target_size.y);
-#if COLORS
-    return 2u * pixels;
-#else
-    return pixels;
-#endif
+    return outline_tile_list() + 4u + outline_tile_count();
 }
 
 // Words per listed piece: instance slot, triangle, edge, and piece | pieces << 16.
@@ -505,8 +499,9 @@ fn draw_piece(seg: Segment, k0: f32, k1: f32, length_px: f32) {
     }
 }
 
-// Marks the output tiles that pixels [first_m, last_m] along axis `major` and
-// [first_o, last_o] across it (target pixels) fall in.
+// Lists the output tiles that pixels [first_m, last_m] along axis `major` and
+// [first_o, last_o] across it (target pixels) fall in, each once a frame (its mark is
+// cleared with the lines).
 fn mark_outline_tiles(first_m: i32, last_m: i32, first_o: i32, last_o: i32, major: u32) {
     var lo = vec2<i32>(first_m, first_o);
     var hi = vec2<i32>(last_m, last_o);
@@ -515,12 +510,21 @@ fn mark_outline_tiles(first_m: i32, last_m: i32, first_o: i32, last_o: i32, majo
         hi = hi.yx;
     }
     let offset = vec2<i32>(frame.output_offset);
-    let tiles = vec2<i32>(textureDimensions(outline_tiles_rw)) - 1;
+    let columns = (u32(frame.output_size.x) + 7u) / 8u;
+    let tiles = vec2<i32>(i32(columns), i32((u32(frame.output_size.y) + 7u) / 8u)) - 1;
     let t0 = clamp((lo - offset) / 8, vec2<i32>(0), tiles);
     let t1 = clamp((hi - offset) / 8, vec2<i32>(0), tiles);
+    let marks = outline_tile_marks();
+    let list = outline_tile_list();
     for (var y = t0.y; y <= t1.y; y++) {
         for (var x = t0.x; x <= t1.x; x++) {
-            textureStore(outline_tiles_rw, vec2<i32>(x, y), vec4<u32>(frame.stamp));
+            if atomicExchange(&acc_rw[marks + u32(y) * columns + u32(x)], 1u) == 0u {
+                let k = atomicAdd(&acc_rw[list + 3u], 1u);
+                atomicStore(&acc_rw[list + 4u + k], u32(x) | (u32(y) << 16u));
+                let size = list_size(k, 1u);
+                atomicMax(&acc_rw[list], size.x);
+                atomicMax(&acc_rw[list + 1u], size.y);
+            }
         }
     }
 }

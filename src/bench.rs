@@ -71,6 +71,8 @@ pub struct Run {
 pub struct EdgeShares {
     /// Tiles with foreground among all 8×8 output tiles.
     pub tiles: f64,
+    /// Tiles the outline pass's lines reach among all 8×8 output tiles.
+    pub outlined_tiles: f64,
     /// Pixels refined among all output pixels.
     pub refined: f64,
     /// Pieces of outline edges the outline pass's piece dispatch drew (or found beyond its
@@ -323,7 +325,8 @@ pub fn bench_scene(
     }
     ctx.finish()?;
 
-    let mut timer = GpuTimer::new(device, queue, 12)?;
+    // Room for every span a frame can have (the host's depth seeding included), and more.
+    let mut timer = GpuTimer::new(device, queue, 16)?;
     let mut gpu: Vec<BTreeMap<String, Vec<f64>>> = vec![BTreeMap::new(); subjects.len()];
     let mut totals = vec![Vec::new(); subjects.len()];
     let mut cpu = vec![Vec::new(); subjects.len()];
@@ -361,6 +364,7 @@ pub fn bench_scene(
                 let w = frame.edge_work(device, queue)?;
                 Some(EdgeShares {
                     tiles: f64::from(w.tiles) / f64::from(w.all_tiles.max(1)),
+                    outlined_tiles: f64::from(w.outlined_tiles) / f64::from(w.all_tiles.max(1)),
                     refined: f64::from(w.refined) / f64::from(w.pixels.max(1)),
                     outline_pieces: w.outline_pieces,
                 })
@@ -466,8 +470,10 @@ pub fn markdown(runs: &[Run]) -> String {
             .collect();
         if let Some(w) = r.edge_work {
             other.push(format!(
-                "tiles {:.1} %, refined {:.2} % of pixels, {} outline pieces",
+                "tiles {:.1} %, outlined tiles {:.1} %, refined {:.2} % of pixels, {} outline \
+                 pieces",
                 100.0 * w.tiles,
+                100.0 * w.outlined_tiles,
                 100.0 * w.refined,
                 w.outline_pieces
             ));

@@ -363,7 +363,7 @@ fn timer_reports_every_pass() {
     let frame = pass
         .prepare(device, &store, &scene, &Style::default(), (64, 64))
         .unwrap();
-    let mut timer = wirepass::gpu::GpuTimer::new(device, &ctx.queue, 12)
+    let mut timer = wirepass::gpu::GpuTimer::new(device, &ctx.queue, 16)
         .expect("software adapters expose TIMESTAMP_QUERY");
     for _ in 0..2 {
         let mut encoder = device.create_command_encoder(&Default::default());
@@ -388,6 +388,8 @@ fn timer_reports_every_pass() {
                 "outline.draw",
                 "outline.pieces",
                 "edge.classify",
+                "edge.tile_list",
+                "edge.outlined",
                 "edge.border",
                 "edge.tiles",
                 "edge.refine"
@@ -521,6 +523,13 @@ fn edge_work_lists_the_tiles_with_foreground_and_the_background_beside_it() {
     }
     assert_eq!(work.tiles, tiles, "{work:?}");
     assert_eq!(work.all_tiles, 13 * 9);
+    // The tiles the outline's lines reach, each listed once: there are more pieces, each
+    // reaching a tile at least, than tiles.
+    assert!(
+        work.outlined_tiles > 10 && work.outlined_tiles <= work.all_tiles,
+        "{work:?}"
+    );
+    assert!(work.outline_pieces > work.all_tiles, "{work:?}");
     assert_eq!(work.pixels, 7000);
     assert!(tiles > 10 && beside > 50, "{tiles} tiles, {beside} beside");
     // Every background pixel beside the foreground once, and the foreground the exact test
@@ -537,5 +546,9 @@ fn edge_work_lists_the_tiles_with_foreground_and_the_background_beside_it() {
     };
     let (store, scene) = single(&mesh, EdgeSelection::Polygon, away.to_view(100.0 / 70.0));
     let (_, work) = draw(&store, &scene);
-    assert_eq!((work.tiles, work.refined), (0, 0), "{work:?}");
+    assert_eq!(
+        (work.tiles, work.outlined_tiles, work.refined),
+        (0, 0, 0),
+        "{work:?}"
+    );
 }

@@ -42,9 +42,6 @@ pub(crate) enum Res {
     /// The edge pass's list of tiles for `tile_main`.
     TilesRw = 24,
     Tiles = 25,
-    /// The output tiles the outline pass's lines reach (`Frame.stamp` per tile).
-    OutlineTilesRw = 26,
-    OutlineTiles = 27,
 }
 
 impl Res {
@@ -74,8 +71,7 @@ impl Res {
         let ty = match self {
             Frame | UniformInstances => buffer(wgpu::BufferBindingType::Uniform),
             AccRw | CullRw | WorkRw | TilesRw => write,
-            Ids | HostDepth | OutlineTiles => texture(wgpu::TextureSampleType::Uint),
-            OutlineTilesRw => storage_texture(super::targets::OUTLINE_TILES_FORMAT),
+            Ids | HostDepth => texture(wgpu::TextureSampleType::Uint),
             HostColor => texture(wgpu::TextureSampleType::Float { filterable: false }),
             OutColor => storage_texture(color),
             OutDiagnostic => storage_texture(super::targets::DIAGNOSTIC_FORMAT),
@@ -102,8 +98,6 @@ impl Res {
                         | UniformInstances
                         | Ids
                         | HostDepth
-                        | OutlineTiles
-                        | OutlineTilesRw
                         | HostColor
                         | OutColor
                         | OutDiagnostic
@@ -235,7 +229,6 @@ pub(crate) struct Sources<'a> {
     pub cull: Option<&'a wgpu::Buffer>,
     pub work: Option<&'a wgpu::Buffer>,
     pub tiles: Option<&'a wgpu::Buffer>,
-    pub outline_tiles: Option<&'a wgpu::TextureView>,
     pub out_color: Option<&'a wgpu::TextureView>,
     pub host_color: Option<&'a wgpu::TextureView>,
     pub out_diagnostic: Option<&'a wgpu::TextureView>,
@@ -253,7 +246,6 @@ impl<'a> Sources<'a> {
             cull: None,
             work: None,
             tiles: None,
-            outline_tiles: None,
             out_color: None,
             host_color: None,
             out_diagnostic: None,
@@ -328,9 +320,6 @@ pub(crate) fn bind_group(
             CullRw | Cull => sources.cull.ok_or_else(|| missing(r))?.as_entire_binding(),
             WorkRw | Work => sources.work.ok_or_else(|| missing(r))?.as_entire_binding(),
             TilesRw | Tiles => sources.tiles.ok_or_else(|| missing(r))?.as_entire_binding(),
-            OutlineTilesRw | OutlineTiles => {
-                wgpu::BindingResource::TextureView(sources.outline_tiles.ok_or_else(|| missing(r))?)
-            }
             OutColor => {
                 wgpu::BindingResource::TextureView(sources.out_color.ok_or_else(|| missing(r))?)
             }

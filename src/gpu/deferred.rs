@@ -95,6 +95,9 @@ struct Variant {
 
 struct EdgePipelines {
     classify: Compute,
+    tile_list: Compute,
+    /// Lines over the background of the tiles the outline pass lists; with outlines only.
+    outlined: Option<Compute>,
     border: Compute,
     tiles: Compute,
     refine: Compute,
@@ -135,6 +138,9 @@ pub struct PreparedFrame {
 pub struct EdgeWork {
     /// 8×8 output tiles holding foreground, which the tile dispatch visited.
     pub tiles: u32,
+    /// Output tiles the outline pass's lines reach, whose background the edge pass's
+    /// outlined dispatch visited (0 where the outline pass did not run).
+    pub outlined_tiles: u32,
     /// Output tiles in all.
     pub all_tiles: u32,
     /// Pixels the refine dispatch decided: centres the exact test could not settle from the
@@ -163,6 +169,11 @@ impl PreparedFrame {
         let t = &self.targets;
         Ok(EdgeWork {
             tiles: count(&t.tiles, 0)?,
+            outlined_tiles: if self.data.outlines {
+                count(&t.acc, t.acc_tiles)?
+            } else {
+                0
+            },
             all_tiles: w.div_ceil(TILE) * h.div_ceil(TILE),
             refined: count(&t.work, 0)?,
             pixels: w * h,
@@ -509,11 +520,31 @@ impl DeferredPass {
             r.extend_from_slice(&out);
             r
         };
-        let mut classify_res = vec![Res::TilesRw];
-        if v.outlines {
-            classify_res.push(Res::OutlineTiles);
-        }
-        let classify = Compute::new(device, &module, "classify_main", with(&classify_res), color)?;
+        let classify = Compute::new(
+            device,
+            &module,
+            "classify_main",
+            with(&[Res::TilesRw]),
+            color,
+        )?;
+        let tile_list = Compute::new(
+            device,
+            &module,
+            "tile_list_main",
+            with(&[Res::TilesRw]),
+            color,
+        )?;
+        let outlined = if v.outlines {
+            Some(Compute::new(
+                device,
+                &module,
+                "outlined_main",
+                with(&[]),
+                color,
+            )?)
+        } else {
+            None
+        };
         let border = Compute::new(device, &module, "border_main", with(&[Res::WorkRw]), color)?;
         let mut tile_res = vec![Res::Tiles, Res::WorkRw];
         let mut neighbours = vec![Res::Neighbours];
@@ -533,6 +564,8 @@ impl DeferredPass {
         }
         let p = Arc::new(EdgePipelines {
             classify,
+            tile_list,
+            outlined,
             border,
             tiles,
             refine,
@@ -572,7 +605,7 @@ impl DeferredPass {
             self.format,
         )?;
         let mut draw_res = store_resources(v.split, true, v.uniform_instances);
-        draw_res.extend([Res::Ids, Res::AccRw, Res::OutlineTilesRw]);
+        draw_res.extend([Res::Ids, Res::AccRw]);
         if v.host {
             draw_res.push(Res::HostDepth);
         }
@@ -706,7 +739,6 @@ impl DeferredPass {
             )?;
         }
         let ids = t.ids.create_view(&Default::default());
-        let outline_tiles = t.outline_tiles.create_view(&Default::default());
         let host_depth = t.host.as_ref().map(|h| h.create_view(&Default::default()));
         let (diag, resolved) = match &t.diagnostic {
             Some((d, r)) => (
@@ -722,7 +754,6 @@ impl DeferredPass {
             cull: Some(&frame.cull),
             work: Some(&t.work),
             tiles: Some(&t.tiles),
-            outline_tiles: Some(&outline_tiles),
             out_color,
             host_color,
             out_diagnostic: diag.as_ref(),
@@ -753,13 +784,23 @@ impl DeferredPass {
             let n = self.results.fetch_add(1, Ordering::Relaxed) + 1;
             frame.encoded.store(n, Ordering::Relaxed);
         }
-        let dispatches = [
-            (
-                "wirepass edge classify",
-                "edge.classify",
-                &edge.classify,
-                Size::Grid(w.div_ceil(TILE), h.div_ceil(TILE)),
-            ),
+        let mut dispatches = vec![(
+            "wirepass edge classify",
+            "edge.classify",
+            &edge.classify,
+            Size::Grid(w.div_ceil(TILE), h.div_ceil(TILE)),
+        )];
+        dispatches.push((
+            "wirepass edge tile list",
+            "edge.tile_list",
+            &edge.tile_list,
+            Size::Grid((w.div_ceil(TILE) * h.div_ceil(TILE)).div_ceil(64), 1),
+        ));
+        if let Some(outlined) = &edge.outlined {
+            let size = Size::Indirect(&t.acc, t.acc_tiles);
+            dispatches.push(("wirepass edge outlined", "edge.outlined", outlined, size));
+        }
+        dispatches.extend([
             (
                 "wirepass edge border",
                 "edge.border",
@@ -778,7 +819,7 @@ impl DeferredPass {
                 &edge.refine,
                 Size::Indirect(&t.work, 0),
             ),
-        ];
+        ]);
         // Bound before anything is recorded, so a failure leaves the encoder as it was.
         let groups = dispatches
             .iter()
@@ -853,6 +894,7 @@ impl DeferredPass {
         let pieces = p.pieces.bind(device, sources)?;
         let t = &frame.targets;
         encoder.clear_buffer(&t.acc, 0, Some(t.acc_pieces));
+        encoder.copy_buffer_to_buffer(&self.reset, 0, &t.acc, t.acc_tiles, LIST_HEADER);
         encoder.copy_buffer_to_buffer(&self.reset, 0, &t.acc, t.acc_pieces, LIST_HEADER);
         encoder.copy_buffer_to_buffer(&self.reset, 0, &frame.cull, 0, LIST_HEADER);
         let groups = frame.data.uniforms_clusters().div_ceil(GROUP);

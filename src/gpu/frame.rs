@@ -31,8 +31,7 @@ pub struct FrameUniforms {
     triangle_split: u32,
     clusters: u32,
     host_depth: u32,
-    stamp: u32,
-    _pad: u32,
+    _pad: [u32; 2],
 }
 
 /// Mirror of WGSL `struct Instance`; field order and padding match it.
@@ -74,17 +73,6 @@ pub(crate) const INSTANCE_INDEX_OFFSET: u64 = 204;
 pub(crate) const INSTANCE_BASES_OFFSET: u64 = 184;
 /// Size of an `InstanceRecord`.
 pub(crate) const INSTANCE_BYTES: u64 = std::mem::size_of::<InstanceRecord>() as u64;
-
-/// A value no other frame of this process has (`Frame.stamp`), never 0.
-fn next_stamp() -> u32 {
-    static NEXT: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(1);
-    loop {
-        let s = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        if s != 0 {
-            return s;
-        }
-    }
-}
 
 impl FrameUniforms {
     /// Instances in the frame.
@@ -370,8 +358,7 @@ impl FrameData {
             triangle_split: buffers.split.triangles,
             clusters,
             host_depth: 0,
-            stamp: next_stamp(),
-            _pad: 0,
+            _pad: [0; 2],
         };
         let frame = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("wirepass frame"),

@@ -33,8 +33,6 @@ const PIXELS_PER_PIECE: u64 = 8;
 const MIN_PIECES: u64 = 1 << 16;
 /// Bytes per listed piece (outline.wgsl, PIECE_WORDS).
 const PIECE_BYTES: u64 = 16;
-/// Format of [`Targets::outline_tiles`].
-pub(crate) const OUTLINE_TILES_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 
 #[derive(Clone)]
 pub(crate) struct Targets {
@@ -44,17 +42,18 @@ pub(crate) struct Targets {
     pub output: (u32, u32),
     pub ids: wgpu::Texture,
     pub depth: wgpu::Texture,
-    /// One u32 per target pixel, or two where instances differ in line colour; then the
-    /// outline pass's piece list, from byte `acc_pieces`.
+    /// The outline buffer (`outline_tile_marks` in scene.wgsl): one u32 per target pixel,
+    /// or two where instances differ in line colour; a mark per output tile; the list of
+    /// the tiles the lines reach, from byte `acc_tiles`; the outline pass's piece list, from
+    /// byte `acc_pieces`.
     pub acc: wgpu::Buffer,
+    pub acc_tiles: u64,
     pub acc_pieces: u64,
     pub acc_colors: bool,
     /// The refine list: header, then one packed pixel per entry.
     pub work: wgpu::Buffer,
     /// The edge pass's list of 8×8 output tiles with work for its tile dispatch.
     pub tiles: wgpu::Buffer,
-    /// Per 8×8 output tile, the stamp of the last frame whose outline lines reach it.
-    pub outline_tiles: wgpu::Texture,
     pub result: Option<wgpu::Texture>,
     pub diagnostic: Option<(wgpu::Texture, wgpu::Texture)>,
     /// The host's depth, where the frame has one.
@@ -95,10 +94,13 @@ impl Targets {
         let (w, h) = spec.size;
         let pixels = u64::from(w) * u64::from(h);
         let binding = device.limits().max_storage_buffer_binding_size;
-        // The lines, then the outline pass's piece list: its header, then room for a piece
-        // per PIXELS_PER_PIECE target pixels (at least MIN_PIECES), less where the binding
-        // limit leaves less (the outline pass draws the pieces it has no room for itself).
-        let acc_pieces = pixels * 4 * if spec.acc_colors { 2 } else { 1 };
+        let tiles = u64::from(spec.output.0.div_ceil(8)) * u64::from(spec.output.1.div_ceil(8));
+        // The lines, the tile marks and list, then the outline pass's piece list: its header,
+        // then room for a piece per PIXELS_PER_PIECE target pixels (at least MIN_PIECES),
+        // less where the binding limit leaves less (the outline pass draws the pieces it has
+        // no room for itself).
+        let acc_tiles = pixels * 4 * if spec.acc_colors { 2 } else { 1 } + 4 * tiles;
+        let acc_pieces = acc_tiles + LIST_HEADER + 4 * tiles;
         if acc_pieces + LIST_HEADER > binding {
             return Err(Error::OverLimit {
                 what: format!("the outline buffer for a {w}x{h} target, in bytes"),
@@ -122,7 +124,6 @@ impl Targets {
                 limit: binding,
             });
         }
-        let tiles = u64::from(spec.output.0.div_ceil(8)) * u64::from(spec.output.1.div_ceil(8));
         // The list, then a mark per tile.
         let tiles_bytes = LIST_HEADER + 8 * tiles;
         use wgpu::TextureUsages as U;
@@ -154,8 +155,9 @@ impl Targets {
             acc: buffer(
                 "wirepass outline lines",
                 acc_bytes,
-                wgpu::BufferUsages::COPY_SRC,
+                wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_SRC,
             ),
+            acc_tiles,
             acc_pieces,
             acc_colors: spec.acc_colors,
             // Read back by PreparedFrame::edge_work.
@@ -168,12 +170,6 @@ impl Targets {
                 "wirepass tile list",
                 tiles_bytes,
                 wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_SRC,
-            ),
-            outline_tiles: texture(
-                "wirepass outline tiles",
-                (spec.output.0.div_ceil(8), spec.output.1.div_ceil(8)),
-                OUTLINE_TILES_FORMAT,
-                U::STORAGE_BINDING | U::TEXTURE_BINDING,
             ),
             result: spec.result.then(|| {
                 texture(
