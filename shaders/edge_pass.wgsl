@@ -213,30 +213,52 @@ const QUAD_CORNER_SHIFT: u32 = 18u;
 const QUAD_SAME: u32 = 1048576u;
 const QUAD_MASK_SHIFT: u32 = 21u;
 
+// A quad as its sampled triangle `s` sees it, from three reads: the diagonal a -> b (the
+// sample's undrawn edge i) and its third corner c, the other triangle's fourth corner d (its
+// corner k) and that triangle's corners in its own order and drawn edges.
+struct Quad {
+    i: u32,
+    k: u32,
+    a: vec3<f32>,
+    b: vec3<f32>,
+    c: vec3<f32>,
+    d: vec3<f32>,
+    q0: vec3<f32>,
+    q1: vec3<f32>,
+    q2: vec3<f32>,
+    // The other triangle's corner after d is a (else b).
+    same: bool,
+    mask: u32,
+}
+
+fn quad_of(s: Sample, bits: u32) -> Quad {
+    var q: Quad;
+    let base = instances[slot(s.inst)].triangle_base;
+    q.i = (bits >> QUAD_EDGE_SHIFT) & 3u;
+    q.k = (bits >> QUAD_CORNER_SHIFT) & 3u;
+    let n = neighbour(base + s.tri, q.i);
+    q.a = sample_corner(s, q.i);
+    q.b = sample_corner(s, (q.i + 1u) % 3u);
+    q.c = sample_corner(s, (q.i + 2u) % 3u);
+    q.d = vertex_at(corner(base + n, q.k) + instances[slot(s.inst)].vertex_base).xyz;
+    // d at k, then the diagonal's ends.
+    q.same = (bits & QUAD_SAME) != 0u;
+    let x = select(q.b, q.a, q.same);
+    let y = select(q.a, q.b, q.same);
+    q.q0 = select(select(y, x, q.k == 2u), q.d, q.k == 0u);
+    q.q1 = select(select(x, y, q.k == 2u), q.d, q.k == 1u);
+    q.q2 = select(select(x, y, q.k == 0u), q.d, q.k == 2u);
+    q.mask = (bits >> QUAD_MASK_SHIFT) & 7u;
+    return q;
+}
+
 // patch_distance for a patch of two triangles (a quad): the drawn edges of the sampled one
 // and of the other one, across the diagonal that joins them, unless that is a silhouette.
-// What the search finds, without its queue, from three reads: the other triangle's id, its
-// fourth corner's index and position (the diagonal's corners are the sample's own).
+// What the search finds, without its queue.
 fn quad_distance(s: Sample, bits: u32, point: vec2<f32>) -> f32 {
-    let base = instances[slot(s.inst)].triangle_base;
-    var best = drawn_segments(s.clip0, s.clip1, s.clip2, bits & 7u, point);
-    let i = (bits >> QUAD_EDGE_SHIFT) & 3u;
-    let k = (bits >> QUAD_CORNER_SHIFT) & 3u;
-    let n = neighbour(base + s.tri, i);
-    let a = sample_corner(s, i);
-    let b = sample_corner(s, (i + 1u) % 3u);
-    let c = sample_corner(s, (i + 2u) % 3u);
-    let d = vertex_at(corner(base + n, k) + instances[slot(s.inst)].vertex_base).xyz;
-    // The other triangle's corners in its own order: d at k, then the diagonal's ends (the
-    // start first where QUAD_SAME says so).
-    let same = (bits & QUAD_SAME) != 0u;
-    let x = select(b, a, same);
-    let y = select(a, b, same);
-    let q0 = select(select(y, x, k == 2u), d, k == 0u);
-    let q1 = select(select(x, y, k == 2u), d, k == 1u);
-    let q2 = select(select(x, y, k == 0u), d, k == 2u);
-    let mask = (bits >> QUAD_MASK_SHIFT) & 7u;
-    return min(best, across(s, q0, q1, q2, mask, a, b, c, point).distance);
+    let best = drawn_segments(s.clip0, s.clip1, s.clip2, bits & 7u, point);
+    let q = quad_of(s, bits);
+    return min(best, across(s, q.q0, q.q1, q.q2, q.mask, q.a, q.b, q.c, point).distance);
 }
 
 // quad_distance for a pixel of tile_main, where the centre lies inside its own triangle, and
@@ -249,12 +271,8 @@ struct QuadFront {
 }
 
 fn quad_front(s: Sample, bits: u32, point: vec2<f32>) -> QuadFront {
-    let base = instances[slot(s.inst)].triangle_base;
-    let i = (bits >> QUAD_EDGE_SHIFT) & 3u;
-    let k = (bits >> QUAD_CORNER_SHIFT) & 3u;
-    let n = neighbour(base + s.tri, i);
-    let d = vertex_at(corner(base + n, k) + instances[slot(s.inst)].vertex_base).xyz;
-    let cd = instances[slot(s.inst)].clip * vec4<f32>(d, 1.0);
+    let q = quad_of(s, bits);
+    let cd = instances[slot(s.inst)].clip * vec4<f32>(q.d, 1.0);
     let size = frame.image_size;
     let h0 = pixel_relative(s.clip0, point, size);
     let h1 = pixel_relative(s.clip1, point, size);
@@ -268,25 +286,16 @@ fn quad_front(s: Sample, bits: u32, point: vec2<f32>) -> QuadFront {
     let drawn = (vec3<u32>(bits) & vec3<u32>(1u, 2u, 4u)) != vec3<u32>(0u);
     let mine = select(vec3<f32>(NO_EDGE), own, drawn);
     var best = min(mine.x, min(mine.y, mine.z));
-    // The other triangle: d at corner k, then the diagonal's ends; its edges k (d -> x) and
-    // k + 2 (y -> d), the diagonal k + 1 being undrawn on both sides (mesh_store::quad_bits).
-    let same = (bits & QUAD_SAME) != 0u;
-    let a = sample_corner(s, i);
-    let b = sample_corner(s, (i + 1u) % 3u);
-    let x = select(b, a, same);
-    let y = select(a, b, same);
-    let pa = select(select(p2, p1, i == 1u), p0, i == 0u);
-    let pb = select(select(p0, p2, i == 1u), p1, i == 0u);
-    let px = select(pb, pa, same);
-    let py = select(pa, pb, same);
-    let mask = (bits >> QUAD_MASK_SHIFT) & 7u;
-    let first = select(NO_EDGE, screen_segment_distance(pd, px), (mask & (1u << k)) != 0u);
-    let last = select(NO_EDGE, screen_segment_distance(py, pd), (mask & (1u << ((k + 2u) % 3u))) != 0u);
-    let q0 = select(select(y, x, k == 2u), d, k == 0u);
-    let q1 = select(select(x, y, k == 2u), d, k == 1u);
-    let q2 = select(select(x, y, k == 0u), d, k == 2u);
-    let joins = !is_silhouette(a, b, sample_corner(s, (i + 2u) % 3u), (q0 + q1 + q2) / 3.0, instances[slot(s.inst)].eye);
-    if joins {
+    // The other triangle's edges k (d -> x) and k + 2 (y -> d), x and y the diagonal's ends
+    // in its order; its edge k + 1, the diagonal, is undrawn on both sides
+    // (mesh_store::quad_bits).
+    let pa = select(select(p2, p1, q.i == 1u), p0, q.i == 0u);
+    let pb = select(select(p0, p2, q.i == 1u), p1, q.i == 0u);
+    let px = select(pb, pa, q.same);
+    let py = select(pa, pb, q.same);
+    let first = select(NO_EDGE, screen_segment_distance(pd, px), (q.mask & (1u << q.k)) != 0u);
+    let last = select(NO_EDGE, screen_segment_distance(py, pd), (q.mask & (1u << ((q.k + 2u) % 3u))) != 0u);
+    if !is_silhouette(q.a, q.b, q.c, (q.q0 + q.q1 + q.q2) / 3.0, instances[slot(s.inst)].eye) {
         best = min(best, min(first, last));
     }
     let front = min(min(s.clip0.z, s.clip1.z), min(s.clip2.z, cd.z)) >= 0.0;
@@ -504,6 +513,7 @@ fn tile_list_main(@builtin(global_invocation_id) gid: vec3<u32>) {
 }
 
 #if OUTLINES
+// The outline pass's lines over the background and host pixels of the tiles they reach.
 @compute @workgroup_size(8, 8)
 fn outlined_main(@builtin(local_invocation_id) local: vec3<u32>, @builtin(workgroup_id) group: vec3<u32>) {
     let list = outline_tile_list();
@@ -608,7 +618,8 @@ fn tile_main(@builtin(local_invocation_id) local: vec3<u32>, @builtin(workgroup_
                 store_pixel(xy, surface_pixel(xy, s, own.distance));
             }
         }
-        // Pixels for refine_main: bit 4 this one, where the exact test could not decide it;
+        // Pixels for refine_main: bit 4 this one, where the exact test could not decide it
+        // or its patch must be searched;
         // bits 0-3 the background next to it (left, right, up, down) in the output, which
         // may hold a triangle the rasterizer missed (border_main lists the background
         // next to foreground in the guard band).
