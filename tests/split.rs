@@ -192,9 +192,9 @@ fn an_image_past_the_outline_buffer_limit_is_a_clear_error() {
     small.finish().unwrap();
 }
 
-/// The outline pass lists the pieces of outline edges after the lines in its buffer; where
-/// the buffer has no room left for them, it draws them where it finds them, to the same
-/// image.
+/// The outline pass lists the pieces of outline edges after the lines (and their tiles) in its
+/// buffer; where the buffer has no room left for them, it draws them where it finds them, to
+/// the same image.
 #[test]
 fn outline_pieces_past_the_list_s_room_are_drawn_where_they_are_found() {
     let (small, _turn) = small_device();
