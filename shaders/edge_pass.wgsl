@@ -373,7 +373,7 @@ fn patch_search(s: Sample, point: vec2<f32>) -> f32 {
 struct Own {
     distance: f32,
     search: bool,
-    // The patch is a quad (quad_distance suffices).
+    // The patch is a quad, measured without a search (quad_front, quad_distance).
     quad: bool,
     // The triangle's `info`.
     info: u32,

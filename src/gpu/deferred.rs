@@ -784,18 +784,20 @@ impl DeferredPass {
             let n = self.results.fetch_add(1, Ordering::Relaxed) + 1;
             frame.encoded.store(n, Ordering::Relaxed);
         }
-        let mut dispatches = vec![(
-            "wirepass edge classify",
-            "edge.classify",
-            &edge.classify,
-            Size::Grid(w.div_ceil(TILE), h.div_ceil(TILE)),
-        )];
-        dispatches.push((
-            "wirepass edge tile list",
-            "edge.tile_list",
-            &edge.tile_list,
-            Size::Grid((w.div_ceil(TILE) * h.div_ceil(TILE)).div_ceil(64), 1),
-        ));
+        let mut dispatches = vec![
+            (
+                "wirepass edge classify",
+                "edge.classify",
+                &edge.classify,
+                Size::Grid(w.div_ceil(TILE), h.div_ceil(TILE)),
+            ),
+            (
+                "wirepass edge tile list",
+                "edge.tile_list",
+                &edge.tile_list,
+                Size::Grid((w.div_ceil(TILE) * h.div_ceil(TILE)).div_ceil(64), 1),
+            ),
+        ];
         if let Some(outlined) = &edge.outlined {
             let size = Size::Indirect(&t.acc, t.acc_tiles);
             dispatches.push(("wirepass edge outlined", "edge.outlined", outlined, size));

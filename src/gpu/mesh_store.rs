@@ -698,8 +698,8 @@ const INFO_QUAD: u32 = 1 << 15;
 
 /// First bit of [`EdgeData::info`] of a quad: its diagonal (edge 0–2, two bits), then the
 /// other triangle's corner off the diagonal (two bits), whether that triangle's next corner
-/// is the diagonal's start (one bit) and its drawn edges (three bits): `quad_distance` in
-/// edge_pass.wgsl measures the other triangle from these, its id and one corner's position.
+/// is the diagonal's start (one bit) and its drawn edges (three bits): `quad_of` in
+/// edge_pass.wgsl reads the other triangle from these, its id and one corner's position.
 const QUAD_SHIFT: u32 = 16;
 
 /// [`INFO_QUAD`] and the bits after [`QUAD_SHIFT`] for triangle `t` of a two-triangle patch
