@@ -105,6 +105,24 @@ fn looking(eye: DVec3, target: DVec3) -> Camera {
     }
 }
 
+/// `check` in polygon mode from each of `eyes` looking at `target`, at each line width.
+fn check_views(what: &str, mesh: &Mesh, target: DVec3, eyes: &[(&str, DVec3)], widths: &[f32]) {
+    for &(name, eye) in eyes {
+        let camera = looking(eye, target);
+        for &width in widths {
+            let name = format!("{what} {name} {width} px");
+            check(
+                &name,
+                mesh,
+                camera,
+                (320, 240),
+                EdgeSelection::Polygon,
+                width,
+            );
+        }
+    }
+}
+
 #[test]
 fn the_creases_of_a_tessellated_cube_are_solid() {
     // Each face a 48 × 48 grid of quads: every crease is the edges of many small triangles.
@@ -202,26 +220,20 @@ fn polygons() -> String {
 #[test]
 fn n_gons_are_drawn_whole_down_to_pixel_size() {
     let mesh = obj("ngons", &polygons());
-    let size = (320, 240);
     // Face on (the small row a few pixels across), then from farther, where the small ones are
     // a pixel or two across.
-    for (name, eye) in [
+    let eyes = [
         ("near", DVec3::new(0.0, -0.5, 14.0)),
         ("tilted", DVec3::new(6.0, -4.0, 9.0)),
         ("far", DVec3::new(0.37, -0.91, 50.0)),
-    ] {
-        let camera = looking(eye, DVec3::new(0.0, -0.5, 0.0));
-        for width in [1.5, 4.0] {
-            check(
-                &format!("n-gons {name} {width} px"),
-                &mesh,
-                camera,
-                size,
-                EdgeSelection::Polygon,
-                width,
-            );
-        }
-    }
+    ];
+    check_views(
+        "n-gons",
+        &mesh,
+        DVec3::new(0.0, -0.5, 0.0),
+        &eyes,
+        &[1.5, 4.0],
+    );
 }
 
 #[test]
@@ -252,25 +264,13 @@ fn concave_and_folded_polygons_are_drawn_whole() {
     text += "f 21 22 23 24 25 26\n";
     text += "v 1.5 -1 0\nv 3.5 -1 0.6\nv 3.5 1 0\nv 1.5 1 0.6\nf 27 28 29 30\n";
     let mesh = obj("concave", &text);
-    let size = (320, 240);
-    for (name, eye) in [
+    let eyes = [
         ("front", DVec3::new(0.0, 0.0, 7.0)),
         ("oblique", DVec3::new(4.0, 3.0, 4.0)),
         ("grazing", DVec3::new(0.0, -7.0, 0.6)),
         ("behind", DVec3::new(-1.0, 1.0, -6.0)),
-    ] {
-        let camera = looking(eye, DVec3::ZERO);
-        for width in [1.5, 5.0] {
-            check(
-                &format!("concave/folded {name} {width} px"),
-                &mesh,
-                camera,
-                size,
-                EdgeSelection::Polygon,
-                width,
-            );
-        }
-    }
+    ];
+    check_views("concave/folded", &mesh, DVec3::ZERO, &eyes, &[1.5, 5.0]);
 }
 
 #[test]
@@ -315,29 +315,16 @@ fn quads_in_any_corner_order_and_winding_are_drawn_whole() {
         }
     }
     let mesh = Mesh::new(positions, None, triangles, Some(masks)).unwrap();
-    let size = (320, 240);
-    for (name, eye) in [
+    let eyes = [
         ("front", DVec3::new(0.2, 0.1, 4.5)),
         ("oblique", DVec3::new(2.5, -2.0, 2.5)),
         ("behind", DVec3::new(-1.0, 0.5, -4.0)),
-    ] {
-        let camera = looking(eye, DVec3::ZERO);
-        for width in [1.5, 5.0] {
-            check(
-                &format!("quads {name} {width} px"),
-                &mesh,
-                camera,
-                size,
-                EdgeSelection::Polygon,
-                width,
-            );
-        }
-    }
+    ];
+    check_views("quads", &mesh, DVec3::ZERO, &eyes, &[1.5, 5.0]);
 }
 
 #[test]
 fn a_quad_cut_by_the_near_plane_is_drawn_whole() {
-    let size = (320, 240);
     // One quad, folded, whose near corner lies behind the eye: the other triangle's pixels
     // beside the diagonal measure edges cut by the near plane (measured uncut, those edges
     // would run through them).
@@ -355,17 +342,14 @@ fn a_quad_cut_by_the_near_plane_is_drawn_whole() {
         Some(vec![0b110, 0b110]),
     )
     .unwrap();
-    let camera = looking(DVec3::new(0.3, 1.5, 2.0), DVec3::new(0.0, 0.0, -2.0));
-    for width in [1.5, 5.0] {
-        check(
-            &format!("a quad cut by the near plane {width} px"),
-            &quad,
-            camera,
-            size,
-            EdgeSelection::Polygon,
-            width,
-        );
-    }
+    let eye = [("from above", DVec3::new(0.3, 1.5, 2.0))];
+    check_views(
+        "a quad cut by the near plane",
+        &quad,
+        DVec3::new(0.0, 0.0, -2.0),
+        &eye,
+        &[1.5, 5.0],
+    );
 }
 
 #[test]
