@@ -103,17 +103,6 @@ fn vertex_at(v: u32) -> vec4<f32> {
     return vertices[v];
 }
 
-// Vertex indices of the store's triangle t (relative to its mesh's first vertex).
-fn corners(t: u32) -> vec3<u32> {
-#if SPLIT
-    if t >= frame.triangle_split {
-        let k = 3u * (t - frame.triangle_split);
-        return vec3<u32>(indices_hi[k], indices_hi[k + 1u], indices_hi[k + 2u]);
-    }
-#endif
-    return vec3<u32>(indices[3u * t], indices[3u * t + 1u], indices[3u * t + 2u]);
-}
-
 // Vertex index of corner k of the store's triangle t (relative to its mesh's first vertex).
 fn corner(t: u32, k: u32) -> u32 {
 #if SPLIT
@@ -122,6 +111,11 @@ fn corner(t: u32, k: u32) -> u32 {
     }
 #endif
     return indices[3u * t + k];
+}
+
+// Vertex indices of the store's triangle t (relative to its mesh's first vertex).
+fn corners(t: u32) -> vec3<u32> {
+    return vec3<u32>(corner(t, 0u), corner(t, 1u), corner(t, 2u));
 }
 
 // The triangle across edge i of the store's triangle t (relative to its mesh).
