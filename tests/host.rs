@@ -503,26 +503,6 @@ fn composite_into_srgb_bgra_and_float_targets_matches_the_storage_path() {
         mean: 0.002,
         p99: 0.02,
     };
-    // The storage path over the host's resolved sRGB image, per sample count.
-    let references = [1, 4].map(|samples| {
-        if samples > 1 && !msaa_host_depth() {
-            return Vec::new();
-        }
-        let (reference, host_image) = stored(
-            HostFormats {
-                samples,
-                ..HostFormats::EXAMPLE
-            },
-            Composite::Lines,
-        );
-        let changed = reference
-            .chunks_exact(4)
-            .zip(host_image.chunks_exact(4))
-            .filter(|(a, b)| a != b)
-            .count();
-        assert!(changed > 5000, "the lines changed only {changed} pixels");
-        reference
-    });
     use wgpu::TextureFormat as F;
     for (color, samples) in [
         (F::Rgba8UnormSrgb, 4),
@@ -540,10 +520,19 @@ fn composite_into_srgb_bgra_and_float_targets_matches_the_storage_path() {
             assert_msaa_refused(formats);
             continue;
         }
+        // The storage path over the same host image: a float host image rounds to 8 bits
+        // otherwise than an sRGB one (one step apart on a tenth of the pixels on some
+        // machines' lavapipe), which is no difference between the two paths.
+        let (reference, host_image) = stored(formats, Composite::Lines);
+        let changed = reference
+            .chunks_exact(4)
+            .zip(host_image.chunks_exact(4))
+            .filter(|(a, b)| a != b)
+            .count();
+        assert!(changed > 5000, "the lines changed only {changed} pixels");
         let image = composited(formats, Composite::Lines);
-        let reference = &references[usize::from(samples > 1)];
         let diff = difference(
-            Rgba::new(reference, SIZE).unwrap(),
+            Rgba::new(&reference, SIZE).unwrap(),
             Rgba::new(&image, SIZE).unwrap(),
         )
         .unwrap();
