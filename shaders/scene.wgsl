@@ -194,9 +194,11 @@ fn pixel_centre(xy: vec2<u32>) -> vec2<f32> {
 
 // Pixels whose centre lies within this many pixels of their triangle's boundary are checked
 // against the triangles of their 3×3 neighbourhood. Rasterizers snap vertices to a sub-pixel
-// grid (8 bits on lavapipe, llvmpipe and desktop GPUs: errors up to 1/512 px), so such a
-// centre may have been given to the wrong side of an edge; the exact test decides.
-const COVERAGE_MARGIN: f32 = 1.0 / 128.0;
+// grid (8 bits on lavapipe, llvmpipe and desktop GPUs: each coordinate off by up to 1/512
+// px, so an edge's line by up to √2/512 ≈ 0.0028 px), so such a centre may have been given
+// to the wrong side of an edge; the exact test decides. The margin leaves 40 % on top of
+// that for the f32 rounding of both tests.
+const COVERAGE_MARGIN: f32 = 1.0 / 256.0;
 
 // One triangle of one instance seen from one screen point.
 struct Sample {
