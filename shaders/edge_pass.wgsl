@@ -667,9 +667,9 @@ fn finish(xy: vec2<u32>, s: Sample) -> Pixel {
 // does so within its snapping error of its boundary (COVERAGE_MARGIN), on the rim of the
 // mesh's image next to a neighbour's triangle. Wherever measured (meshes of 2 k to 20 M
 // triangles, near, far and grazing cameras) every such owner lay within two steps. Twice
-// that bounds the walks, which at
-// millions of sub-pixel triangles would otherwise wander up to WALK_STEPS each over the
-// surface towards its silhouette, the slowest lane holding up its batch.
+// that bounds the walks, which at millions of sub-pixel triangles would otherwise wander up
+// to WALK_STEPS each over the surface towards its silhouette, the slowest lane holding up
+// its batch.
 const BACKGROUND_WALK_STEPS: u32 = 4u;
 
 // The triangle whose surface the centre of target pixel `xy` sees, for a pixel `tile_main`
