@@ -73,10 +73,10 @@ impl View {
 /// deferred cases are byte-identical on every machine measured, while the forward and
 /// two-pass baselines (interpolated altitudes, hardware lines) differ on a CPU with AVX-512
 /// from the one the references were blessed on, on both adapters, and each column holds the
-/// larger of the two machines' measurements. Largest llvmpipe values: deferred mean 0.00003 / p99
-/// 0.00059, forward 0.0305 / 0.633 (fandisk, eye inside: the baseline divides by w, and
-/// where it breaks the adapters break differently), two-pass 0.078 / 0.50 (1 px hardware
-/// lines rasterise differently).
+/// larger of the two machines' measurements (the deferred lavapipe column stays exactly 0).
+/// Largest llvmpipe values: deferred mean 0.00003 / p99 0.00059, forward 0.0305 / 0.633
+/// (fandisk, eye inside: the baseline divides by w, and where it breaks the adapters break
+/// differently), two-pass 0.078 / 0.50 (1 px hardware lines rasterise differently).
 #[rustfmt::skip]
 const MEASURED: &[(&str, [f32; 2], [f32; 2])] = &[
     // (case, lavapipe [mean, p99], llvmpipe-GL [mean, p99])
