@@ -32,7 +32,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "output",
         size,
         wgpu::TextureFormat::Rgba8Unorm,
-        wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
+        // RENDER_ATTACHMENT lets the pass clear the background instead of writing it.
+        wgpu::TextureUsages::STORAGE_BINDING
+            | wgpu::TextureUsages::COPY_SRC
+            | wgpu::TextureUsages::RENDER_ATTACHMENT,
     );
 
     // Construct once and upload the mesh once.

@@ -1,12 +1,14 @@
-// The deferred edge pass, after common.wgsl and scene.wgsl. Three dispatches, so that work
+// The deferred edge pass, after common.wgsl and scene.wgsl. Several dispatches, so that work
 // only some pixels need runs only for them (a software rasterizer runs the arithmetic of
 // both sides of every branch, and a loop until its last lane is done; it skips only the
 // memory reads of masked lanes):
 //
-// `classify_main`, one invocation per output pixel: background and host pixels are written
-// here, without lines; the 8×8 tiles that hold foreground are marked.
+// `background_main`, one invocation per output pixel: background and host pixels are
+// written, without lines. Only where the background is not one colour that a clear of the
+// output lays down instead (DeferredPass::background_clear).
 //
-// `tile_list_main`, one invocation per output tile: the marked tiles are listed.
+// `classify_main`, one invocation per 8×8 output tile: the tiles that hold foreground are
+// listed.
 //
 // `outlined_main`, dispatched indirectly over the tiles the outline pass listed (those its
 // lines reach): their background and host pixels get the outline pass's line, if any.
@@ -59,8 +61,7 @@ struct ListRead {
 @group(0) @binding(15) var<storage, read_write> work_rw: List;
 @group(0) @binding(16) var<storage, read> work: ListRead;
 
-// The tiles `tile_list_main` lists for `tile_main`, then the mark per output tile that
-// `classify_main` sets.
+// The tiles `classify_main` lists for `tile_main`.
 @group(0) @binding(24) var<storage, read_write> tiles_rw: List;
 @group(0) @binding(25) var<storage, read> tiles: ListRead;
 
@@ -477,35 +478,33 @@ fn no_sample(inst: u32) -> Sample {
     return s;
 }
 
+// Pixels without a triangle, without lines (those over the background are outlined_main's).
+// Background next to foreground is written here too; tile_main lists it for refine_main,
+// which decides it.
 @compute @workgroup_size(8, 8)
-fn classify_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(workgroup_id) group: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
-    let inside = all(vec2<f32>(gid.xy) < frame.output_size);
+fn background_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let xy = gid.xy + vec2<u32>(frame.output_offset);
     let raster = textureLoad(ids, xy, 0).x;
-    let empty = raster >= HOST_ID;
-    // Background next to foreground is written here too; tile_main lists it again for
-    // refine_main, which decides it. Lines over the background are outlined_main's.
-    if inside && empty {
+    if all(vec2<f32>(gid.xy) < frame.output_size) && raster >= HOST_ID {
         store_pixel(xy, empty_pixel(xy, raster, vec2<u32>(0u)));
-    }
-    // Foreground marks its tile (the marks, after the list, are cleared each frame): one
-    // store, where listing the tile here would cost every pixel the list's atomics (and a
-    // workgroup barrier and vote would cost every tile).
-    if inside && !empty {
-        atomicStore(&tiles_rw.items[groups.x * groups.y + group.y * groups.x + group.x], 1u);
     }
 }
 
-// Lists the output tiles classify_main marked, one invocation per tile.
-@compute @workgroup_size(64)
-fn tile_list_main(@builtin(global_invocation_id) gid: vec3<u32>) {
+// Lists the output tiles that hold foreground, one invocation per tile: its 64 id reads cost
+// less than a lane per pixel, and the list's atomics are paid once a tile.
+@compute @workgroup_size(8, 8)
+fn classify_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let size = vec2<u32>(frame.output_size);
-    let columns = (size.x + 7u) / 8u;
-    let count = columns * ((size.y + 7u) / 8u);
-    let t = gid.x;
-    if t < count && atomicLoad(&tiles_rw.items[count + t]) != 0u {
+    let first = 8u * gid.xy;
+    let last = size - 1u;
+    var least = BACKGROUND_ID;
+    for (var k = 0u; k < 64u; k++) {
+        let at = min(first + vec2<u32>(k % 8u, k / 8u), last);
+        least = min(least, textureLoad(ids, at + vec2<u32>(frame.output_offset), 0).x);
+    }
+    if all(first < size) && least < HOST_ID {
         let k = atomicAdd(&tiles_rw.count, 1u);
-        atomicStore(&tiles_rw.items[k], (t % columns) | ((t / columns) << 16u));
+        atomicStore(&tiles_rw.items[k], gid.x | (gid.y << 16u));
         let size = list_size(k, 1u);
         atomicMax(&tiles_rw.x, size.x);
         atomicMax(&tiles_rw.y, size.y);
@@ -592,7 +591,7 @@ fn tile_main(@builtin(local_invocation_id) local: vec3<u32>, @builtin(workgroup_
         let at = vec2<u32>(tile & 0xffffu, tile >> 16u) * 8u + local.xy;
         let xy = at + vec2<u32>(frame.output_offset);
         let raster = textureLoad(ids, xy, 0).xy;
-        // Background pixels were finished by classify_main.
+        // Background pixels were finished by background_main or the clear.
         let foreground = all(vec2<f32>(at) < frame.output_size) && raster.x < HOST_ID;
         // Memory reads are skipped for masked lanes, so background lanes do not sample.
         var s = no_sample(raster.x);

@@ -52,7 +52,8 @@ pub struct Run {
     /// Method name.
     pub method: String,
     /// GPU time of each pass, and of each group of passes: `edge` is the sum of its
-    /// dispatches (`edge.classify`, `edge.border`, `edge.tiles`, `edge.refine`; the floor's `edge.floor`),
+    /// dispatches (`edge.clear` or `edge.background`, `edge.classify`, `edge.outlined`,
+    /// `edge.border`, `edge.tiles`, `edge.refine`; the floor's `edge.floor`),
     /// `outline` of `outline.cull`, `outline.draw` and `outline.pieces`.
     pub passes: BTreeMap<String, Stats>,
     /// Median over frames of the sum of the passes.
@@ -264,7 +265,8 @@ pub fn bench_scene(
     let lines = up.edge_lines(ctx, shot.world)?;
     let scene = up.scene(shot.world, shot.view);
     let storage = || {
-        let usage = wgpu::TextureUsages::STORAGE_BINDING;
+        // RENDER_ATTACHMENT: the edge pass clears the background instead of writing it.
+        let usage = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::RENDER_ATTACHMENT;
         texture_2d(
             device,
             "wirepass bench output",

@@ -45,7 +45,9 @@
 //! let scene = Scene::borrowed(view, &instances);
 //! let frame = pass.prepare(&device, &meshes, &scene, &Style::default(), size)?;
 //!
-//! let usage = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC;
+//! // RENDER_ATTACHMENT lets the pass clear the background instead of writing it.
+//! use wgpu::TextureUsages as U;
+//! let usage = U::STORAGE_BINDING | U::COPY_SRC | U::RENDER_ATTACHMENT;
 //! let output = texture_2d(&device, "output", size, pass.output_format(), usage);
 //! let mut encoder = device.create_command_encoder(&Default::default());
 //! let target = output.create_view(&Default::default());

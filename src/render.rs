@@ -389,7 +389,10 @@ pub fn render_deferred_on(
     }
     let scene = up.scene(shot.world, shot.view);
     let frame = pass.prepare(device, &up.store, &scene, shot.style, canvas)?;
-    let usage = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC;
+    // RENDER_ATTACHMENT: the edge pass clears the background instead of writing it.
+    let usage = wgpu::TextureUsages::STORAGE_BINDING
+        | wgpu::TextureUsages::COPY_SRC
+        | wgpu::TextureUsages::RENDER_ATTACHMENT;
     let output = texture_2d(
         device,
         "wirepass output",

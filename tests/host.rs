@@ -497,6 +497,74 @@ fn stored(formats: HostFormats, content: Composite) -> (Vec<u8>, Vec<u8>) {
     (out, host)
 }
 
+/// Where the output can be cleared (RENDER_ATTACHMENT usage), `Shaded` clears the background
+/// instead of writing it pixel by pixel: the bytes must be those it writes, in every output
+/// format, over the host's depth (host pixels take the background too), for a background
+/// whose channels no format holds exactly.
+#[test]
+fn a_cleared_background_is_the_background_the_pass_writes() {
+    let ctx = device();
+    let f = fixture();
+    let view = f.scene.view(ASPECT, DepthRange::Standard);
+    let targets = draw_host(HostFormats::EXAMPLE, &view, SIZE);
+    let wp = Wirepass::new();
+    let style = Style {
+        background: wirepass::Color([0.1, 0.33, 0.7071, 0.6]),
+        ..style()
+    };
+    let scene = Scene::borrowed(view, &wp.instances);
+    use wgpu::TextureFormat as F;
+    use wgpu::TextureUsages as U;
+    for format in [F::Rgba8Unorm, F::Rgba16Float, F::Rgba32Float] {
+        let options = PassOptions {
+            output_format: format,
+            ..PassOptions::default()
+        };
+        let mut pass = DeferredPass::new(&ctx.device, options).unwrap();
+        let canvas = Canvas::new(SIZE).with_host_depth(HostDepth {
+            texture: &targets.depth,
+            view,
+        });
+        let frame = pass
+            .prepare(&ctx.device, &wp.store, &scene, &style, canvas)
+            .unwrap();
+        let draw = |usage| {
+            let output = texture_2d(&ctx.device, "output", SIZE, format, usage);
+            let out_view = output.create_view(&Default::default());
+            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            let target = OutputTarget::Shaded(&out_view);
+            pass.encode(&ctx.device, &mut encoder, &wp.store, &frame, target)
+                .unwrap();
+            ctx.queue.submit([encoder.finish()]);
+            read_texture(&ctx.device, &ctx.queue, &output, wgpu::TextureAspect::All).unwrap()
+        };
+        let written = draw(U::STORAGE_BINDING | U::COPY_SRC);
+        let cleared = draw(U::STORAGE_BINDING | U::COPY_SRC | U::RENDER_ATTACHMENT);
+        let texel = written.len() / (SIZE.0 * SIZE.1) as usize;
+        let pixels = |bytes: &[u8]| {
+            bytes
+                .chunks_exact(texel)
+                .map(<[u8]>::to_vec)
+                .collect::<Vec<_>>()
+        };
+        let (written, cleared) = (pixels(&written), pixels(&cleared));
+        let differ = written.iter().zip(&cleared).filter(|(a, b)| a != b).count();
+        let first = written.iter().zip(&cleared).find(|(a, b)| a != b);
+        assert_eq!(
+            differ, 0,
+            "{format:?}: {differ} pixels differ, first {first:?}"
+        );
+        // The corner shows the background; so do many pixels, and thousands do not.
+        let corner = &written[0];
+        let background = written.iter().filter(|p| *p == corner).count();
+        assert!(
+            background > written.len() / 2 && background + 5000 < written.len(),
+            "{format:?}: {background} background pixels"
+        );
+    }
+    ctx.finish().unwrap();
+}
+
 #[test]
 fn composite_into_srgb_bgra_and_float_targets_matches_the_storage_path() {
     let threshold = Threshold {

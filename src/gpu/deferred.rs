@@ -27,7 +27,9 @@ const GROUP: u32 = 64;
 pub struct PassOptions {
     /// Format of the storage texture that [`OutputTarget::Shaded`] and
     /// [`OutputTarget::Overlay`] write: `Rgba8Unorm` (written sRGB-encoded), `Rgba16Float`
-    /// or `Rgba32Float` (linear). It needs `STORAGE_BINDING` usage.
+    /// or `Rgba32Float` (linear). It needs `STORAGE_BINDING` usage; with
+    /// `RENDER_ATTACHMENT` as well, [`OutputTarget::Shaded`] clears the background (one
+    /// fill) instead of writing it pixel by pixel, with the same result.
     pub output_format: wgpu::TextureFormat,
     /// The host's render pass that [`DeferredPass::render`] draws into, if it is used.
     pub render_target: Option<RenderTarget>,
@@ -94,8 +96,9 @@ struct Variant {
 }
 
 struct EdgePipelines {
+    /// Writes the pixels without a triangle, where no clear lays them down.
+    background: Compute,
     classify: Compute,
-    tile_list: Compute,
     /// Lines over the background of the tiles the outline pass lists; with outlines only.
     outlined: Option<Compute>,
     border: Compute,
@@ -392,6 +395,18 @@ impl DeferredPass {
     ) -> Result<PreparedFrame> {
         let canvas = canvas.into();
         let window = canvas.window;
+        // An Rgba16Float output holds the background as its nearest half, so that a clear and
+        // the shader's store (whose conversion may round either way) give the same bits.
+        let held;
+        let style = if self.format == wgpu::TextureFormat::Rgba16Float {
+            held = Style {
+                background: crate::Color(style.background.0.map(round_to_half)),
+                ..style.clone()
+            };
+            &held
+        } else {
+            style
+        };
         let data = FrameData::new(device, store, scene, style, window, true)?;
         let host = match &canvas.host_depth {
             Some(h) => Some(self.host.prepare(device, h, &scene.view, window.image)?),
@@ -451,6 +466,35 @@ impl DeferredPass {
             host,
             composite,
             encoded: AtomicU64::new(0),
+        })
+    }
+
+    /// The value every output pixel without a triangle or a line gets, as a clear colour,
+    /// where that is one value (Shade: the background, encoded as store_pixel encodes it;
+    /// Result: transparent) and `view` can be cleared (RENDER_ATTACHMENT usage).
+    fn background_clear(
+        &self,
+        mode: Mode,
+        view: &wgpu::TextureView,
+        frame: &PreparedFrame,
+    ) -> Option<wgpu::Color> {
+        if !view
+            .texture()
+            .usage()
+            .contains(wgpu::TextureUsages::RENDER_ATTACHMENT)
+        {
+            return None;
+        }
+        let [r, g, b, a] = match mode {
+            Mode::Shade => background_value(self.format, frame.data.uniforms.background()),
+            Mode::Result { .. } => [0.0; 4],
+            Mode::Overlay { .. } | Mode::Diagnostic => return None,
+        };
+        Some(wgpu::Color {
+            r: f64::from(r),
+            g: f64::from(g),
+            b: f64::from(b),
+            a: f64::from(a),
         })
     }
 
@@ -520,18 +564,12 @@ impl DeferredPass {
             r.extend_from_slice(&out);
             r
         };
+        let background = Compute::new(device, &module, "background_main", with(&[]), color)?;
         let classify = Compute::new(
             device,
             &module,
             "classify_main",
-            with(&[Res::TilesRw]),
-            color,
-        )?;
-        let tile_list = Compute::new(
-            device,
-            &module,
-            "tile_list_main",
-            with(&[Res::TilesRw]),
+            vec![Res::Frame, Res::Ids, Res::TilesRw],
             color,
         )?;
         let outlined = if v.outlines {
@@ -563,8 +601,8 @@ impl DeferredPass {
             return Err(Error::Device(format!("building the edge pass: {e}")));
         }
         let p = Arc::new(EdgePipelines {
+            background,
             classify,
-            tile_list,
             outlined,
             border,
             tiles,
@@ -642,8 +680,9 @@ impl DeferredPass {
 
     /// [`encode`](Self::encode) with GPU timestamps around each pass, named
     /// `"visibility"`, `"outline.cull"`, `"outline.draw"` and `"outline.pieces"` (when outlines
-    /// are drawn), and `"edge.classify"`, `"edge.border"`, `"edge.tiles"` and `"edge.refine"`,
-    /// in `timer`.
+    /// are drawn), `"edge.clear"` or `"edge.background"` (whichever lays down the background),
+    /// and `"edge.classify"`, `"edge.outlined"` (with outlines), `"edge.border"`,
+    /// `"edge.tiles"` and `"edge.refine"`, in `timer`.
     pub fn encode_timed(
         &self,
         device: &wgpu::Device,
@@ -784,20 +823,25 @@ impl DeferredPass {
             let n = self.results.fetch_add(1, Ordering::Relaxed) + 1;
             frame.encoded.store(n, Ordering::Relaxed);
         }
-        let mut dispatches = vec![
-            (
-                "wirepass edge classify",
-                "edge.classify",
-                &edge.classify,
-                Size::Grid(w.div_ceil(TILE), h.div_ceil(TILE)),
-            ),
-            (
-                "wirepass edge tile list",
-                "edge.tile_list",
-                &edge.tile_list,
-                Size::Grid((w.div_ceil(TILE) * h.div_ceil(TILE)).div_ceil(64), 1),
-            ),
-        ];
+        // Where the background is one colour and the output can be cleared, a clear lays it
+        // down at the speed of a fill; elsewhere a dispatch writes it.
+        let clear = out_color.and_then(|v| self.background_clear(mode, v, frame));
+        let (columns, rows) = (w.div_ceil(TILE), h.div_ceil(TILE));
+        let mut dispatches = Vec::new();
+        if clear.is_none() {
+            dispatches.push((
+                "wirepass edge background",
+                "edge.background",
+                &edge.background,
+                Size::Grid(columns, rows),
+            ));
+        }
+        dispatches.push((
+            "wirepass edge classify",
+            "edge.classify",
+            &edge.classify,
+            Size::Grid(columns.div_ceil(TILE), rows.div_ceil(TILE)),
+        ));
         if let Some(outlined) = &edge.outlined {
             let size = Size::Indirect(&t.acc, t.acc_tiles);
             dispatches.push(("wirepass edge outlined", "edge.outlined", outlined, size));
@@ -827,11 +871,30 @@ impl DeferredPass {
             .iter()
             .map(|d| d.2.bind(device, &sources))
             .collect::<Result<Vec<_>>>()?;
-        encoder.clear_buffer(&t.tiles, 0, None);
         encoder.copy_buffer_to_buffer(&self.reset, 0, &t.tiles, 0, LIST_HEADER);
         let marks = LIST_HEADER + 4 * u64::from(t.size.0) * u64::from(t.size.1);
         encoder.clear_buffer(&t.work, marks, None);
         encoder.copy_buffer_to_buffer(&self.reset, 0, &t.work, 0, LIST_HEADER);
+        if let (Some(color), Some(view)) = (clear, out_color) {
+            encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("wirepass edge clear"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(color),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: None,
+                timestamp_writes: timer
+                    .as_deref_mut()
+                    .and_then(|t| t.render_span("edge.clear")),
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+        }
         // Each dispatch is a pass of its own, timed on its own (the benchmark sums the
         // `edge.*` spans into the edge pass).
         for ((label, span, pipeline, size), group) in dispatches.into_iter().zip(groups) {
@@ -946,6 +1009,38 @@ fn dispatch(
     }
 }
 
+/// What store_pixel writes into an output of `format` for a pixel of background colour
+/// `background` (linear) without a line: encode_output of it, alpha at least 0, as the
+/// format holds it (a clear converts exactly what the format holds exactly).
+fn background_value(format: wgpu::TextureFormat, background: [f32; 4]) -> [f32; 4] {
+    let [r, g, b, a] = background;
+    let a = a.max(0.0);
+    match format {
+        wgpu::TextureFormat::Rgba8Unorm => {
+            let unorm = |x: f32| (x.clamp(0.0, 1.0) * 255.0).round() / 255.0;
+            let srgb = |c: f32| unorm(crate::style::linear_to_srgb(c));
+            [srgb(r), srgb(g), srgb(b), unorm(a)]
+        }
+        wgpu::TextureFormat::Rgba16Float => [r, g, b, a].map(round_to_half),
+        _ => [r, g, b, a],
+    }
+}
+
+/// `x` rounded to the nearest IEEE half-precision value (ties to even), as f32.
+fn round_to_half(x: f32) -> f32 {
+    if !x.is_finite() || x == 0.0 {
+        return x;
+    }
+    // A half has 10 fraction bits; below 2^-14 its spacing stays 2^-24.
+    let exponent = (((x.to_bits() >> 23) & 0xff) as i32 - 127).max(-14);
+    let step = 2f32.powi(exponent - 10);
+    let r = (x / step).round_ties_even() * step;
+    if r.abs() > 65504.0 {
+        return f32::INFINITY.copysign(x);
+    }
+    r
+}
+
 fn variant_flags(v: Variant) -> Vec<&'static str> {
     let mut flags = Vec::new();
     if v.split {
@@ -1048,4 +1143,40 @@ fn check_texture(
         return Err(Error::Misuse(format!("{what} is not a single 2D texture")));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn round_to_half_is_the_nearest_half() {
+        let mut x = 1.0e-9_f32;
+        while x < 70000.0 {
+            for v in [x, -x, x * 1.000_3, x * 0.999_7] {
+                let want = half::f16::from_f32(v).to_f32();
+                assert_eq!(round_to_half(v).to_bits(), want.to_bits(), "{v:e}");
+            }
+            x *= 1.013;
+        }
+        // Ties go to even, as a conversion does.
+        for v in [
+            1.0 + 1.0 / 2048.0,
+            1.0 + 3.0 / 2048.0,
+            2.0_f32.powi(-24) * 2.5,
+        ] {
+            assert_eq!(round_to_half(v), half::f16::from_f32(v).to_f32(), "{v:e}");
+        }
+    }
+
+    #[test]
+    fn the_background_value_is_what_the_shader_stores() {
+        let c = [0.1, 0.5, 1.0, 0.25];
+        let srgb = background_value(wgpu::TextureFormat::Rgba8Unorm, c);
+        let want = [89.0, 188.0, 255.0, 64.0].map(|b: f32| b / 255.0);
+        assert_eq!(srgb, want);
+        // Alpha at least 0; float formats hold linear values.
+        let f = background_value(wgpu::TextureFormat::Rgba32Float, [0.1, 0.2, 0.3, -1.0]);
+        assert_eq!(f, [0.1, 0.2, 0.3, 0.0]);
+    }
 }

@@ -75,6 +75,11 @@ pub(crate) const INSTANCE_BASES_OFFSET: u64 = 184;
 pub(crate) const INSTANCE_BYTES: u64 = std::mem::size_of::<InstanceRecord>() as u64;
 
 impl FrameUniforms {
+    /// The background colour (linear RGBA).
+    pub fn background(&self) -> [f32; 4] {
+        self.background
+    }
+
     /// Instances in the frame.
     pub fn instances(&self) -> u32 {
         self.instances

@@ -124,8 +124,8 @@ impl Targets {
                 limit: binding,
             });
         }
-        // The list, then a mark per tile.
-        let tiles_bytes = LIST_HEADER + 8 * tiles;
+        // The list: header, then one packed tile per entry.
+        let tiles_bytes = LIST_HEADER + 4 * tiles;
         use wgpu::TextureUsages as U;
         let texture =
             |label, size, format, usage| super::texture_2d(device, label, size, format, usage);
@@ -176,7 +176,8 @@ impl Targets {
                     "wirepass result",
                     spec.output,
                     RESULT_FORMAT,
-                    U::STORAGE_BINDING | U::TEXTURE_BINDING,
+                    // Cleared where the edge pass lays down its background.
+                    U::STORAGE_BINDING | U::TEXTURE_BINDING | U::RENDER_ATTACHMENT,
                 )
             }),
             diagnostic: spec.diagnostic.then(|| {
