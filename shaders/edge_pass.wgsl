@@ -57,7 +57,7 @@ struct ListRead {
     items: array<u32>,
 }
 
-// The pixels `tile_main` leaves to `refine_main`, with a mark bit per target pixel.
+// The pixels `classify_main`, `border_main` and `tile_main` leave to `refine_main`.
 @group(0) @binding(15) var<storage, read_write> work_rw: List;
 @group(0) @binding(16) var<storage, read> work: ListRead;
 
@@ -490,24 +490,97 @@ fn background_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
 }
 
-// Lists the output tiles that hold foreground, one invocation per tile: its 64 id reads cost
-// less than a lane per pixel, and the list's atomics are paid once a tile.
+// Whether output pixel `at` (in output coordinates, clamped to the output) shows a triangle.
+fn foreground_at(at: vec2<i32>) -> bool {
+    let q = clamp(at, vec2<i32>(0), vec2<i32>(frame.output_size) - 1) + vec2<i32>(frame.output_offset);
+    return textureLoad(ids, vec2<u32>(q), 0).x < HOST_ID;
+}
+
+// Half of a tile as bits: bit 8 × row + column of rows 0-3 (x) and 4-7 (y).
+// `bits` (bit i for row i) placed in column `column`.
+fn tile_column(bits: u32, column: u32) -> vec2<u32> {
+    var out = vec2<u32>(0u);
+    for (var row = 0u; row < 4u; row++) {
+        out.x |= ((bits >> row) & 1u) << (8u * row + column);
+        out.y |= ((bits >> (row + 4u)) & 1u) << (8u * row + column);
+    }
+    return out;
+}
+
+// One invocation per 8×8 output tile, from its ids and those of the ring of pixels
+// edge-adjacent to it (bit masks, so each pixel's four neighbours cost no reads): lists the
+// tile for tile_main if it holds foreground, and lists for refine_main its background
+// pixels next to foreground, which may hold a triangle the rasterizer missed (border_main
+// lists the background next to foreground in the guard band). Reads cost a lane per tile
+// less than a lane per pixel, and the lists' atomics are paid once a tile.
 @compute @workgroup_size(8, 8)
 fn classify_main(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let size = vec2<u32>(frame.output_size);
-    let first = 8u * gid.xy;
-    let last = size - 1u;
-    var least = BACKGROUND_ID;
-    for (var k = 0u; k < 64u; k++) {
-        let at = min(first + vec2<u32>(k % 8u, k / 8u), last);
-        least = min(least, textureLoad(ids, at + vec2<u32>(frame.output_offset), 0).x);
+    let first = vec2<i32>(8u * gid.xy);
+    if !all(vec2<f32>(first) < frame.output_size) {
+        return;
     }
-    if all(first < size) && least < HOST_ID {
+    // The tile's columns and rows inside the output, a bit each.
+    let room = vec2<i32>(frame.output_size) - first;
+    let columns = select(0xffu, (1u << u32(room.x)) - 1u, room.x < 8);
+    let rows = select(0xffu, (1u << u32(room.y)) - 1u, room.y < 8);
+    // Pixels inside the output (tile_column's layout), and the foreground among them.
+    var inside = vec2<u32>(0u);
+    for (var row = 0u; row < 4u; row++) {
+        inside.x |= select(0u, columns << (8u * row), (rows & (1u << row)) != 0u);
+        inside.y |= select(0u, columns << (8u * row), (rows & (16u << row)) != 0u);
+    }
+    var fg = vec2<u32>(0u);
+    for (var k = 0u; k < 32u; k++) {
+        let at = first + vec2<i32>(vec2<u32>(k % 8u, k / 8u));
+        fg |= select(vec2<u32>(0u), vec2<u32>(1u << k), vec2<bool>(foreground_at(at), foreground_at(at + vec2<i32>(0, 4))));
+    }
+    fg &= inside;
+    // The ring: bit i of each side is its pixel in row or column i, where inside the output.
+    var top = 0u;
+    var bottom = 0u;
+    var left = 0u;
+    var right = 0u;
+    for (var i = 0; i < 8; i++) {
+        let bit = 1u << u32(i);
+        top |= select(0u, bit, foreground_at(first + vec2<i32>(i, -1)));
+        bottom |= select(0u, bit, foreground_at(first + vec2<i32>(i, 8)));
+        left |= select(0u, bit, foreground_at(first + vec2<i32>(-1, i)));
+        right |= select(0u, bit, foreground_at(first + vec2<i32>(8, i)));
+    }
+    top &= select(0u, columns, first.y > 0);
+    bottom &= select(0u, columns, room.y > 8);
+    left &= select(0u, rows, first.x > 0);
+    right &= select(0u, rows, room.x > 8);
+    // Pixels whose left, right, upper or lower neighbour is foreground.
+    let from_left = ((fg << vec2<u32>(1u)) & vec2<u32>(0xfefefefeu)) | tile_column(left, 0u);
+    let from_right = ((fg >> vec2<u32>(1u)) & vec2<u32>(0x7f7f7f7fu)) | tile_column(right, 7u);
+    let from_above = vec2<u32>((fg.x << 8u) | (top & 0xffu), (fg.y << 8u) | (fg.x >> 24u));
+    let from_below = vec2<u32>((fg.x >> 8u) | (fg.y << 24u), (fg.y >> 8u) | (bottom << 24u));
+    var listed = (from_left | from_right | from_above | from_below) & inside & ~fg;
+    if any(fg != vec2<u32>(0u)) {
         let k = atomicAdd(&tiles_rw.count, 1u);
         atomicStore(&tiles_rw.items[k], gid.x | (gid.y << 16u));
         let size = list_size(k, 1u);
         atomicMax(&tiles_rw.x, size.x);
         atomicMax(&tiles_rw.y, size.y);
+    }
+    let n = countOneBits(listed.x) + countOneBits(listed.y);
+    if n != 0u {
+        var k = atomicAdd(&work_rw.count, n);
+        let size = list_size(k + n - 1u, 64u);
+        atomicMax(&work_rw.x, size.x);
+        atomicMax(&work_rw.y, size.y);
+        let origin = vec2<u32>(first) + vec2<u32>(frame.output_offset);
+        // A loop ends once no lane has pixels left, so tiles without any cost nearly nothing.
+        while any(listed != vec2<u32>(0u)) {
+            let half = select(1u, 0u, listed.x != 0u);
+            let bits = listed[half];
+            let b = firstTrailingBit(bits);
+            listed[half] = bits & (bits - 1u);
+            let xy = origin + vec2<u32>(b % 8u, b / 8u + 4u * half);
+            atomicStore(&work_rw.items[k], xy.x | (xy.y << 16u));
+            k++;
+        }
     }
 }
 
@@ -535,14 +608,8 @@ fn neighbour_offset(i: u32) -> vec2<i32> {
     return select(vec2<i32>(0, d), vec2<i32>(d, 0), i < 2u);
 }
 
-// Appends target pixel xy to the refine list, once.
+// Appends target pixel xy to the refine list (each pixel is listed by one invocation only).
 fn refine_later(xy: vec2<u32>) {
-    let pixels = u32(frame.target_size.x) * u32(frame.target_size.y);
-    let index = xy.y * u32(frame.target_size.x) + xy.x;
-    let bit = 1u << (index & 31u);
-    if (atomicOr(&work_rw.items[pixels + index / 32u], bit) & bit) != 0u {
-        return;
-    }
     let k = atomicAdd(&work_rw.count, 1u);
     atomicStore(&work_rw.items[k], xy.x | (xy.y << 16u));
     let size = list_size(k, 64u);
@@ -574,12 +641,20 @@ fn border_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let first = vec2<i32>(frame.output_offset);
     let last = vec2<i32>(frame.output_offset + frame.output_size) - 1;
+    var beyond = false;
     for (var i = 0u; i < 4u; i++) {
         let n = q + neighbour_offset(i);
-        if (any(n < first) || any(n > last)) && id_at(n).x < HOST_ID {
-            refine_later(vec2<u32>(q));
-            return;
+        let outside = any(n < first) || any(n > last);
+        if id_at(n).x < HOST_ID {
+            // Foreground inside the output: classify_main lists this pixel.
+            if !outside {
+                return;
+            }
+            beyond = true;
         }
+    }
+    if beyond {
+        refine_later(vec2<u32>(q));
     }
 }
 
@@ -617,29 +692,10 @@ fn tile_main(@builtin(local_invocation_id) local: vec3<u32>, @builtin(workgroup_
                 store_pixel(xy, surface_pixel(xy, s, own.distance));
             }
         }
-        // Pixels for refine_main: bit 4 this one, where the exact test could not decide it
-        // or its patch must be searched;
-        // bits 0-3 the background next to it (left, right, up, down) in the output, which
-        // may hold a triangle the rasterizer missed (border_main lists the background
-        // next to foreground in the guard band).
-        let q = vec2<i32>(xy);
-        let first = vec2<i32>(frame.output_offset);
-        let last = vec2<i32>(frame.output_offset + frame.output_size) - 1;
-        var pending = select(0u, 16u, foreground && (!certain || (own.search && !own.quad)));
-        for (var i = 0u; i < 4u; i++) {
-            let n = q + neighbour_offset(i);
-            if all(n >= first) && all(n <= last) && id_at(n).x >= HOST_ID {
-                pending |= 1u << i;
-            }
-        }
-        if !foreground {
-            pending = 0u;
-        }
-        // A loop ends once no lane has work left, so tiles without any cost nearly nothing.
-        while pending != 0u {
-            let i = firstTrailingBit(pending);
-            pending &= pending - 1u;
-            refine_later(vec2<u32>(q + select(neighbour_offset(i), vec2<i32>(0), i == 4u)));
+        // The pixel goes to refine_main where the exact test could not decide it or its patch
+        // must be searched (classify_main lists the background next to it).
+        if foreground && (!certain || (own.search && !own.quad)) {
+            refine_later(xy);
         }
     }
 }

@@ -569,7 +569,7 @@ impl DeferredPass {
             device,
             &module,
             "classify_main",
-            vec![Res::Frame, Res::Ids, Res::TilesRw],
+            vec![Res::Frame, Res::Ids, Res::TilesRw, Res::WorkRw],
             color,
         )?;
         let outlined = if v.outlines {
@@ -872,8 +872,6 @@ impl DeferredPass {
             .map(|d| d.2.bind(device, &sources))
             .collect::<Result<Vec<_>>>()?;
         encoder.copy_buffer_to_buffer(&self.reset, 0, &t.tiles, 0, LIST_HEADER);
-        let marks = LIST_HEADER + 4 * u64::from(t.size.0) * u64::from(t.size.1);
-        encoder.clear_buffer(&t.work, marks, None);
         encoder.copy_buffer_to_buffer(&self.reset, 0, &t.work, 0, LIST_HEADER);
         if let (Some(color), Some(view)) = (clear, out_color) {
             encoder.begin_render_pass(&wgpu::RenderPassDescriptor {

@@ -111,8 +111,8 @@ impl Targets {
         }
         let pieces = (pixels / PIXELS_PER_PIECE).max(MIN_PIECES);
         let acc_bytes = (acc_pieces + LIST_HEADER + PIECE_BYTES * pieces).min(binding / 4 * 4);
-        // The list, then a mark bit per target pixel.
-        let work_bytes = LIST_HEADER + 4 * pixels + 4 * pixels.div_ceil(32);
+        // The list: header, then one packed pixel per entry (a pixel is listed once).
+        let work_bytes = LIST_HEADER + 4 * pixels;
         if work_bytes > binding {
             return Err(Error::OverLimit {
                 what: format!(
