@@ -509,7 +509,7 @@ fn a_cleared_background_is_the_background_the_pass_writes() {
     let targets = draw_host(HostFormats::EXAMPLE, &view, SIZE);
     let wp = Wirepass::new();
     let style = Style {
-        background: wirepass::Color([0.1, 0.33, 0.7071, 0.6]),
+        background: wirepass::Color([0.1, 0.33, 0.707, 0.6]),
         ..style()
     };
     let scene = Scene::borrowed(view, &wp.instances);
