@@ -739,7 +739,10 @@ fn resolve(xy: vec2<u32>) -> Sample {
     let host = host_at(vec2<i32>(xy));
     let raster = textureLoad(ids, xy, 0).xy;
     let raster_empty = raster.x >= HOST_ID;
-    var best = no_sample(raster.x);
+    // The nearest covering triangle so far (its full sample is taken once, at the end, so
+    // that the candidates' line distances are never computed).
+    var best = vec2<u32>(raster.x, 0u);
+    var best_near = 0.0;
     var found = false;
     var background_near = raster_empty;
     var checked = raster;
@@ -760,15 +763,19 @@ fn resolve(xy: vec2<u32>) -> Sample {
             continue;
         }
         let s = locate(id.x, id.y, point, steps, true);
-        if s.covers && s.depth > host && (!found || s.near < best.near) {
-            best = s;
+        if s.covers && s.depth > host && (!found || s.near < best_near) {
+            best = vec2<u32>(s.inst, s.tri);
+            best_near = s.near;
             found = true;
         }
     }
     if !found && !background_near {
         return sample(raster.x, raster.y, point);
     }
-    return best;
+    if !found {
+        return no_sample(raster.x);
+    }
+    return sample(best.x, best.y, point);
 }
 
 @compute @workgroup_size(64)
