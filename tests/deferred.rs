@@ -387,10 +387,10 @@ fn timer_reports_every_pass() {
                 "outline.cull",
                 "outline.draw",
                 "outline.pieces",
-                "edge.background",
                 "edge.classify",
-                "edge.outlined",
                 "edge.border",
+                "edge.background",
+                "edge.outlined",
                 "edge.tiles",
                 "edge.refine"
             ]

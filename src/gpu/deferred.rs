@@ -827,7 +827,24 @@ impl DeferredPass {
         // down at the speed of a fill; elsewhere a dispatch writes it.
         let clear = out_color.and_then(|v| self.background_clear(mode, v, frame));
         let (columns, rows) = (w.div_ceil(TILE), h.div_ceil(TILE));
-        let mut dispatches = Vec::new();
+        // The lists first, then the background (the clear or its dispatch), then the passes
+        // that write the output: a software rasterizer runs a clear when a later pass reads
+        // its texture, and a dispatch between the two would be timed in neither span.
+        let mut dispatches = vec![
+            (
+                "wirepass edge classify",
+                "edge.classify",
+                &edge.classify,
+                Size::Grid(columns.div_ceil(TILE), rows.div_ceil(TILE)),
+            ),
+            (
+                "wirepass edge border",
+                "edge.border",
+                &edge.border,
+                Size::Grid((2 * (w + h)).div_ceil(64), 1),
+            ),
+        ];
+        let lists = dispatches.len();
         if clear.is_none() {
             dispatches.push((
                 "wirepass edge background",
@@ -836,23 +853,11 @@ impl DeferredPass {
                 Size::Grid(columns, rows),
             ));
         }
-        dispatches.push((
-            "wirepass edge classify",
-            "edge.classify",
-            &edge.classify,
-            Size::Grid(columns.div_ceil(TILE), rows.div_ceil(TILE)),
-        ));
         if let Some(outlined) = &edge.outlined {
             let size = Size::Indirect(&t.acc, t.acc_tiles);
             dispatches.push(("wirepass edge outlined", "edge.outlined", outlined, size));
         }
         dispatches.extend([
-            (
-                "wirepass edge border",
-                "edge.border",
-                &edge.border,
-                Size::Grid((2 * (w + h)).div_ceil(64), 1),
-            ),
             (
                 "wirepass edge tiles",
                 "edge.tiles",
@@ -873,29 +878,16 @@ impl DeferredPass {
             .collect::<Result<Vec<_>>>()?;
         encoder.copy_buffer_to_buffer(&self.reset, 0, &t.tiles, 0, LIST_HEADER);
         encoder.copy_buffer_to_buffer(&self.reset, 0, &t.work, 0, LIST_HEADER);
-        if let (Some(color), Some(view)) = (clear, out_color) {
-            encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("wirepass edge clear"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(color),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: None,
-                timestamp_writes: timer
-                    .as_deref_mut()
-                    .and_then(|t| t.render_span("edge.clear")),
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-        }
         // Each dispatch is a pass of its own, timed on its own (the benchmark sums the
         // `edge.*` spans into the edge pass).
-        for ((label, span, pipeline, size), group) in dispatches.into_iter().zip(groups) {
+        for (k, ((label, span, pipeline, size), group)) in
+            dispatches.into_iter().zip(groups).enumerate()
+        {
+            if k == lists {
+                if let (Some(color), Some(view)) = (clear, out_color) {
+                    clear_output(encoder, timer.as_deref_mut(), view, color);
+                }
+            }
             let timer = timer.as_deref_mut();
             dispatch(encoder, timer, (label, span), (pipeline, &group), size);
         }
@@ -988,6 +980,31 @@ enum Size<'b> {
 
 /// Records one dispatch as a compute pass of its own, labelled `names.0` and timed as the
 /// span `names.1`.
+/// Clears `view` to `color` in a render pass of its own, timed as `edge.clear`.
+fn clear_output(
+    encoder: &mut wgpu::CommandEncoder,
+    timer: Option<&mut GpuTimer>,
+    view: &wgpu::TextureView,
+    color: wgpu::Color,
+) {
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("wirepass edge clear"),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Clear(color),
+                store: wgpu::StoreOp::Store,
+            },
+        })],
+        depth_stencil_attachment: None,
+        timestamp_writes: timer.and_then(|t| t.render_span("edge.clear")),
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+}
+
 fn dispatch(
     encoder: &mut wgpu::CommandEncoder,
     timer: Option<&mut GpuTimer>,
