@@ -3,12 +3,17 @@
 // both sides of every branch, and a loop until its last lane is done; it skips only the
 // memory reads of masked lanes):
 //
+// In order:
+//
+// `classify_main`, one invocation per 8×8 output tile: the tiles that hold foreground are
+// listed, and the background next to foreground is appended to the refine list.
+//
+// `border_main`, over the output's border pixels: the background there next to foreground
+// in the guard band joins that list.
+//
 // `background_main`, one invocation per output pixel: background and host pixels are
 // written, without lines. Only where the background is not one colour that a clear of the
 // output lays down instead (DeferredPass::background_clear).
-//
-// `classify_main`, one invocation per 8×8 output tile: the tiles that hold foreground are
-// listed.
 //
 // `outlined_main`, dispatched indirectly over the tiles the outline pass listed (those its
 // lines reach): their background and host pixels get the outline pass's line, if any.
@@ -17,11 +22,8 @@
 // a pixel is tested exactly at the centre; where it covers the centre with room to spare
 // (nearly every pixel), the pixel is finished here: distance to the drawn edges,
 // perspective-correct barycentrics, shading, the line. Pixels it cannot decide (the centre
-// within COVERAGE_MARGIN of the triangle's boundary or outside it) are appended to a list
-// instead, and so is the background next to the tiles' foreground.
-//
-// `border_main`, over the output's border pixels: the background there next to foreground
-// in the guard band joins that list.
+// within COVERAGE_MARGIN of the triangle's boundary or outside it) are appended to the
+// refine list instead.
 //
 // `refine_main`, dispatched indirectly over that list only: the exact coverage search among
 // the neighbourhood's triangles and the walks across edges from them.
