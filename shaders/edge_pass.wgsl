@@ -481,8 +481,8 @@ fn no_sample(inst: u32) -> Sample {
 }
 
 // Pixels without a triangle, without lines (those over the background are outlined_main's).
-// Background next to foreground is written here too; tile_main lists it for refine_main,
-// which decides it.
+// Background next to foreground is written here too; classify_main listed it for
+// refine_main, which decides it.
 @compute @workgroup_size(8, 8)
 fn background_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let xy = gid.xy + vec2<u32>(frame.output_offset);

@@ -52,8 +52,8 @@ pub struct Run {
     /// Method name.
     pub method: String,
     /// GPU time of each pass, and of each group of passes: `edge` is the sum of its
-    /// dispatches (`edge.clear` or `edge.background`, `edge.classify`, `edge.outlined`,
-    /// `edge.border`, `edge.tiles`, `edge.refine`; the floor's `edge.floor`),
+    /// dispatches (`edge.classify`, `edge.border`, `edge.clear` or `edge.background`,
+    /// `edge.outlined`, `edge.tiles`, `edge.refine`; the floor's `edge.floor`),
     /// `outline` of `outline.cull`, `outline.draw` and `outline.pieces`.
     pub passes: BTreeMap<String, Stats>,
     /// Median over frames of the sum of the passes.

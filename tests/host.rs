@@ -533,9 +533,13 @@ fn a_cleared_background_is_the_background_the_pass_writes() {
         let frame = pass
             .prepare(&ctx.device, &wp.store, &scene, &style, canvas)
             .unwrap();
-        let draw = |usage| {
+        // The host's view may leave out the texture's RENDER_ATTACHMENT usage.
+        let draw = |usage, view_usage| {
             let output = texture_2d(&ctx.device, "output", SIZE, format, usage);
-            let out_view = output.create_view(&Default::default());
+            let out_view = output.create_view(&wgpu::TextureViewDescriptor {
+                usage: view_usage,
+                ..Default::default()
+            });
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
             let target = OutputTarget::Shaded(&out_view);
             pass.encode(&ctx.device, &mut encoder, &wp.store, &frame, target)
@@ -553,8 +557,10 @@ fn a_cleared_background_is_the_background_the_pass_writes() {
             assert_ne!(format, F::Rgba8Unorm, "{allowed:?}");
             continue;
         }
-        let written = draw(U::STORAGE_BINDING | U::COPY_SRC);
-        let cleared = draw(clearable);
+        let written = draw(U::STORAGE_BINDING | U::COPY_SRC, None);
+        let cleared = draw(clearable, None);
+        let narrow_view = draw(clearable, Some(U::STORAGE_BINDING));
+        assert_eq!(narrow_view, cleared, "{format:?}: a storage-only view");
         let texel = written.len() / (SIZE.0 * SIZE.1) as usize;
         let pixels = |bytes: &[u8]| {
             bytes

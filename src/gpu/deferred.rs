@@ -471,17 +471,16 @@ impl DeferredPass {
 
     /// The value every output pixel without a triangle or a line gets, as a clear colour,
     /// where that is one value (Shade: the background, encoded as store_pixel encodes it;
-    /// Result: transparent) and `view` can be cleared (RENDER_ATTACHMENT usage).
+    /// Result: transparent) and the output `texture` can be cleared whole (RENDER_ATTACHMENT
+    /// usage, one mip level: the storage view writes that level).
     fn background_clear(
         &self,
         mode: Mode,
-        view: &wgpu::TextureView,
+        texture: &wgpu::Texture,
         frame: &PreparedFrame,
     ) -> Option<wgpu::Color> {
-        if !view
-            .texture()
-            .usage()
-            .contains(wgpu::TextureUsages::RENDER_ATTACHMENT)
+        let usage = texture.usage();
+        if !usage.contains(wgpu::TextureUsages::RENDER_ATTACHMENT) || texture.mip_level_count() != 1
         {
             return None;
         }
@@ -825,7 +824,7 @@ impl DeferredPass {
         }
         // Where the background is one colour and the output can be cleared, a clear lays it
         // down at the speed of a fill; elsewhere a dispatch writes it.
-        let clear = out_color.and_then(|v| self.background_clear(mode, v, frame));
+        let clear = out_color.and_then(|v| self.background_clear(mode, v.texture(), frame));
         let (columns, rows) = (w.div_ceil(TILE), h.div_ceil(TILE));
         // The lists first, then the background (the clear or its dispatch), then the passes
         // that write the output: a software rasterizer runs a clear when a later pass reads
@@ -885,7 +884,9 @@ impl DeferredPass {
         {
             if k == lists {
                 if let (Some(color), Some(view)) = (clear, out_color) {
-                    clear_output(encoder, timer.as_deref_mut(), view, color);
+                    // A view of its own: the host's may leave out RENDER_ATTACHMENT usage.
+                    let whole = view.texture().create_view(&Default::default());
+                    clear_output(encoder, timer.as_deref_mut(), &whole, color);
                 }
             }
             let timer = timer.as_deref_mut();
