@@ -28,8 +28,9 @@ pub struct PassOptions {
     /// Format of the storage texture that [`OutputTarget::Shaded`] and
     /// [`OutputTarget::Overlay`] write: `Rgba8Unorm` (written sRGB-encoded), `Rgba16Float`
     /// or `Rgba32Float` (linear). It needs `STORAGE_BINDING` usage; with
-    /// `RENDER_ATTACHMENT` as well, [`OutputTarget::Shaded`] clears the background (one
-    /// fill) instead of writing it pixel by pixel, with the same result.
+    /// `RENDER_ATTACHMENT` as well (and one mip level), [`OutputTarget::Shaded`] clears the
+    /// background (one fill) instead of writing it pixel by pixel, with the same result. An
+    /// `Rgba16Float` output takes the background as its nearest half.
     pub output_format: wgpu::TextureFormat,
     /// The host's render pass that [`DeferredPass::render`] draws into, if it is used.
     pub render_target: Option<RenderTarget>,
@@ -679,9 +680,9 @@ impl DeferredPass {
 
     /// [`encode`](Self::encode) with GPU timestamps around each pass, named
     /// `"visibility"`, `"outline.cull"`, `"outline.draw"` and `"outline.pieces"` (when outlines
-    /// are drawn), `"edge.clear"` or `"edge.background"` (whichever lays down the background),
-    /// and `"edge.classify"`, `"edge.outlined"` (with outlines), `"edge.border"`,
-    /// `"edge.tiles"` and `"edge.refine"`, in `timer`.
+    /// are drawn), and `"edge.classify"`, `"edge.border"`, `"edge.clear"` or
+    /// `"edge.background"` (whichever lays down the background), `"edge.outlined"` (with
+    /// outlines), `"edge.tiles"` and `"edge.refine"`, in `timer`.
     pub fn encode_timed(
         &self,
         device: &wgpu::Device,
@@ -979,8 +980,6 @@ enum Size<'b> {
     Indirect(&'b wgpu::Buffer, u64),
 }
 
-/// Records one dispatch as a compute pass of its own, labelled `names.0` and timed as the
-/// span `names.1`.
 /// Clears `view` to `color` in a render pass of its own, timed as `edge.clear`.
 fn clear_output(
     encoder: &mut wgpu::CommandEncoder,
@@ -1006,6 +1005,8 @@ fn clear_output(
     });
 }
 
+/// Records one dispatch as a compute pass of its own, labelled `names.0` and timed as the
+/// span `names.1`.
 fn dispatch(
     encoder: &mut wgpu::CommandEncoder,
     timer: Option<&mut GpuTimer>,
