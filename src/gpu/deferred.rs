@@ -6,6 +6,7 @@ use super::composite::{Composite, CompositePipeline, RenderTarget};
 use super::frame::{Canvas, FrameData};
 use super::host::{HostFrame, HostImport};
 use super::mesh_store::MeshStore;
+use super::raster;
 use super::targets::{TargetSpec, Targets, LIST_HEADER, RESULT_FORMAT};
 use super::visibility::Visibility;
 use super::{shaders, GpuTimer};
@@ -485,17 +486,14 @@ impl DeferredPass {
         {
             return None;
         }
-        let [r, g, b, a] = match mode {
-            Mode::Shade => background_value(self.format, frame.data.uniforms.background()),
-            Mode::Result { .. } => [0.0; 4],
-            Mode::Overlay { .. } | Mode::Diagnostic => return None,
-        };
-        Some(wgpu::Color {
-            r: f64::from(r),
-            g: f64::from(g),
-            b: f64::from(b),
-            a: f64::from(a),
-        })
+        match mode {
+            Mode::Shade => Some(background_value(
+                self.format,
+                frame.data.uniforms.background(),
+            )),
+            Mode::Result { .. } => Some(wgpu::Color::TRANSPARENT),
+            Mode::Overlay { .. } | Mode::Diagnostic => None,
+        }
     }
 
     fn variant(&self, frame: &PreparedFrame) -> Variant {
@@ -989,15 +987,7 @@ fn clear_output(
 ) {
     encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: Some("wirepass edge clear"),
-        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-            view,
-            depth_slice: None,
-            resolve_target: None,
-            ops: wgpu::Operations {
-                load: wgpu::LoadOp::Clear(color),
-                store: wgpu::StoreOp::Store,
-            },
-        })],
+        color_attachments: &[raster::cleared(view, color)],
         depth_stencil_attachment: None,
         timestamp_writes: timer.and_then(|t| t.render_span("edge.clear")),
         occlusion_query_set: None,
@@ -1027,19 +1017,22 @@ fn dispatch(
 }
 
 /// What store_pixel writes into an output of `format` for a pixel of background colour
-/// `background` (linear) without a line: encode_output of it, alpha at least 0, as the
-/// format holds it (a clear converts exactly what the format holds exactly).
-fn background_value(format: wgpu::TextureFormat, background: [f32; 4]) -> [f32; 4] {
+/// `background` (linear) without a line, as a clear colour: the baselines' clear colour of
+/// it (encode_output's encoding) with alpha at least 0, and an 8-bit one on the format's own
+/// steps (a clear converts exactly what the format holds exactly; an Rgba16Float output's
+/// background already is a half, see `prepare`).
+fn background_value(format: wgpu::TextureFormat, background: [f32; 4]) -> wgpu::Color {
     let [r, g, b, a] = background;
-    let a = a.max(0.0);
-    match format {
-        wgpu::TextureFormat::Rgba8Unorm => {
-            let unorm = |x: f32| (x.clamp(0.0, 1.0) * 255.0).round() / 255.0;
-            let srgb = |c: f32| unorm(crate::style::linear_to_srgb(c));
-            [srgb(r), srgb(g), srgb(b), unorm(a)]
-        }
-        wgpu::TextureFormat::Rgba16Float => [r, g, b, a].map(round_to_half),
-        _ => [r, g, b, a],
+    let c = raster::clear_color(format, [r, g, b, a.max(0.0)]);
+    if format != wgpu::TextureFormat::Rgba8Unorm {
+        return c;
+    }
+    let unorm = |x: f64| (x.clamp(0.0, 1.0) * 255.0).round() / 255.0;
+    wgpu::Color {
+        r: unorm(c.r),
+        g: unorm(c.g),
+        b: unorm(c.b),
+        a: unorm(c.a),
     }
 }
 
@@ -1188,12 +1181,13 @@ mod tests {
 
     #[test]
     fn the_background_value_is_what_the_shader_stores() {
+        let rgba = |c: wgpu::Color| [c.r, c.g, c.b, c.a];
         let c = [0.1, 0.5, 1.0, 0.25];
         let srgb = background_value(wgpu::TextureFormat::Rgba8Unorm, c);
-        let want = [89.0, 188.0, 255.0, 64.0].map(|b: f32| b / 255.0);
-        assert_eq!(srgb, want);
+        let want = [89.0, 188.0, 255.0, 64.0].map(|b: f64| b / 255.0);
+        assert_eq!(rgba(srgb), want);
         // Alpha at least 0; float formats hold linear values.
         let f = background_value(wgpu::TextureFormat::Rgba32Float, [0.1, 0.2, 0.3, -1.0]);
-        assert_eq!(f, [0.1, 0.2, 0.3, 0.0]);
+        assert_eq!(rgba(f), [0.1, 0.2, 0.3, 0.0].map(|v: f32| f64::from(v)));
     }
 }

@@ -40,6 +40,22 @@ pub(super) fn encode_snippet(format: wgpu::TextureFormat) -> Option<&'static str
     }
 }
 
+/// A colour attachment cleared to `color` when the pass begins, and stored.
+pub(super) fn cleared(
+    view: &wgpu::TextureView,
+    color: wgpu::Color,
+) -> Option<wgpu::RenderPassColorAttachment<'_>> {
+    Some(wgpu::RenderPassColorAttachment {
+        view,
+        depth_slice: None,
+        resolve_target: None,
+        ops: wgpu::Operations {
+            load: wgpu::LoadOp::Clear(color),
+            store: wgpu::StoreOp::Store,
+        },
+    })
+}
+
 /// The clear colour of an output of `format` for the linear background `bg`.
 pub(super) fn clear_color(format: wgpu::TextureFormat, bg: [f32; 4]) -> wgpu::Color {
     let encode = format == wgpu::TextureFormat::Rgba8Unorm;
@@ -278,18 +294,7 @@ impl RasterFrame {
         let ids = self.ids.create_view(&Default::default());
         let diagnostic = self.diagnostic.create_view(&Default::default());
         let depth = self.depth.create_view(&Default::default());
-        let clear = |view, color| {
-            Some(wgpu::RenderPassColorAttachment {
-                view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(color),
-                    store: wgpu::StoreOp::Store,
-                },
-            })
-        };
-        let mut colors = vec![clear(output, clear_color(format, self.background))];
+        let mut colors = vec![cleared(output, clear_color(format, self.background))];
         if maps {
             let uint = |v: u32| wgpu::Color {
                 r: f64::from(v),
@@ -297,8 +302,8 @@ impl RasterFrame {
                 b: 0.0,
                 a: 0.0,
             };
-            colors.push(clear(&ids, uint(u32::MAX)));
-            colors.push(clear(
+            colors.push(cleared(&ids, uint(u32::MAX)));
+            colors.push(cleared(
                 &diagnostic,
                 wgpu::Color {
                     r: f64::from(NO_EDGE.to_bits()),
