@@ -535,7 +535,10 @@ fn mark_outline_tiles(first_m: i32, last_m: i32, first_o: i32, last_o: i32, majo
 // rasterizer gave the 3×3 pixel centres around x (a sliver of surface in front of the edge
 // may own no centre next to x, but one a pixel further on), and those a walk across edges
 // from them reaches when they do not cover x themselves (x may lie in a small triangle that
-// owns none of those centres).
+// owns none of those centres). A walk ends at a fold (`locate`): beyond it the surface lies
+// on this side of the fold's edge, and a walk towards x, a point of a silhouette, would
+// only bounce between the edge's two triangles or wander over the far side for all its
+// steps, the slowest lane holding up its batch.
 fn visible_at(x: vec2<f32>, near: f32, w: f32, reverse: f32, inst: u32, t: u32, n: u32) -> bool {
     let centre = vec2<i32>(floor(x - frame.target_origin));
     if host_hides_point(x - frame.target_origin, reverse) {
@@ -548,7 +551,7 @@ fn visible_at(x: vec2<f32>, near: f32, w: f32, reverse: f32, inst: u32, t: u32, 
             continue;
         }
         last = id;
-        let s = locate(id.x, id.y, x, WALK_STEPS, false);
+        let s = locate(id.x, id.y, x, WALK_STEPS, true);
         if s.covers && !(s.inst == inst && (s.tri == t || s.tri == n)) && nearer(s.near, near, w) {
             return false;
         }
