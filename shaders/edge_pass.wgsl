@@ -210,15 +210,19 @@ fn across(s: Sample, q0: vec3<f32>, q1: vec3<f32>, q2: vec3<f32>, mask: u32, a: 
 // Bits of a quad triangle's `info` (INFO_QUAD; mesh_store::quad_bits) that describe the
 // other triangle without reading it: the diagonal (this triangle's undrawn edge, bits
 // 16-17), the other triangle's corner off the diagonal (18-19), whether its next corner is
-// the diagonal's start (bit 20) or its end, and its drawn edges (21-23).
+// the diagonal's start (bit 20) or its end, its drawn edges (21-23), and whether it is
+// stored right after this one (bit 24) or right before it (bit 25).
 const QUAD_EDGE_SHIFT: u32 = 16u;
 const QUAD_CORNER_SHIFT: u32 = 18u;
 const QUAD_SAME: u32 = 1048576u;
 const QUAD_MASK_SHIFT: u32 = 21u;
+const QUAD_NEXT: u32 = 16777216u;
+const QUAD_PREVIOUS: u32 = 33554432u;
 
-// A quad as its sampled triangle `s` sees it, from three reads: the diagonal a -> b (the
-// sample's undrawn edge i) and its third corner c, the other triangle's fourth corner d (its
-// corner k) and that triangle's corners in its own order and drawn edges.
+// A quad as its sampled triangle `s` sees it, from two reads (three where its halves are
+// not stored side by side): the diagonal a -> b (the sample's undrawn edge i) and its third
+// corner c, the other triangle's fourth corner d (its corner k) and that triangle's corners
+// in its own order and drawn edges.
 struct Quad {
     i: u32,
     k: u32,
@@ -239,7 +243,13 @@ fn quad_of(s: Sample, bits: u32) -> Quad {
     let base = instances[slot(s.inst)].triangle_base;
     q.i = (bits >> QUAD_EDGE_SHIFT) & 3u;
     q.k = (bits >> QUAD_CORNER_SHIFT) & 3u;
-    let n = neighbour(base + s.tri, q.i);
+    // The other triangle: next to this one where the store keeps a source quad's halves
+    // together (no read, and its corners share a cache line with these); else across the
+    // diagonal, read behind a branch so that the lanes of stored pairs skip the read.
+    var n = select(s.tri - 1u, s.tri + 1u, (bits & QUAD_NEXT) != 0u);
+    if (bits & (QUAD_NEXT | QUAD_PREVIOUS)) == 0u {
+        n = neighbour(base + s.tri, q.i);
+    }
     q.a = sample_corner(s, q.i);
     q.b = sample_corner(s, (q.i + 1u) % 3u);
     q.c = sample_corner(s, (q.i + 2u) % 3u);

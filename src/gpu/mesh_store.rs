@@ -702,12 +702,19 @@ const INFO_QUAD: u32 = 1 << 15;
 /// edge_pass.wgsl reads the other triangle from these, its id and one corner's position.
 const QUAD_SHIFT: u32 = 16;
 
+/// Bits of [`EdgeData::info`] of a quad: its other triangle is stored right after this one
+/// ([`QUAD_NEXT`]) or right before it ([`QUAD_PREVIOUS`]), as the cluster order keeps the
+/// halves of a source quad ([`Mesh::quad_partners`]); with neither, `quad_of` reads it from
+/// the adjacency.
+const QUAD_NEXT: u32 = 1 << 24;
+const QUAD_PREVIOUS: u32 = 1 << 25;
+
 /// [`INFO_QUAD`] and the bits after [`QUAD_SHIFT`] for triangle `t` of a two-triangle patch
-/// under edge mask `mask`, or 0 (the triangle is then searched as any small patch is) where
-/// the other triangle does not meet it across the diagonal at bit-identical positions (so
-/// that the diagonal's ends read from either triangle are the same numbers) or draws the
-/// diagonal from its side.
-fn quad_bits(mesh: &Mesh, mask: &[u8], t: usize) -> u32 {
+/// under edge mask `mask` (`stored` maps triangles to their stored places), or 0 (the
+/// triangle is then searched as any small patch is) where the other triangle does not meet
+/// it across the diagonal at bit-identical positions (so that the diagonal's ends read from
+/// either triangle are the same numbers) or draws the diagonal from its side.
+fn quad_bits(mesh: &Mesh, mask: &[u8], stored: &[u32], t: usize) -> u32 {
     let neighbours = mesh.edge_neighbours();
     let (tris, positions) = (mesh.triangles(), mesh.positions());
     let at = |v: u32| positions[v as usize].to_array().map(f32::to_bits);
@@ -729,7 +736,15 @@ fn quad_bits(mesh: &Mesh, mask: &[u8], t: usize) -> u32 {
         return 0;
     };
     let k = (j + 2) % 3;
+    let place = if stored[n] == stored[t] + 1 {
+        QUAD_NEXT
+    } else if stored[n] + 1 == stored[t] {
+        QUAD_PREVIOUS
+    } else {
+        0
+    };
     INFO_QUAD
+        | place
         | (e as u32) << QUAD_SHIFT
         | (k as u32) << (QUAD_SHIFT + 2)
         | u32::from(same) << (QUAD_SHIFT + 4)
@@ -742,7 +757,7 @@ pub(crate) struct EdgeData {
     /// bits 0–2 the drawn edges, bit 3 a boundary edge, bits 4–7 the fold code of
     /// [`Mesh::outline_hints`], bits 8–10 the edges that may be drawn as outlines, bit 11
     /// a large patch, bits 12–14 the drawn edges the outline pass draws, bit 15 a patch of
-    /// two triangles, bits 16–23 that quad's other triangle ([`quad_bits`]).
+    /// two triangles, bits 16–25 that quad's other triangle ([`quad_bits`]).
     pub info: Vec<u32>,
     pub lines: MeshLines,
 }
@@ -770,7 +785,7 @@ impl EdgeData {
                     0
                 };
                 let quad = if patches.size[t] == 2 {
-                    quad_bits(mesh, &mask, t)
+                    quad_bits(mesh, &mask, &stored, t)
                 } else {
                     0
                 };
@@ -874,7 +889,7 @@ mod tests {
         let mask = vec![0b011, ALL_EDGES & !(1 << shared)];
         let mesh = Mesh::new(p, None, vec![[0, 1, 2], second], Some(mask)).unwrap();
         let mask = mesh.edge_mask(EdgeSelection::Polygon);
-        [0, 1].map(|t| quad_bits(&mesh, &mask, t))
+        [0, 1].map(|t| quad_bits(&mesh, &mask, &[0, 1], t))
     }
 
     fn square() -> Vec<Vec3> {
@@ -898,6 +913,9 @@ mod tests {
         let [first, second] = quad_info(square(), [0, 2, 3]);
         assert_eq!(decode(first), (2, 2, false, 0b110));
         assert_eq!(decode(second), (0, 1, false, 0b011));
+        // Stored side by side, each says where the other is.
+        assert_eq!(first & (QUAD_NEXT | QUAD_PREVIOUS), QUAD_NEXT);
+        assert_eq!(second & (QUAD_NEXT | QUAD_PREVIOUS), QUAD_PREVIOUS);
         // The second triangle wound the other way (its next corner after 3 is the first
         // triangle's diagonal start, 2), and with split vertices at the same positions.
         let mut p = square();

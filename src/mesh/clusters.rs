@@ -4,7 +4,9 @@
 //!
 //! Triangles are ordered along a Morton curve through their centroids and cut into runs of
 //! [`CLUSTER_TRIANGLES`], so a cluster is a compact patch whatever order the file lists its
-//! triangles in, and its normals spread little on a smooth surface.
+//! triangles in, and its normals spread little on a smooth surface. The two triangles of a
+//! quad stay side by side in that order, so the edge pass finds a quad's other triangle
+//! next to the one it holds, without reading the adjacency.
 //!
 //! A neighboured edge can be a silhouette only while the eye sees its triangle's plane within
 //! the edge's fold of edge-on ([`super::adjacency::outline_hints`]). A cluster's bounds are a
@@ -13,7 +15,7 @@
 //! normal in the cone that stays more than the fold away from 90°, no triangle of the cluster
 //! has an outline edge.
 
-use super::adjacency::{fold_bound, ANY_FOLD};
+use super::adjacency::{fold_bound, ANY_FOLD, NO_NEIGHBOUR};
 use crate::par::*;
 use glam::DVec3;
 
@@ -51,8 +53,15 @@ pub struct Clusters {
     pub bounds: Vec<ClusterBounds>,
 }
 
-/// Clusters the triangles; `hints` are [`super::Mesh::outline_hints`].
-pub fn clusters(positions: &[glam::Vec3], triangles: &[[u32; 3]], hints: &[u8]) -> Clusters {
+/// Clusters the triangles; `hints` are [`super::Mesh::outline_hints`], `partners` the
+/// other triangle of each triangle's quad ([`NO_NEIGHBOUR`] for none; symmetric), which the
+/// order keeps right after it.
+pub fn clusters(
+    positions: &[glam::Vec3],
+    triangles: &[[u32; 3]],
+    hints: &[u8],
+    partners: &[u32],
+) -> Clusters {
     let corner = |t: u32, k: usize| positions[triangles[t as usize][k] as usize].as_dvec3();
     let centroid = |t: u32| (corner(t, 0) + corner(t, 1) + corner(t, 2)) / 3.0;
     let (lo, hi) = (0..triangles.len() as u32).map(centroid).fold(
@@ -61,17 +70,24 @@ pub fn clusters(positions: &[glam::Vec3], triangles: &[[u32; 3]], hints: &[u8]) 
     );
     let cells = ((1u64 << MORTON_BITS) - 1) as f64;
     let scale = cells / (hi - lo).max_element().max(f64::MIN_POSITIVE);
+    // One key per quad, placed at its first triangle; its second follows it.
+    let partner = |t: u32| Some(partners[t as usize]).filter(|&u| u != NO_NEIGHBOUR);
     let mut keyed: Vec<(u64, u32)> = (0..triangles.len() as u32)
         .into_par_iter()
+        .filter(|&t| partner(t).is_none_or(|u| t < u))
         .map(|t| {
-            let q = ((centroid(t) - lo) * scale)
+            let c = partner(t).map_or(centroid(t), |u| (centroid(t) + centroid(u)) * 0.5);
+            let q = ((c - lo) * scale)
                 .clamp(DVec3::ZERO, DVec3::splat(cells))
                 .as_u64vec3();
             (morton(q.x) | morton(q.y) << 1 | morton(q.z) << 2, t)
         })
         .collect();
     keyed.par_sort_unstable();
-    let order: Vec<u32> = keyed.into_iter().map(|(_, t)| t).collect();
+    let order: Vec<u32> = keyed
+        .into_iter()
+        .flat_map(|(_, t)| std::iter::once(t).chain(partner(t)))
+        .collect();
     let bounds = order
         .par_chunks(CLUSTER_TRIANGLES)
         .map(|ids| {
@@ -168,4 +184,32 @@ pub fn may_fold(bounds: &ClusterBounds, eye: glam::DVec4) -> bool {
     let reach = beta + bounds.spread;
     let quarter = std::f64::consts::FRAC_PI_2;
     !(gamma + reach < quarter || gamma - reach > quarter)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_quad_s_triangles_are_stored_side_by_side() {
+        for mesh in [crate::mesh::sphere(5000), crate::mesh::cube(3000)] {
+            let mesh = mesh.unwrap();
+            let partners = mesh.quad_partners();
+            let paired = partners.iter().filter(|&&p| p != NO_NEIGHBOUR).count();
+            assert!(paired > mesh.triangle_count() / 2, "{paired} paired");
+            let order = &mesh.outline_clusters().order;
+            let mut stored = vec![usize::MAX; order.len()];
+            for (s, &t) in order.iter().enumerate() {
+                assert_eq!(stored[t as usize], usize::MAX, "triangle {t} stored twice");
+                stored[t as usize] = s;
+            }
+            assert_eq!(order.len(), mesh.triangle_count());
+            for (t, &p) in partners.iter().enumerate() {
+                if p != NO_NEIGHBOUR {
+                    assert_eq!(partners[p as usize], t as u32);
+                    assert_eq!(stored[t].abs_diff(stored[p as usize]), 1, "quad {t}, {p}");
+                }
+            }
+        }
+    }
 }

@@ -338,8 +338,41 @@ impl Mesh {
     /// first use.
     pub fn outline_clusters(&self) -> &clusters::Clusters {
         self.outline_clusters.get_or_init(|| {
-            clusters::clusters(&self.positions, &self.triangles, self.outline_hints())
+            clusters::clusters(
+                &self.positions,
+                &self.triangles,
+                self.outline_hints(),
+                &self.quad_partners(),
+            )
         })
+    }
+
+    /// Per triangle, the other triangle of its quad, or [`adjacency::NO_NEIGHBOUR`]: two
+    /// triangles whose only edges that are not polygon edges are the one they share, the
+    /// two halves of a source polygon of four corners.
+    pub fn quad_partners(&self) -> Vec<u32> {
+        let neighbours = self.edge_neighbours();
+        // The one edge of t that is not a polygon edge, if it has exactly one.
+        let diagonal = |t: usize| {
+            let open = !self.polygon_edges[t] & ALL_EDGES;
+            (open.count_ones() == 1).then(|| open.trailing_zeros() as usize)
+        };
+        (0..self.triangles.len())
+            .map(|t| {
+                let Some(e) = diagonal(t) else {
+                    return adjacency::NO_NEIGHBOUR;
+                };
+                let n = neighbours[t][e];
+                let back = n != adjacency::NO_NEIGHBOUR
+                    && n != t as u32
+                    && diagonal(n as usize).is_some_and(|j| neighbours[n as usize][j] == t as u32);
+                if back {
+                    n
+                } else {
+                    adjacency::NO_NEIGHBOUR
+                }
+            })
+            .collect()
     }
 
     /// Per triangle, the edges that may be drawn as outlines (bit `i` for edge `i`): all of
