@@ -1,5 +1,11 @@
 // Definitions every wirepass shader shares. Each function has a Rust twin of the same name
 // (src/edge_math.rs, src/style.rs, src/gpu/mesh_store.rs); tests keep the two equal.
+//
+// No `if` or loop condition in these shaders depends on uniform values alone (a frame
+// setting, the record of a frame's one instance): lavapipe (Mesa 22) then specialises the
+// pipeline for those values again at every dispatch, which costs milliseconds for a large
+// shader even when the dispatch has no work. Such choices are `select`s, or `#if` flags
+// (src/gpu/shaders.rs).
 
 // Per frame (src/gpu/frame.rs, FrameUniforms).
 struct Frame {
@@ -240,10 +246,7 @@ fn line_reach(width: f32) -> f32 {
 // A line's strength at view depth `depth`: 1 up to fade.x, falling linearly to 0 at fade.y;
 // 1 everywhere when fade.y <= fade.x (no fade).
 fn depth_fade(depth: f32, fade: vec2<f32>) -> f32 {
-    if !(fade.y > fade.x) {
-        return 1.0;
-    }
-    return clamp((fade.y - depth) / (fade.y - fade.x), 0.0, 1.0);
+    return select(1.0, clamp((fade.y - depth) / (fade.y - fade.x), 0.0, 1.0), fade.y > fade.x);
 }
 
 // Which line colours a pixel most: lines are ranked by their intensity in 1/4095 steps, and
@@ -313,20 +316,15 @@ fn cluster_splats(c: Cluster) -> bool {
 // orthographic eye sees along one direction (β = 0).
 fn cluster_may_fold(c: Cluster, eye: vec4<f32>) -> bool {
     let spread = select(c.spread, -1.0 - c.spread, cluster_splats(c));
-    var d = -eye.xyz;
-    var beta = 0.0;
-    if eye.w != 0.0 {
-        d = c.center - eye.xyz / eye.w;
-        let distance = length(d);
-        if !(distance > c.radius) {
-            return true;
-        }
-        beta = asin(c.radius / distance);
-    }
+    let perspective = eye.w != 0.0;
+    let d = select(-eye.xyz, c.center - eye.xyz / eye.w, perspective);
+    let distance = length(d);
+    let inside = perspective && !(distance > c.radius);
+    let beta = select(0.0, asin(c.radius / distance), perspective);
     let gamma = atan2(length(cross(d, c.axis)), dot(d, c.axis));
     let reach = beta + spread;
     let quarter = 1.5707963;
-    return !(gamma + reach < quarter || gamma - reach > quarter);
+    return inside || !(gamma + reach < quarter || gamma - reach > quarter);
 }
 
 // Twin of mesh_store::unpack_normal: a unit normal packed octahedrally into two 16-bit

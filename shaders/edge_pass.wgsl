@@ -395,10 +395,7 @@ struct Own {
 fn own_lines(s: Sample) -> Own {
     let flags = instances[slot(s.inst)].flags;
     let bits = info[instances[slot(s.inst)].triangle_base + s.tri];
-    var mask = bits & 7u;
-    if (flags & INSTANCE_EDGES) == 0u {
-        mask = 0u;
-    }
+    let mask = select(0u, bits & 7u, (flags & INSTANCE_EDGES) != 0u);
     let near = vec3<f32>(s.clip0.z, s.clip1.z, s.clip2.z);
     let d = drawn_distances(s.lines, near, mask);
     var own = Own(min(d.x, min(d.y, d.z)), false, false, bits);

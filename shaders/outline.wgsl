@@ -174,16 +174,12 @@ fn outline_triangle(inst: u32, t: u32) {
     }
     let normal = cross(p[1] - p[0], p[2] - p[0]);
     let eye = instances[slot(inst)].eye;
-    var may_fold = true;
-    if eye.w != 0.0 {
-        let e = eye.xyz / eye.w;
-        let height = abs(dot(p[0] - e, normal));
-        let farthest = sqrt(max(dot(p[0] - e, p[0] - e), max(dot(p[1] - e, p[1] - e), dot(p[2] - e, p[2] - e))));
-        may_fold = !(height > fold_bound * farthest * length(normal));
-    } else {
-        // Seen along one direction: the angle to edge-on is the same from every vertex.
-        may_fold = !(abs(dot(eye.xyz, normal)) > fold_bound * length(eye.xyz) * length(normal));
-    }
+    let e = eye.xyz / eye.w;
+    let height = abs(dot(p[0] - e, normal));
+    let farthest = sqrt(max(dot(p[0] - e, p[0] - e), max(dot(p[1] - e, p[1] - e), dot(p[2] - e, p[2] - e))));
+    // Seen along one direction (w = 0): the angle to edge-on is the same from every vertex.
+    let along = !(abs(dot(eye.xyz, normal)) > fold_bound * length(eye.xyz) * length(normal));
+    let may_fold = select(along, !(height > fold_bound * farthest * length(normal)), eye.w != 0.0);
     if !(may_fold && outlines) && !boundary && splat == 0u {
         return;
     }
