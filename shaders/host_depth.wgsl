@@ -30,8 +30,7 @@ struct HostParams {
     mode: u32,
     // Whether greater host depth is nearer (a reversed host convention).
     reversed: u32,
-    // Samples per pixel of the host's depth texture.
-    samples: u32,
+    _pad: u32,
     // The smallest step of the host's depth format near its far end: 2^-bits for unorm
     // formats, the f32 step at 1 for float ones (relative for a reversed float format).
     quantum: f32,
@@ -60,7 +59,9 @@ fn host_value(xy: vec2<u32>) -> u32 {
     // The farthest sample: towards `far`.
     var d = 1.0 - far;
 #if MULTISAMPLED
-    for (var s = 0u; s < host.samples; s++) {
+    // The texture's own count, not a uniform: a loop bound by uniform values alone is
+    // re-specialised by lavapipe at every dispatch (see common.wgsl).
+    for (var s = 0u; s < textureNumSamples(host_depth); s++) {
         let x = textureLoad(host_depth, image, i32(s)).x;
         d = select(max(d, x), min(d, x), host.reversed == 1u);
     }
@@ -70,15 +71,12 @@ fn host_value(xy: vec2<u32>) -> u32 {
     if d == far {
         return 0xffffffffu;
     }
-    var reverse = 1.0 - d;
-    if host.mode == 1u {
-        reverse = d;
-    } else if host.mode == 2u {
-        let pixel = vec2<f32>(image) + 0.5;
-        let ndc = vec2<f32>(pixel.x / f32(size.x) * 2.0 - 1.0, 1.0 - pixel.y / f32(size.y) * 2.0);
-        let q = vec4<f32>(ndc, d, 1.0);
-        reverse = dot(host.a, q) / dot(host.b, q);
-    }
+    let pixel = vec2<f32>(image) + 0.5;
+    let ndc = vec2<f32>(pixel.x / f32(size.x) * 2.0 - 1.0, 1.0 - pixel.y / f32(size.y) * 2.0);
+    let q = vec4<f32>(ndc, d, 1.0);
+    // Selects, not branches on the uniform mode (see common.wgsl).
+    let same = select(1.0 - d, d, host.mode == 1u);
+    let reverse = select(same, dot(host.a, q) / dot(host.b, q), host.mode == 2u);
     // Moved back by the margin, so the pass's own surfaces win ties with the host's copy.
     return bitcast<u32>(clamp(reverse - host_margin(reverse, host.quantum), 0.0, 1.0));
 }

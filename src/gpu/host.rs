@@ -44,7 +44,7 @@ struct HostParams {
     b: [f32; 4],
     mode: u32,
     reversed: u32,
-    samples: u32,
+    _pad: u32,
     quantum: f32,
 }
 
@@ -145,7 +145,7 @@ impl HostImport {
             b: b.as_vec4().to_array(),
             mode,
             reversed: u32::from(reversed),
-            samples: t.sample_count(),
+            _pad: 0,
             quantum: depth_quantum(t.format(), host.view.depth) as f32,
         };
         let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
