@@ -187,14 +187,16 @@ fn outline_triangle(inst: u32, t: u32) {
         if ((allowed | splat) & (1u << i)) == 0u {
             continue;
         }
-        let n = neighbour(base + t, i);
+        let word = neighbour_word(base + t, i);
+        let n = select(word & NEIGHBOUR_INDEX, BACKGROUND_ID, word == BACKGROUND_ID);
         let a = p[i];
         let b = p[(i + 1u) % 3u];
         var outline = (splat & (1u << i)) != 0u || ((allowed & (1u << i)) != 0u && n == BACKGROUND_ID);
         if !outline && (allowed & (1u << i)) != 0u && may_fold && t < n {
-            // Shared edges are drawn by the lower id only.
-            let w = corners(base + n) + vbase;
-            let d = (vertex_at(w.x).xyz + vertex_at(w.y).xyz + vertex_at(w.z).xyz) / 3.0;
+            // Shared edges are drawn by the lower id only. The neighbour's centroid, its
+            // corners summed in its own order; only the one off the edge is read.
+            let q = beyond_edge(inst, word, vec4<f32>(a, 0.0), vec4<f32>(b, 0.0));
+            let d = (q.q0.xyz + q.q1.xyz + q.q2.xyz) / 3.0;
             outline = is_silhouette(a, b, p[(i + 2u) % 3u], d, eye);
         }
         if outline {

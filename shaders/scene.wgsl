@@ -76,8 +76,10 @@ fn slot(i: u32) -> u32 {
 #if SPLIT
 @group(0) @binding(5) var<storage, read> indices_hi: array<u32>;
 #endif
-// The triangle across each edge (edge i = corner i -> i+1), relative to the mesh's first
-// triangle, or BACKGROUND_ID for boundary and non-manifold edges.
+// Per edge (edge i = corner i -> i+1), the triangle across it (mesh_store::neighbour_word):
+// bits 0-28 its index relative to the mesh's first triangle, bits 29-30 its corner off the
+// shared edge, bit 31 set where it runs along that edge the same way; BACKGROUND_ID (all
+// ones) for boundary and non-manifold edges.
 @group(0) @binding(6) var<storage, read> neighbours: array<u32>;
 #if SPLIT
 @group(0) @binding(7) var<storage, read> neighbours_hi: array<u32>;
@@ -118,14 +120,51 @@ fn corners(t: u32) -> vec3<u32> {
     return vec3<u32>(corner(t, 0u), corner(t, 1u), corner(t, 2u));
 }
 
-// The triangle across edge i of the store's triangle t (relative to its mesh).
-fn neighbour(t: u32, i: u32) -> u32 {
+// The neighbour word of edge i of the store's triangle t.
+fn neighbour_word(t: u32, i: u32) -> u32 {
 #if SPLIT
     if t >= frame.triangle_split {
         return neighbours_hi[3u * (t - frame.triangle_split) + i];
     }
 #endif
     return neighbours[3u * t + i];
+}
+
+const NEIGHBOUR_INDEX: u32 = 0x1fffffffu;
+const NEIGHBOUR_CORNER_SHIFT: u32 = 29u;
+const NEIGHBOUR_SAME_WAY: u32 = 0x80000000u;
+
+// The triangle across edge i of the store's triangle t (relative to its mesh), or
+// BACKGROUND_ID.
+fn neighbour(t: u32, i: u32) -> u32 {
+    let word = neighbour_word(t, i);
+    return select(word & NEIGHBOUR_INDEX, BACKGROUND_ID, word == BACKGROUND_ID);
+}
+
+// The triangle across an edge a -> b of another one, from the edge's neighbour word and the
+// store's corner data: its index (relative to its mesh) and its corners in its own order.
+// It shares a and b, so only its corner off the edge is read.
+struct Beyond {
+    tri: u32,
+    q0: vec4<f32>,
+    q1: vec4<f32>,
+    q2: vec4<f32>,
+}
+
+fn beyond_edge(inst: u32, word: u32, a: vec4<f32>, b: vec4<f32>) -> Beyond {
+    var out: Beyond;
+    out.tri = word & NEIGHBOUR_INDEX;
+    let k = (word >> NEIGHBOUR_CORNER_SHIFT) & 3u;
+    let base = instances[slot(inst)].triangle_base;
+    let d = vertex_at(corner(base + out.tri, k) + instances[slot(inst)].vertex_base);
+    // Its corners k + 1 and k + 2: the edge's start and end where it runs the same way.
+    let same = (word & NEIGHBOUR_SAME_WAY) != 0u;
+    let first = select(b, a, same);
+    let second = select(a, b, same);
+    out.q0 = select(select(first, second, k == 1u), d, k == 0u);
+    out.q1 = select(select(second, first, k == 0u), d, k == 1u);
+    out.q2 = select(select(first, second, k == 0u), d, k == 2u);
+    return out;
 }
 
 // The id target at a target pixel, clamped to the targets.
@@ -232,16 +271,20 @@ struct Sample {
 }
 
 fn sample(inst: u32, tri: u32, point: vec2<f32>) -> Sample {
+    let v = corners(instances[slot(inst)].triangle_base + tri) + instances[slot(inst)].vertex_base;
+    return sample_corners(inst, tri, vertex_at(v.x), vertex_at(v.y), vertex_at(v.z), point);
+}
+
+// `sample` of a triangle whose corners (v0, v1, v2, in its own order) are already read.
+fn sample_corners(inst: u32, tri: u32, v0: vec4<f32>, v1: vec4<f32>, v2: vec4<f32>, point: vec2<f32>) -> Sample {
     var s: Sample;
     s.inst = inst;
     s.tri = tri;
     let clip = instances[slot(inst)].clip;
     let depth_row = instances[slot(inst)].depth_row;
-    let base = instances[slot(inst)].vertex_base;
-    let v = corners(instances[slot(inst)].triangle_base + tri) + base;
-    s.v0 = vertex_at(v.x);
-    s.v1 = vertex_at(v.y);
-    s.v2 = vertex_at(v.z);
+    s.v0 = v0;
+    s.v1 = v1;
+    s.v2 = v2;
     let h0 = vec4<f32>(s.v0.xyz, 1.0);
     let h1 = vec4<f32>(s.v1.xyz, 1.0);
     let h2 = vec4<f32>(s.v2.xyz, 1.0);
@@ -292,15 +335,21 @@ const WALK_STEPS: u32 = 24u;
 // way than the last one that faced it either way): the triangle beyond a silhouette edge
 // lies on screen on this side of the edge, so it cannot cover a point beyond it, and the
 // walk would only wander over the surface's far side (a walk from the mesh towards a
-// background point does that for all its steps). One `sample` in one loop, so a shader
-// holds one copy of it.
+// background point does that for all its steps). One `sample_corners` in one loop, so a
+// shader holds one copy of it; a step reads only the next triangle's corner off the crossed
+// edge (`beyond_edge`), so the corners of the returned sample that it shares with the
+// triangle before it carry that one's normal bits (w) where a seam splits their vertices.
 fn locate(inst: u32, tri: u32, point: vec2<f32>, steps: u32, stop_at_fold: bool) -> Sample {
     var t = tri;
     var s: Sample;
     let eye = instances[slot(inst)].eye;
+    let v = corners(instances[slot(inst)].triangle_base + tri) + instances[slot(inst)].vertex_base;
+    var q0 = vertex_at(v.x);
+    var q1 = vertex_at(v.y);
+    var q2 = vertex_at(v.z);
     var facing = 0.0;
     for (var step = 0u; step <= steps; step++) {
-        let next_s = sample(inst, t, point);
+        let next_s = sample_corners(inst, t, q0, q1, q2, point);
         let side = dot(towards_eye(next_s.v0.xyz, eye), cross(next_s.v1.xyz - next_s.v0.xyz, next_s.v2.xyz - next_s.v0.xyz));
         if stop_at_fold && side * facing < 0.0 {
             break;
@@ -318,11 +367,17 @@ fn locate(inst: u32, tri: u32, point: vec2<f32>, steps: u32, stop_at_fold: bool)
         }
         // Corner k's weight is negative beyond the opposite edge k + 1 (mod 3).
         let edge = select(select(0u, 2u, b.y == lowest), 1u, b.x == lowest);
-        let next = neighbour(instances[slot(inst)].triangle_base + t, edge);
-        if next == BACKGROUND_ID {
+        let word = neighbour_word(instances[slot(inst)].triangle_base + t, edge);
+        if word == BACKGROUND_ID {
             break;
         }
-        t = next;
+        let start = select(select(q2, q1, edge == 1u), q0, edge == 0u);
+        let end = select(select(q0, q2, edge == 1u), q1, edge == 0u);
+        let next = beyond_edge(inst, word, start, end);
+        t = next.tri;
+        q0 = next.q0;
+        q1 = next.q1;
+        q2 = next.q2;
     }
     return s;
 }

@@ -5,8 +5,9 @@
 //! two so the mesh spans about ±1 (meshes of any extent, 1e-30 or 1e30, and far from the
 //! origin keep f32's precision; the model matrix takes the offset and scale back in f64),
 //! and the unit normal packed octahedrally into 32 bits. Per triangle: three vertex indices
-//! (12 bytes, also the index buffer), the triangle across each edge (12 bytes), and 4 bytes
-//! of edge data ([`EdgeData`]). Per cluster of 64 triangles: the outline pass's bounds
+//! (12 bytes, also the index buffer), the triangle across each edge and which of its corners
+//! lies off that edge (12 bytes, [`neighbour_word`]), and 4 bytes of edge data
+//! ([`EdgeData`]). Per cluster of 64 triangles: the outline pass's bounds
 //! (32 bytes).
 //!
 //! A mesh's triangles are stored in its clusters' order (a Morton curve through the
@@ -263,6 +264,12 @@ impl MeshStore {
     ) -> Result<MeshId> {
         let vertices = count(mesh.positions().len(), "vertices")?;
         let triangles = count(mesh.triangle_count(), "triangles")?;
+        if triangles > MAX_MESH_TRIANGLES {
+            return Err(Error::InvalidMesh(format!(
+                "{triangles} triangles are more than the {MAX_MESH_TRIANGLES} one mesh of the \
+                 store can hold (its adjacency indexes a triangle in 29 bits)"
+            )));
+        }
         let clusters = triangles.div_ceil(CLUSTER);
         self.check_capacity(
             self.vertices.used() + u64::from(vertices),
@@ -644,19 +651,10 @@ impl MeshData {
             stored[t as usize] = s as u32;
         }
         let tris = mesh.triangles();
-        let across = mesh.edge_neighbours();
         let indices = order.iter().map(|&t| tris[t as usize]).collect();
         let neighbours = order
             .iter()
-            .map(|&t| {
-                across[t as usize].map(|n| {
-                    if n == NO_NEIGHBOUR {
-                        u32::MAX
-                    } else {
-                        stored[n as usize]
-                    }
-                })
-            })
+            .map(|&t| [0, 1, 2].map(|i| neighbour_word(mesh, &stored, t as usize, i)))
             .collect();
         let bounds: Vec<[f32; 8]> = clusters
             .bounds
@@ -685,6 +683,48 @@ impl MeshData {
             bounds: (lo, hi),
         }
     }
+}
+
+/// Most triangles in one mesh: a neighbour word holds the neighbour's index in 29 bits, and
+/// the all-ones word means no neighbour.
+pub(crate) const MAX_MESH_TRIANGLES: u32 = (1 << 29) - 1;
+/// The neighbour word's bits below this hold the neighbour's stored index (relative to its
+/// mesh); the next two its corner off the shared edge.
+const NEIGHBOUR_CORNER_SHIFT: u32 = 29;
+/// Bit of a neighbour word: the neighbour runs along the shared edge the same way as this
+/// triangle (the two are wound oppositely); clear, the other way.
+const NEIGHBOUR_SAME_WAY: u32 = 1 << 31;
+
+/// What the passes read of the triangle across edge `i` of triangle `t` (`scene.wgsl`,
+/// `neighbour_word`): its stored index, its corner k off the shared edge and whether its
+/// corners k + 1 and k + 2 are that edge's start and end (the same way) or its end and start.
+/// A step of a walk across the edge then reads one corner, not three; `u32::MAX` where there
+/// is no neighbour. The shared corners are found by position, as the adjacency welds them.
+fn neighbour_word(mesh: &Mesh, stored: &[u32], t: usize, i: usize) -> u32 {
+    let n = mesh.edge_neighbours()[t][i];
+    if n == NO_NEIGHBOUR {
+        return u32::MAX;
+    }
+    let tris = mesh.triangles();
+    let at = |v: u32| (mesh.positions()[v as usize] + Vec3::ZERO).to_array().map(f32::to_bits);
+    let (a, b) = (at(tris[t][i]), at(tris[t][(i + 1) % 3]));
+    let other = tris[n as usize];
+    let back = (0..3).find(|&j| {
+        let (p, q) = (at(other[j]), at(other[(j + 1) % 3]));
+        mesh.edge_neighbours()[n as usize][j] == t as u32 && ((p, q) == (a, b) || (p, q) == (b, a))
+    });
+    // The adjacency pairs the two sides of an edge with the same welded ends, so `back` is
+    // always found; without it the edge reads as a boundary.
+    let Some(j) = back else {
+        return u32::MAX;
+    };
+    let k = (j as u32 + 2) % 3;
+    let same_way = if at(other[j]) == a {
+        NEIGHBOUR_SAME_WAY
+    } else {
+        0
+    };
+    stored[n as usize] | k << NEIGHBOUR_CORNER_SHIFT | same_way
 }
 
 /// Bit of [`EdgeData::info`]: the triangle's patch is large ([`Patches::large`]).
@@ -923,6 +963,39 @@ mod tests {
         let [first, second] = quad_info(p, [3, 5, 4]);
         assert_eq!(decode(first), (2, 0, true, 0b101));
         assert_eq!(decode(second), (1, 1, true, 0b011));
+    }
+
+    #[test]
+    fn neighbour_words_give_the_corner_off_the_edge_and_the_way_round() {
+        let mut split = square();
+        split.extend([split[0], split[2]]);
+        // The second triangle wound against the first, with it, and on split vertices.
+        for (p, second) in [
+            (square(), [0, 2, 3]),
+            (square(), [0, 3, 2]),
+            (split, [3, 5, 4]),
+        ] {
+            let mesh = Mesh::new(p.clone(), None, vec![[0, 1, 2], second], None).unwrap();
+            let tris = mesh.triangles();
+            for (t, i) in (0..2).flat_map(|t| (0..3).map(move |i| (t, i))) {
+                let word = neighbour_word(&mesh, &[0, 1], t, i);
+                let n = mesh.edge_neighbours()[t][i];
+                if n == NO_NEIGHBOUR {
+                    assert_eq!(word, u32::MAX);
+                    continue;
+                }
+                assert_eq!(word & MAX_MESH_TRIANGLES, n);
+                // The neighbour's corners as beyond_edge (scene.wgsl) rebuilds them: corner k
+                // read, the next two the edge's ends.
+                let k = (word >> NEIGHBOUR_CORNER_SHIFT & 3) as usize;
+                let (a, b) = (p[tris[t][i] as usize], p[tris[t][(i + 1) % 3] as usize]);
+                let same = word & NEIGHBOUR_SAME_WAY != 0;
+                let mut q = [p[tris[n as usize][k] as usize]; 3];
+                q[(k + 1) % 3] = if same { a } else { b };
+                q[(k + 2) % 3] = if same { b } else { a };
+                assert_eq!(q, tris[n as usize].map(|v| p[v as usize]), "{t} {i}");
+            }
+        }
     }
 
     #[test]
