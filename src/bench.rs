@@ -76,6 +76,8 @@ pub struct EdgeShares {
     pub outlined_tiles: f64,
     /// Pixels refined among all output pixels.
     pub refined: f64,
+    /// Clusters of 64 triangles the outline pass's cull listed for its triangle dispatch.
+    pub outline_clusters: u32,
     /// Pieces of outline edges the outline pass's piece dispatch drew (or found beyond its
     /// list's room).
     pub outline_pieces: u32,
@@ -368,6 +370,7 @@ pub fn bench_scene(
                     tiles: f64::from(w.tiles) / f64::from(w.all_tiles.max(1)),
                     outlined_tiles: f64::from(w.outlined_tiles) / f64::from(w.all_tiles.max(1)),
                     refined: f64::from(w.refined) / f64::from(w.pixels.max(1)),
+                    outline_clusters: w.outline_clusters,
                     outline_pieces: w.outline_pieces,
                 })
             }
@@ -473,10 +476,11 @@ pub fn markdown(runs: &[Run]) -> String {
         if let Some(w) = r.edge_work {
             other.push(format!(
                 "tiles {:.1} %, outlined tiles {:.1} %, refined {:.2} % of pixels, {} outline \
-                 pieces",
+                 clusters, {} outline pieces",
                 100.0 * w.tiles,
                 100.0 * w.outlined_tiles,
                 100.0 * w.refined,
+                w.outline_clusters,
                 w.outline_pieces
             ));
         }

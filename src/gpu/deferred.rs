@@ -153,6 +153,9 @@ pub struct EdgeWork {
     pub refined: u32,
     /// Output pixels in all.
     pub pixels: u32,
+    /// Clusters of 64 triangles the outline pass's cull listed (those that may hold an
+    /// outline edge from the eye, or a drawn edge of a large patch), 0 where it did not run.
+    pub outline_clusters: u32,
     /// Pieces (up to 16 px) of outline edges the outline pass listed or found beyond its
     /// list's room, 0 where it did not run.
     pub outline_pieces: u32,
@@ -182,6 +185,11 @@ impl PreparedFrame {
             all_tiles: w.div_ceil(TILE) * h.div_ceil(TILE),
             refined: count(&t.work, 0)?,
             pixels: w * h,
+            outline_clusters: if self.data.outlines {
+                count(&self.cull, 0)?
+            } else {
+                0
+            },
             outline_pieces: if self.data.outlines {
                 count(&t.acc, t.acc_pieces)?
             } else {
@@ -440,9 +448,11 @@ impl DeferredPass {
             self.cull = Some(device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("wirepass cluster list"),
                 size: cull_bytes.next_power_of_two().min(limit),
+                // COPY_SRC: `edge_work` reads its count back.
                 usage: wgpu::BufferUsages::STORAGE
                     | wgpu::BufferUsages::INDIRECT
-                    | wgpu::BufferUsages::COPY_DST,
+                    | wgpu::BufferUsages::COPY_DST
+                    | wgpu::BufferUsages::COPY_SRC,
                 mapped_at_creation: false,
             }));
         }
