@@ -100,7 +100,7 @@ pub use camera::{Camera, DepthRange, View};
 pub use error::{Error, Result};
 pub use gpu::{
     Canvas, Composite, DeferredPass, HostDepth, MeshId, MeshStore, OutputTarget, PassOptions,
-    PreparedFrame, RenderTarget,
+    PreparedFrame, RenderTarget, TriangleIds,
 };
 pub use mesh::{EdgeSelection, Mesh};
 pub use scene::{Instance, InstanceStyle, Scene};

@@ -5,7 +5,7 @@ mod common;
 
 use common::{camera, cpu_distance, framing, gpu, load, shoot};
 use glam::{DMat4, Vec3};
-use wirepass::gpu::{DeferredPass, MeshStore, OutputTarget, PassOptions};
+use wirepass::gpu::{DeferredPass, MeshStore, OutputTarget, PassOptions, TriangleIds};
 use wirepass::render::{Frame, Method, BACKGROUND};
 use wirepass::{Camera, EdgeSelection, Instance, Mesh, Scene, Style};
 
@@ -417,13 +417,16 @@ fn vertex_pulling_fallback_matches_primitive_index() {
     );
     scene.instances.to_mut().push(copy);
     let read = |pulled: bool| {
-        let options = PassOptions::default();
-        let pass = if pulled {
-            DeferredPass::with_vertex_pulling(device, options)
+        let triangle_ids = if pulled {
+            TriangleIds::VertexPulling
         } else {
-            DeferredPass::new(device, options)
+            TriangleIds::PrimitiveIndex
         };
-        let mut pass = pass.unwrap().with_diagnostics();
+        let options = PassOptions {
+            triangle_ids,
+            ..PassOptions::default()
+        };
+        let mut pass = DeferredPass::new(device, options).unwrap().with_diagnostics();
         let frame = pass
             .prepare(device, &store, &scene, &Style::default(), size)
             .unwrap();

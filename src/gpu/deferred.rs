@@ -35,6 +35,8 @@ pub struct PassOptions {
     pub output_format: wgpu::TextureFormat,
     /// The host's render pass that [`DeferredPass::render`] draws into, if it is used.
     pub render_target: Option<RenderTarget>,
+    /// How the visibility pass learns which triangle a pixel shows.
+    pub triangle_ids: TriangleIds,
 }
 
 impl Default for PassOptions {
@@ -42,8 +44,29 @@ impl Default for PassOptions {
         Self {
             output_format: wgpu::TextureFormat::Rgba8Unorm,
             render_target: None,
+            triangle_ids: TriangleIds::Auto,
         }
     }
+}
+
+/// How the visibility pass learns which triangle each pixel shows. Every choice gives the
+/// same ids; they differ in what the device needs and in speed.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum TriangleIds {
+    /// [`VertexPulling`](TriangleIds::VertexPulling) on a CPU adapter, whose rasterizer
+    /// takes a slower path for a fragment shader that reads the primitive index (lavapipe:
+    /// the visibility pass about a quarter slower at 2 M triangles), and on a device without
+    /// `Features::PRIMITIVE_INDEX`; [`PrimitiveIndex`](TriangleIds::PrimitiveIndex)
+    /// elsewhere.
+    #[default]
+    Auto,
+    /// An indexed draw whose fragment shader reads `@builtin(primitive_index)`. Needs
+    /// `Features::PRIMITIVE_INDEX`.
+    PrimitiveIndex,
+    /// A draw of three vertices a triangle, each reading its corner from the store's
+    /// buffers, that passes the triangle as a flat varying. Needs storage buffers in the
+    /// vertex stage.
+    VertexPulling,
 }
 
 /// Where the edge pass writes.
@@ -313,20 +336,22 @@ pub struct DeferredPass {
 }
 
 impl DeferredPass {
-    /// Builds the pipelines. Uses `@builtin(primitive_index)` where the device has
-    /// `Features::PRIMITIVE_INDEX`, and a vertex-pulling visibility pass otherwise.
+    /// Builds the pipelines, the visibility pass as `options.triangle_ids` says.
     pub fn new(device: &wgpu::Device, options: PassOptions) -> Result<Self> {
-        let pulled = !device.features().contains(wgpu::Features::PRIMITIVE_INDEX);
-        Self::build(device, options, pulled)
-    }
-
-    /// Builds the pipelines with the vertex-pulling visibility pass even where the device
-    /// has `PRIMITIVE_INDEX`, e.g. to test the path other adapters take.
-    pub fn with_vertex_pulling(device: &wgpu::Device, options: PassOptions) -> Result<Self> {
-        Self::build(device, options, true)
-    }
-
-    fn build(device: &wgpu::Device, options: PassOptions, pulled: bool) -> Result<Self> {
+        let primitive_index = device.features().contains(wgpu::Features::PRIMITIVE_INDEX);
+        let pulled = match options.triangle_ids {
+            TriangleIds::Auto => {
+                !primitive_index || device.adapter_info().device_type == wgpu::DeviceType::Cpu
+            }
+            TriangleIds::PrimitiveIndex if !primitive_index => {
+                return Err(Error::MissingFeature {
+                    adapter: device.adapter_info().name,
+                    what: "Features::PRIMITIVE_INDEX (TriangleIds::PrimitiveIndex)".into(),
+                })
+            }
+            TriangleIds::PrimitiveIndex => false,
+            TriangleIds::VertexPulling => true,
+        };
         static NEXT: AtomicU32 = AtomicU32::new(1);
         let format = options.output_format;
         if shaders::storage_format_name(format).is_none() {

@@ -12,7 +12,7 @@ use crate::error::Result;
 pub(crate) const BACKGROUND: u32 = u32::MAX;
 
 /// The visibility pipelines: instanced with `@builtin(primitive_index)`, or vertex-pulled
-/// where the device lacks `PRIMITIVE_INDEX` (then also in a variant for a split store).
+/// (`TriangleIds`; then also in a variant for a split store).
 pub(crate) struct Visibility {
     pulled: bool,
     pipelines: [Option<Raster>; 2],
