@@ -426,7 +426,9 @@ fn vertex_pulling_fallback_matches_primitive_index() {
             triangle_ids,
             ..PassOptions::default()
         };
-        let mut pass = DeferredPass::new(device, options).unwrap().with_diagnostics();
+        let mut pass = DeferredPass::new(device, options)
+            .unwrap()
+            .with_diagnostics();
         let frame = pass
             .prepare(device, &store, &scene, &Style::default(), size)
             .unwrap();

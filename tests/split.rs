@@ -125,8 +125,9 @@ fn the_pulled_visibility_pass_reads_both_halves() {
             triangle_ids,
             ..PassOptions::default()
         };
-        let mut pass = DeferredPass::new(device, options).unwrap()
-        .with_diagnostics();
+        let mut pass = DeferredPass::new(device, options)
+            .unwrap()
+            .with_diagnostics();
         let frame = pass
             .prepare(device, &store, &scene, &Style::default(), size)
             .unwrap();

@@ -706,7 +706,11 @@ fn neighbour_word(mesh: &Mesh, stored: &[u32], t: usize, i: usize) -> u32 {
         return u32::MAX;
     }
     let tris = mesh.triangles();
-    let at = |v: u32| (mesh.positions()[v as usize] + Vec3::ZERO).to_array().map(f32::to_bits);
+    let at = |v: u32| {
+        (mesh.positions()[v as usize] + Vec3::ZERO)
+            .to_array()
+            .map(f32::to_bits)
+    };
     let (a, b) = (at(tris[t][i]), at(tris[t][(i + 1) % 3]));
     let other = tris[n as usize];
     let back = (0..3).find(|&j| {

@@ -18,9 +18,7 @@ mod visibility;
 
 pub use composite::{Composite, RenderTarget};
 pub use context::{GpuContext, OPTIONAL_FEATURES};
-pub use deferred::{
-    DeferredPass, EdgeWork, OutputTarget, PassOptions, PreparedFrame, TriangleIds,
-};
+pub use deferred::{DeferredPass, EdgeWork, OutputTarget, PassOptions, PreparedFrame, TriangleIds};
 pub use forward::{forward_source, ForwardPass};
 pub use frame::{light_world_dir, Canvas, FrameUniforms, InstanceRecord, Window, MAX_INSTANCES};
 pub use host::{depth_quantum, HostDepth};
