@@ -7,7 +7,7 @@ mod common;
 
 use common::gpu;
 use glam::{DMat4, Vec3};
-use wirepass::gpu::{DeferredPass, MeshStore, PassOptions};
+use wirepass::gpu::{DeferredPass, MeshStore, OutputTarget, PassOptions, TriangleIds};
 use wirepass::mesh::Procedural;
 use wirepass::{Camera, Color, EdgeSelection, Error, Instance, Scene, Style};
 
@@ -396,5 +396,57 @@ fn meshes_of_tiny_and_huge_extent_render_like_a_unit_one() {
             diff.mean <= 0.002 && diff.p99 <= 0.02,
             "x{scale:e}: FLIP {diff}"
         );
+    }
+}
+
+#[test]
+fn triangle_ids_without_primitive_index_pull_vertices_or_are_an_error() {
+    // A device without optional features: no PRIMITIVE_INDEX.
+    let (device, queue) = device_with(gpu().adapter.limits());
+    assert!(!device.features().contains(wgpu::Features::PRIMITIVE_INDEX));
+    let with = |triangle_ids| {
+        DeferredPass::new(
+            device,
+            PassOptions {
+                triangle_ids,
+                ..PassOptions::default()
+            },
+        )
+    };
+    match with(TriangleIds::PrimitiveIndex) {
+        Err(Error::MissingFeature { what, .. }) => assert!(what.contains("PRIMITIVE_INDEX")),
+        other => panic!("expected a missing feature, got {:?}", other.err()),
+    }
+    // Auto and VertexPulling draw with pulled vertices.
+    let mesh: wirepass::Mesh = "sphere:2000"
+        .parse::<Procedural>()
+        .unwrap()
+        .build()
+        .unwrap();
+    let mut store = MeshStore::new(device);
+    let id = store
+        .insert(device, queue, &mesh, EdgeSelection::Polygon)
+        .unwrap();
+    let scene = Scene::new(cam().to_view(1.0), vec![Instance::new(id, DMat4::IDENTITY)]);
+    for ids in [TriangleIds::Auto, TriangleIds::VertexPulling] {
+        let mut pass = with(ids).unwrap();
+        let frame = pass
+            .prepare(device, &store, &scene, &Style::default(), (64, 64))
+            .unwrap();
+        let usage = wgpu::TextureUsages::STORAGE_BINDING;
+        let output =
+            wirepass::gpu::texture_2d(device, "out", (64, 64), pass.output_format(), usage);
+        let view = output.create_view(&Default::default());
+        let mut encoder = device.create_command_encoder(&Default::default());
+        pass.encode(
+            device,
+            &mut encoder,
+            &store,
+            &frame,
+            OutputTarget::Shaded(&view),
+        )
+        .unwrap();
+        queue.submit([encoder.finish()]);
+        device.poll(wgpu::PollType::wait_indefinitely()).unwrap();
     }
 }
