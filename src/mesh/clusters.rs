@@ -15,7 +15,7 @@
 //! normal in the cone that stays more than the fold away from 90°, no triangle of the cluster
 //! has an outline edge.
 
-use super::adjacency::{fold_bound, ANY_FOLD, NO_NEIGHBOUR};
+use super::adjacency::{fold_bound, ANY_FOLD};
 use crate::par::*;
 use glam::DVec3;
 
@@ -54,8 +54,9 @@ pub struct Clusters {
 }
 
 /// Clusters the triangles; `hints` are [`super::Mesh::outline_hints`], `partners` the
-/// other triangle of each triangle's quad ([`NO_NEIGHBOUR`] for none; symmetric), which the
-/// order keeps right after it.
+/// other triangle of each triangle's quad ([`super::adjacency::NO_NEIGHBOUR`] for none),
+/// which the order keeps next to it where the two name each other
+/// ([`super::Mesh::quad_partners`]).
 pub fn clusters(
     positions: &[glam::Vec3],
     triangles: &[[u32; 3]],
@@ -70,8 +71,13 @@ pub fn clusters(
     );
     let cells = ((1u64 << MORTON_BITS) - 1) as f64;
     let scale = cells / (hi - lo).max_element().max(f64::MIN_POSITIVE);
-    // One key per quad, placed at its first triangle; its second follows it.
-    let partner = |t: u32| Some(partners[t as usize]).filter(|&u| u != NO_NEIGHBOUR);
+    // One key per quad, placed at its first triangle; its second follows it. Only pairs
+    // that name each other count, so that every triangle is placed once whatever `partners`
+    // holds.
+    let partner = |t: u32| {
+        Some(partners[t as usize])
+            .filter(|&u| u != t && partners.get(u as usize).is_some_and(|&back| back == t))
+    };
     let mut keyed: Vec<(u64, u32)> = (0..triangles.len() as u32)
         .into_par_iter()
         .filter(|&t| partner(t).is_none_or(|u| t < u))
@@ -189,6 +195,7 @@ pub fn may_fold(bounds: &ClusterBounds, eye: glam::DVec4) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mesh::adjacency::NO_NEIGHBOUR;
 
     #[test]
     fn a_quad_s_triangles_are_stored_side_by_side() {
@@ -211,5 +218,24 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn partners_that_do_not_name_each_other_leave_the_order_a_permutation() {
+        let mesh = crate::mesh::grid(200).unwrap();
+        let n = mesh.triangle_count() as u32;
+        // Each triangle names the next: no two name each other, and the last names none.
+        let partners: Vec<u32> = (0..n)
+            .map(|t| if t + 1 < n { t + 1 } else { NO_NEIGHBOUR })
+            .collect();
+        let c = clusters(
+            mesh.positions(),
+            mesh.triangles(),
+            mesh.outline_hints(),
+            &partners,
+        );
+        let mut order = c.order.clone();
+        order.sort_unstable();
+        assert_eq!(order, (0..n).collect::<Vec<_>>());
     }
 }
