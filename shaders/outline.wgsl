@@ -188,7 +188,7 @@ fn outline_triangle(inst: u32, t: u32) {
             continue;
         }
         let word = neighbour_word(base + t, i);
-        let n = select(word & NEIGHBOUR_INDEX, BACKGROUND_ID, word == BACKGROUND_ID);
+        let n = neighbour_of(word);
         let a = p[i];
         let b = p[(i + 1u) % 3u];
         var outline = (splat & (1u << i)) != 0u || ((allowed & (1u << i)) != 0u && n == BACKGROUND_ID);

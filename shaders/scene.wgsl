@@ -134,11 +134,15 @@ const NEIGHBOUR_INDEX: u32 = 0x1fffffffu;
 const NEIGHBOUR_CORNER_SHIFT: u32 = 29u;
 const NEIGHBOUR_SAME_WAY: u32 = 0x80000000u;
 
+// The triangle a neighbour word names (relative to its mesh), or BACKGROUND_ID.
+fn neighbour_of(word: u32) -> u32 {
+    return select(word & NEIGHBOUR_INDEX, BACKGROUND_ID, word == BACKGROUND_ID);
+}
+
 // The triangle across edge i of the store's triangle t (relative to its mesh), or
 // BACKGROUND_ID.
 fn neighbour(t: u32, i: u32) -> u32 {
-    let word = neighbour_word(t, i);
-    return select(word & NEIGHBOUR_INDEX, BACKGROUND_ID, word == BACKGROUND_ID);
+    return neighbour_of(neighbour_word(t, i));
 }
 
 // The triangle across an edge a -> b of another one, from the edge's neighbour word and the
