@@ -5,7 +5,7 @@ mod common;
 
 use common::{camera, cpu_distance, framing, gpu, load, shoot};
 use glam::{DMat4, Vec3};
-use wirepass::gpu::{DeferredPass, MeshStore, OutputTarget, PassOptions, TriangleIds};
+use wirepass::gpu::{DeferredPass, MeshStore, OutputTarget, PassOptions};
 use wirepass::render::{Frame, Method, BACKGROUND};
 use wirepass::{Camera, EdgeSelection, Instance, Mesh, Scene, Style};
 
@@ -417,18 +417,7 @@ fn vertex_pulling_fallback_matches_primitive_index() {
     );
     scene.instances.to_mut().push(copy);
     let read = |pulled: bool| {
-        let triangle_ids = if pulled {
-            TriangleIds::VertexPulling
-        } else {
-            TriangleIds::PrimitiveIndex
-        };
-        let options = PassOptions {
-            triangle_ids,
-            ..PassOptions::default()
-        };
-        let mut pass = DeferredPass::new(device, options)
-            .unwrap()
-            .with_diagnostics();
+        let mut pass = common::diagnostic_pass(device, pulled);
         let frame = pass
             .prepare(device, &store, &scene, &Style::default(), size)
             .unwrap();

@@ -8,7 +8,7 @@ use common::gpu;
 use glam::{DMat4, DVec3, Vec3};
 use std::sync::{Arc, Mutex, MutexGuard};
 use wirepass::cli::CameraArgs;
-use wirepass::gpu::{DeferredPass, GpuContext, MeshStore, OutputTarget, PassOptions, TriangleIds};
+use wirepass::gpu::{DeferredPass, GpuContext, MeshStore, OutputTarget, PassOptions};
 use wirepass::mesh::Procedural;
 use wirepass::render::{render, Method, Object, Shot, Uploaded, World, WorldMesh, BACKGROUND};
 use wirepass::{Color, EdgeSelection, Error, Instance, InstanceStyle, Scene, Style};
@@ -116,18 +116,7 @@ fn the_pulled_visibility_pass_reads_both_halves() {
     let size = (128, 96);
     let (store, scene) = stored(&small, &mesh, size);
     let ids = |pulled: bool| {
-        let triangle_ids = if pulled {
-            TriangleIds::VertexPulling
-        } else {
-            TriangleIds::PrimitiveIndex
-        };
-        let options = PassOptions {
-            triangle_ids,
-            ..PassOptions::default()
-        };
-        let mut pass = DeferredPass::new(device, options)
-            .unwrap()
-            .with_diagnostics();
+        let mut pass = common::diagnostic_pass(device, pulled);
         let frame = pass
             .prepare(device, &store, &scene, &Style::default(), size)
             .unwrap();

@@ -6,7 +6,7 @@ pub mod gltf_file;
 use glam::{DVec2, Vec3};
 use std::path::PathBuf;
 use std::sync::OnceLock;
-use wirepass::gpu::GpuContext;
+use wirepass::gpu::{DeferredPass, GpuContext, PassOptions, TriangleIds};
 use wirepass::render::{render, Frame, Method, Shot, World};
 use wirepass::{edge_math, Camera, EdgeSelection, Mesh, Style};
 
@@ -169,4 +169,21 @@ pub fn worst_pixels(truth: &Frame, frame: &Frame, bound: f64, n: usize) -> Strin
             )
         })
         .collect()
+}
+
+/// A deferred pass with diagnostics on `device`, its visibility pass taking triangle ids
+/// from pulled vertices (`pulled`) or from the primitive index.
+pub fn diagnostic_pass(device: &wgpu::Device, pulled: bool) -> DeferredPass {
+    let triangle_ids = if pulled {
+        TriangleIds::VertexPulling
+    } else {
+        TriangleIds::PrimitiveIndex
+    };
+    let options = PassOptions {
+        triangle_ids,
+        ..PassOptions::default()
+    };
+    DeferredPass::new(device, options)
+        .unwrap()
+        .with_diagnostics()
 }
