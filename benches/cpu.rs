@@ -12,8 +12,8 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Duration;
 use wirepass::mesh::{adjacency, load, load_obj};
-use wirepass::raycast::{render_raycast, RayCaster};
-use wirepass::render::{Shot, World};
+use wirepass::truth::raycast::{render_raycast, RayCaster};
+use wirepass::world::{Shot, World};
 use wirepass::{Camera, EdgeSelection, Style};
 
 #[path = "../tests/common/gltf_file.rs"]

@@ -75,26 +75,17 @@ pub mod edge_math;
 pub mod error;
 pub mod gpu;
 pub mod mesh;
-mod par;
 pub mod scene;
 pub mod style;
 
-#[cfg(feature = "tools")]
-pub mod bench;
-#[cfg(feature = "cli")]
-pub mod cli;
-#[cfg(feature = "tools")]
-pub mod compare;
-#[cfg(feature = "tools")]
-pub mod outline;
-#[cfg(feature = "tools")]
-pub mod raycast;
-#[cfg(feature = "regression")]
-pub mod regression;
-#[cfg(feature = "tools")]
-pub mod render;
-#[cfg(feature = "tools")]
-pub mod scene_file;
+#[cfg(feature = "truth")]
+pub mod world;
+
+#[cfg(feature = "truth")]
+pub mod truth;
+
+#[cfg(any(feature = "tools", feature = "regression"))]
+pub mod tools;
 
 pub use camera::{Camera, DepthRange, View};
 pub use error::{Error, Result};

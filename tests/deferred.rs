@@ -6,13 +6,14 @@ mod common;
 use common::{camera, cpu_distance, framing, gpu, load, shoot};
 use glam::{DMat4, Vec3};
 use wirepass::gpu::{DeferredPass, MeshStore, OutputTarget, PassOptions};
-use wirepass::render::{Frame, Method, BACKGROUND};
+use wirepass::tools::offline::Method;
+use wirepass::world::{Rendering, BACKGROUND};
 use wirepass::{Camera, EdgeSelection, Instance, Mesh, Scene, Style};
 
 /// Draws without outlines: the tests here check each triangle's own edges against the CPU
 /// definition; outlines are checked against the ground truth (tests/ground_truth.rs,
 /// tests/outline.rs).
-fn draw(mesh: &Mesh, camera: Camera, size: (u32, u32), edges: EdgeSelection) -> Frame {
+fn draw(mesh: &Mesh, camera: Camera, size: (u32, u32), edges: EdgeSelection) -> Rendering {
     let style = Style {
         silhouettes: false,
         ..Style::default()
@@ -26,7 +27,7 @@ fn draw_styled(
     size: (u32, u32),
     edges: EdgeSelection,
     style: Style,
-) -> Frame {
+) -> Rendering {
     shoot(mesh, camera, &style, size, edges, Method::Deferred)
 }
 
@@ -36,7 +37,7 @@ fn draw_styled(
 fn max_distance_error(
     mesh: &Mesh,
     cam: &Camera,
-    frame: &Frame,
+    frame: &Rendering,
     edges: EdgeSelection,
     reach: f64,
 ) -> (f64, usize) {
@@ -185,7 +186,7 @@ fn vertices_behind_the_eye_keep_exact_edges() {
 fn seen_crossing(
     mesh: &Mesh,
     cam: &Camera,
-    frame: &Frame,
+    frame: &Rendering,
     test: impl Fn(glam::DVec4) -> bool,
 ) -> usize {
     let vp = cam.view_projection(frame.size.0, frame.size.1);

@@ -7,7 +7,8 @@ mod common;
 
 use common::{camera, shoot};
 use glam::Vec3;
-use wirepass::render::{Frame, Method};
+use wirepass::tools::offline::Method;
+use wirepass::world::Rendering;
 use wirepass::{Camera, EdgeSelection, Mesh, Style};
 
 const SIZE: (u32, u32) = (64, 48);
@@ -16,12 +17,12 @@ fn looking_down_z() -> Camera {
     camera(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, 0.1, 20.0)
 }
 
-fn draw(mesh: &Mesh, cam: Camera, edges: EdgeSelection) -> Frame {
+fn draw(mesh: &Mesh, cam: Camera, edges: EdgeSelection) -> Rendering {
     shoot(mesh, cam, &Style::default(), SIZE, edges, Method::Deferred)
 }
 
 /// Checks the frame's maps; returns how many pixels show a triangle.
-fn check(name: &str, mesh: &Mesh, frame: &Frame) -> usize {
+fn check(name: &str, mesh: &Mesh, frame: &Rendering) -> usize {
     let n = (SIZE.0 * SIZE.1) as usize;
     assert_eq!(frame.ids.len(), n, "{name}");
     let mut covered = 0;

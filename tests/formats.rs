@@ -531,7 +531,7 @@ fn polygons_of_a_million_corners_load() {
 /// order, welded the same way, so the same smooth normals.
 #[test]
 fn stl_and_obj_twins_render_identically() {
-    use wirepass::render::Method;
+    use wirepass::tools::offline::Method;
     let torus = torus();
     // The OBJ has one vertex per distinct position and no normals, like the welded STL.
     let mut obj = String::new();

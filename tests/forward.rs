@@ -13,7 +13,8 @@ use std::collections::BTreeSet;
 use std::path::PathBuf;
 use std::sync::OnceLock;
 use wirepass::gpu::{drawn_edges, GpuContext};
-use wirepass::render::{render, Frame, Method, Shot, World};
+use wirepass::tools::offline::{render, Method};
+use wirepass::world::{Rendering, Shot, World};
 use wirepass::{Camera, Color, EdgeSelection, Mesh, Style};
 
 const BACKGROUND: u32 = u32::MAX;
@@ -52,7 +53,7 @@ fn per_triangle() -> Style {
 
 /// Every triangle edge drawn: then both methods draw the same lines, each pixel's own
 /// triangle's (in the masked modes the deferred method's lines also cross undrawn edges).
-fn draw(mesh: &Mesh, camera: Camera, size: (u32, u32), style: &Style, method: Method) -> Frame {
+fn draw(mesh: &Mesh, camera: Camera, size: (u32, u32), style: &Style, method: Method) -> Rendering {
     draw_edges(mesh, camera, size, style, EdgeSelection::All, method)
 }
 
@@ -63,7 +64,7 @@ fn draw_edges(
     style: &Style,
     edges: EdgeSelection,
     method: Method,
-) -> Frame {
+) -> Rendering {
     let world = World::single(mesh.clone(), edges);
     let shot = Shot {
         world: &world,
@@ -89,7 +90,7 @@ struct Agreement {
     max_byte: u8,
 }
 
-fn agreement(deferred: &Frame, forward: &Frame) -> Agreement {
+fn agreement(deferred: &Rendering, forward: &Rendering) -> Agreement {
     let n = deferred.ids.len();
     let mut same = 0;
     let mut worst: f64 = 0.0;
@@ -217,7 +218,7 @@ struct Damage {
     wrong: usize,
 }
 
-fn damage(deferred: &Frame, forward: &Frame) -> Damage {
+fn damage(deferred: &Rendering, forward: &Rendering) -> Damage {
     let mut d = Damage {
         compared: 0,
         nan: 0,

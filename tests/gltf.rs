@@ -16,9 +16,10 @@ use glam::{DMat4, DQuat, DVec3, Vec3};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 use std::process::Command;
-use wirepass::compare::metrics;
-use wirepass::mesh::gltf::{load_gltf, Document, GltfProjection};
-use wirepass::render::{Frame, Method, World, BACKGROUND};
+use wirepass::mesh::formats::gltf::{load_gltf, Document, GltfProjection};
+use wirepass::tools::compare::metrics;
+use wirepass::tools::offline::Method;
+use wirepass::world::{Rendering, World, BACKGROUND};
 use wirepass::{Camera, EdgeSelection, Mesh, Style, View};
 
 const SIZE: (u32, u32) = (320, 240);
@@ -72,7 +73,7 @@ fn aspect() -> f64 {
 /// Renders `world` with the ray-cast ground truth and the deferred pass and checks the
 /// deferred one within the bounds of tests/ground_truth.rs: id agreement ≥ 0.999, distance
 /// error p99 ≤ 0.01 px and max ≤ 0.1 px. Returns both frames.
-fn against_truth(label: &str, world: &World, view: View, style: &Style) -> (Frame, Frame) {
+fn against_truth(label: &str, world: &World, view: View, style: &Style) -> (Rendering, Rendering) {
     let truth = shoot_world(world, view, style, SIZE, Method::Raycast);
     let frame = shoot_world(world, view, style, SIZE, Method::Deferred);
     let m = metrics(&truth, &frame).unwrap_or_else(|e| panic!("{e}"));
@@ -101,7 +102,7 @@ fn pixel(view: &View, p: DVec3) -> (usize, usize) {
     (px as usize, py as usize)
 }
 
-fn distance_at(frame: &Frame, (x, y): (usize, usize)) -> f32 {
+fn distance_at(frame: &Rendering, (x, y): (usize, usize)) -> f32 {
     frame.edge_distance[y * frame.size.0 as usize + x]
 }
 
@@ -430,7 +431,7 @@ fn node_hierarchy_instances_meshes_against_the_ground_truth() {
         meshes: world
             .meshes
             .iter()
-            .map(|m| wirepass::render::WorldMesh {
+            .map(|m| wirepass::world::WorldMesh {
                 edges: EdgeSelection::Feature(30.0),
                 ..m.clone()
             })
@@ -539,7 +540,20 @@ fn cameras_give_the_views_the_specification_defines() {
 
 /// Runs `wirepass render FILE --size 64x48 ARGS`, with `--dump DIR` if given.
 fn cli(file: &Path, args: &[&str], dump: Option<&Path>) -> (bool, String) {
-    let mut cmd = Command::new(env!("CARGO_BIN_EXE_wirepass"));
+    // The command is the workspace's `wirepass-cli` package; `cargo test` at the root builds
+    // it beside this test's own binary.
+    let exe = std::env::current_exe().unwrap();
+    let bin = exe
+        .parent()
+        .and_then(Path::parent)
+        .unwrap()
+        .join(format!("wirepass{}", std::env::consts::EXE_SUFFIX));
+    assert!(
+        bin.exists(),
+        "{} is missing: run the tests from the workspace root (cargo test), which builds it",
+        bin.display()
+    );
+    let mut cmd = Command::new(bin);
     cmd.arg("render")
         .arg(file)
         .args(["--size", "64x48", "-o"])
@@ -917,17 +931,17 @@ fn repeated_codes_line_strings_and_line_style() {
     let world = World::from_gltf(doc, None);
     assert_eq!(world.objects[0].style.line_width, Some(4.0));
 
-    let options = wirepass::cli::WorldOptions {
+    let options = wirepass::tools::load::WorldOptions {
         line_width: Some(2.0),
         ..Default::default()
     };
-    let loaded = wirepass::cli::load_world(path.to_str(), &options).unwrap();
+    let loaded = wirepass::tools::load::load_world(path.to_str(), &options).unwrap();
     assert_eq!(
         loaded.world.objects[0].style.line_width, None,
         "the command line's width"
     );
     assert_eq!(loaded.world.meshes[0].edges, EdgeSelection::Authored);
-    let loaded = wirepass::cli::load_world(path.to_str(), &Default::default()).unwrap();
+    let loaded = wirepass::tools::load::load_world(path.to_str(), &Default::default()).unwrap();
     assert_eq!(loaded.world.objects[0].style.line_width, Some(4.0));
 }
 
@@ -951,7 +965,7 @@ fn scene_files_take_gltf_meshes_with_their_edges() {
             {"mesh": "scene-cube.glb", "edges": "all", "transform": {"translate": [3, 0, 0]}}
         ]}"#,
     );
-    let loaded = wirepass::cli::load_world(scene.to_str(), &Default::default()).unwrap();
+    let loaded = wirepass::tools::load::load_world(scene.to_str(), &Default::default()).unwrap();
     let meshes = &loaded.world.meshes;
     assert_eq!(meshes.len(), 2);
     assert_eq!(meshes[0].edges, EdgeSelection::Authored);

@@ -14,9 +14,10 @@ mod common;
 
 use common::{framing, gpu, load, shoot};
 use glam::{DVec3, Vec3};
-use wirepass::compare::{distance_errors, metrics, Metrics};
-use wirepass::raycast::RayCaster;
-use wirepass::render::{Frame, Method, Shot, World};
+use wirepass::tools::compare::{distance_errors, metrics, Metrics};
+use wirepass::tools::offline::Method;
+use wirepass::truth::raycast::RayCaster;
+use wirepass::world::{Rendering, Shot, World};
 use wirepass::{Camera, EdgeSelection, Mesh, Style};
 
 const SIZE: (u32, u32) = (320, 240);
@@ -171,7 +172,7 @@ fn measure(
 }
 
 /// The pixels with the largest distance errors, for the failure message.
-pub fn worst_pixels(truth: &Frame, frame: &Frame) -> String {
+pub fn worst_pixels(truth: &Rendering, frame: &Rendering) -> String {
     let errors = distance_errors(truth, frame).unwrap_or_else(|e| panic!("{e}"));
     let mut worst: Vec<(usize, f64)> = errors
         .iter()
@@ -283,7 +284,8 @@ fn compare_writes_images_and_report() {
     };
     let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("compare_suzanne");
     let _ = std::fs::remove_dir_all(&out);
-    let report = wirepass::compare::run(gpu(), &shot, &out).unwrap_or_else(|e| panic!("{e}"));
+    let report =
+        wirepass::tools::compare::run(gpu(), &shot, &out).unwrap_or_else(|e| panic!("{e}"));
     let text = std::fs::read_to_string(out.join("report.json")).unwrap();
     let json: serde_json::Value = serde_json::from_str(&text).unwrap();
     assert_eq!(json["size"], serde_json::json!([96, 72]));
@@ -320,5 +322,5 @@ fn compare_writes_images_and_report() {
     for file in ["raycast.png", "sheet.png"] {
         assert!(out.join(file).is_file(), "{file} not written");
     }
-    assert!(wirepass::compare::table(&report).contains("deferred"));
+    assert!(wirepass::tools::compare::table(&report).contains("deferred"));
 }

@@ -14,17 +14,16 @@ mod host;
 
 use host::{HostFormats, HostRenderer, HostScene, HostTargets};
 use std::sync::{Arc, OnceLock};
-use wirepass::compare::metrics;
 use wirepass::gpu::{
     read_texture, texture_2d, Canvas, Composite, DeferredPass, GpuContext, HostDepth, MeshStore,
     OutputTarget, PassOptions, PreparedFrame, RenderTarget,
 };
-use wirepass::raycast::{render_raycast_over, HostOccluders};
-use wirepass::regression::{difference, Rgba, Threshold};
-use wirepass::render::{
-    render_deferred_on, Frame, Object, Shot, Uploaded, World, WorldMesh, BACKGROUND, HOST,
-};
 use wirepass::style::line_reach;
+use wirepass::tools::compare::metrics;
+use wirepass::tools::offline::{render_deferred_on, Uploaded};
+use wirepass::tools::regression::{difference, Rgba, Threshold};
+use wirepass::truth::raycast::{render_raycast_over, HostOccluders};
+use wirepass::world::{Object, Rendering, Shot, World, WorldMesh, BACKGROUND, HOST};
 use wirepass::{wgpu, DepthRange, EdgeSelection, Error, Instance, InstanceStyle, Scene, Style};
 
 const SIZE: (u32, u32) = (320, 240);
@@ -238,7 +237,7 @@ fn host_case(
     // Outlines over farther host surfaces have their full width: as many host pixels lie
     // within half a line width of an outline in the frame as in the truth.
     let half = 0.5 * f64::from(style.line_width);
-    let within = |fr: &Frame| {
+    let within = |fr: &Rendering| {
         (0..fr.ids.len())
             .filter(|&i| fr.ids[i] == HOST && f64::from(fr.edge_distance[i]) < half)
             .count()

@@ -314,8 +314,8 @@ fn a_mesh_too_wide_for_f32_is_reported_as_such() {
     )
     .unwrap();
     for args in [
-        wirepass::cli::CameraArgs::default(),
-        wirepass::cli::CameraArgs {
+        wirepass::tools::load::CameraPlacement::default(),
+        wirepass::tools::load::CameraPlacement {
             eye: Some(Vec3::new(0.0, 0.0, 1e3)),
             ..Default::default()
         },
@@ -331,7 +331,7 @@ fn a_far_explicit_eye_gets_finite_planes() {
     // The distance to the mesh used to be an f32 length whose squares overflowed, giving
     // "invalid camera: near inf must be > 0" for --eye 1e30,1e30,1e30.
     let mesh = Procedural::Sphere(200).build().unwrap();
-    let args = wirepass::cli::CameraArgs {
+    let args = wirepass::tools::load::CameraPlacement {
         eye: Some(Vec3::splat(1e30)),
         ..Default::default()
     };
@@ -359,13 +359,13 @@ fn meshes_of_tiny_and_huge_extent_render_like_a_unit_one() {
             size,
             EdgeSelection::Polygon,
         );
-        scene.draw(wirepass::render::Method::Deferred)
+        scene.draw(wirepass::tools::offline::Method::Deferred)
     };
     let reference = draw(&at_scale(1.0));
     let covered = reference
         .ids
         .iter()
-        .filter(|&&id| id != wirepass::render::BACKGROUND)
+        .filter(|&&id| id != wirepass::world::BACKGROUND)
         .count();
     assert!(
         covered > 2000,
@@ -385,9 +385,9 @@ fn meshes_of_tiny_and_huge_extent_render_like_a_unit_one() {
             .filter(|(a, b)| a == b)
             .count();
         let agreement = same_ids as f64 / reference.ids.len() as f64;
-        let diff = wirepass::regression::difference(
-            wirepass::regression::Rgba::new(&reference.rgba, size).unwrap(),
-            wirepass::regression::Rgba::new(&frame.rgba, size).unwrap(),
+        let diff = wirepass::tools::regression::difference(
+            wirepass::tools::regression::Rgba::new(&reference.rgba, size).unwrap(),
+            wirepass::tools::regression::Rgba::new(&frame.rgba, size).unwrap(),
         )
         .unwrap();
         println!("extent x{scale:e}: id agreement {agreement:.5}, FLIP {diff}");

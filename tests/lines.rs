@@ -12,9 +12,10 @@ mod common;
 
 use common::{cpu_distance, framing, load, shoot};
 use glam::{DVec3, Vec3};
-use wirepass::compare::metrics;
 use wirepass::gpu::{DeferredPass, PassOptions, Window};
-use wirepass::render::{render_deferred_on, Frame, Method, Shot, Uploaded, World};
+use wirepass::tools::compare::metrics;
+use wirepass::tools::offline::{render_deferred_on, Method, Uploaded};
+use wirepass::world::{Rendering, Shot, World};
 use wirepass::{style, Camera, EdgeSelection, Mesh, Style};
 
 const MIN_ID_AGREEMENT: f64 = 0.999;
@@ -30,7 +31,7 @@ fn check(
     size: (u32, u32),
     edges: EdgeSelection,
     line_width: f32,
-) -> (Frame, Frame) {
+) -> (Rendering, Rendering) {
     let style = Style {
         line_width,
         ..Style::default()
@@ -59,7 +60,7 @@ fn check(
 fn lines_across_undrawn_edges(
     mesh: &Mesh,
     camera: &Camera,
-    truth: &Frame,
+    truth: &Rendering,
     edges: EdgeSelection,
     line_width: f32,
 ) -> usize {
@@ -369,7 +370,7 @@ fn quads_of_a_dense_sphere_are_drawn_whole() {
 }
 
 /// The deferred frame of `window` of `shot`'s image.
-fn render_window(shot: &Shot<'_>, up: &Uploaded, window: Window) -> Frame {
+fn render_window(shot: &Shot<'_>, up: &Uploaded, window: Window) -> Rendering {
     let ctx = common::gpu();
     let pass = DeferredPass::new(&ctx.device, PassOptions::default())
         .unwrap_or_else(|e| panic!("{e}"))

@@ -5,9 +5,10 @@
 mod common;
 
 use common::{framing, load, TestScene};
-use wirepass::compare::metrics;
-use wirepass::render::{Frame, Method};
 use wirepass::style::{line_intensity, DepthFade};
+use wirepass::tools::compare::metrics;
+use wirepass::tools::offline::Method;
+use wirepass::world::Rendering;
 use wirepass::{EdgeSelection, Mesh, Style};
 
 const SIZE: (u32, u32) = (256, 256);
@@ -22,7 +23,7 @@ fn scene(mesh: &Mesh, style: Style) -> TestScene {
     )
 }
 
-fn draw(scene: &TestScene, method: Method) -> Frame {
+fn draw(scene: &TestScene, method: Method) -> Rendering {
     scene.draw(method)
 }
 
@@ -57,7 +58,7 @@ fn outlines_reach_over_the_background_in_deferred_only() {
         assert!(forward.edge_distance[i].is_infinite() || forward.ids[i] != u32::MAX);
     }
     // The whole outline's width: pixels with full line colour, counted on each side.
-    let dark = |f: &Frame| {
+    let dark = |f: &Rendering| {
         (0..f.ids.len())
             .filter(|&i| line_intensity(f64::from(f.edge_distance[i]), 3.0) > 0.99)
             .count()
@@ -119,7 +120,7 @@ fn lines_fade_with_depth_in_every_method() {
     // View depth per covered pixel, from the 0..1 depth of `perspective_rh`.
     let cam = framing(&mesh, SIZE);
     let (n, f) = (f64::from(cam.near), f64::from(cam.far));
-    let view_depth = |frame: &Frame, i: usize| {
+    let view_depth = |frame: &Rendering, i: usize| {
         let z = f64::from(frame.depth[i]);
         n * f / (f - z * (f - n))
     };

@@ -12,8 +12,9 @@ mod common;
 use common::{gpu, load};
 use glam::Vec3;
 use std::path::PathBuf;
-use wirepass::regression::{check_against_reference, Outcome, Threshold};
-use wirepass::render::{render, Method, Shot, World};
+use wirepass::tools::offline::{render, Method};
+use wirepass::tools::regression::{check_against_reference, Outcome, Threshold};
+use wirepass::world::{Shot, World};
 use wirepass::{Camera, EdgeSelection, Mesh, Style};
 
 const SIZE: (u32, u32) = (256, 256);

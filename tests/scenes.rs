@@ -12,8 +12,9 @@ mod common;
 use common::{load, shoot_world};
 use glam::{DMat4, DQuat, DVec3};
 use std::sync::Arc;
-use wirepass::compare::{metrics, Metrics};
-use wirepass::render::{Frame, Method, Object, World, WorldMesh, BACKGROUND};
+use wirepass::tools::compare::{metrics, Metrics};
+use wirepass::tools::offline::Method;
+use wirepass::world::{Object, Rendering, World, WorldMesh, BACKGROUND};
 use wirepass::{Camera, DepthRange, EdgeSelection, InstanceStyle, Mesh, Style, View};
 
 const SIZE: (u32, u32) = (320, 240);
@@ -41,7 +42,7 @@ fn world(meshes: Vec<(Mesh, EdgeSelection)>, objects: Vec<(usize, DMat4)>) -> Wo
 }
 
 /// The deferred frame and its metrics against the ground truth; panics past the bounds.
-fn check(name: &str, world: &World, view: View, style: &Style) -> (Frame, Metrics) {
+fn check(name: &str, world: &World, view: View, style: &Style) -> (Rendering, Metrics) {
     let truth = shoot_world(world, view, style, SIZE, Method::Raycast);
     let frame = shoot_world(world, view, style, SIZE, Method::Deferred);
     let m = metrics(&truth, &frame).unwrap_or_else(|e| panic!("{e}"));
@@ -324,12 +325,12 @@ fn a_scene_file_with_an_orthographic_camera_matches_the_ground_truth() {
         ),
     )
     .unwrap();
-    let options = wirepass::cli::WorldOptions {
+    let options = wirepass::tools::load::WorldOptions {
         edges: Some(EdgeSelection::Polygon),
         ..Default::default()
     };
-    let wirepass::cli::Loaded { world, camera, .. } =
-        wirepass::cli::load_world(Some(scene.to_str().unwrap()), &options).unwrap();
+    let wirepass::tools::load::Loaded { world, camera, .. } =
+        wirepass::tools::load::load_world(Some(scene.to_str().unwrap()), &options).unwrap();
     assert_eq!(world.objects.len(), 3);
     assert_eq!(
         world.meshes.len(),

@@ -7,10 +7,11 @@ mod common;
 use common::gpu;
 use glam::{DMat4, DVec3, Vec3};
 use std::sync::{Arc, Mutex, MutexGuard};
-use wirepass::cli::CameraArgs;
 use wirepass::gpu::{DeferredPass, GpuContext, MeshStore, OutputTarget, PassOptions};
 use wirepass::mesh::Procedural;
-use wirepass::render::{render, Method, Object, Shot, Uploaded, World, WorldMesh, BACKGROUND};
+use wirepass::tools::load::CameraPlacement;
+use wirepass::tools::offline::{render, Method, Uploaded};
+use wirepass::world::{Object, Shot, World, WorldMesh, BACKGROUND};
 use wirepass::{Color, EdgeSelection, Error, Instance, InstanceStyle, Scene, Style};
 
 /// 64 KiB: 5440 triangles of indices in the first binding (a multiple of 64 triangles, so
@@ -43,9 +44,9 @@ fn a_mesh_split_over_two_bindings_renders_as_if_whole() {
     assert!(mesh.positions().len() as u32 * 12 <= SMALL);
     let size = (128, 96);
     // From below, where the triangles past the split lie.
-    let below = CameraArgs {
+    let below = CameraPlacement {
         eye: Some(Vec3::new(0.6, -2.5, 1.2)),
-        ..CameraArgs::default()
+        ..CameraPlacement::default()
     };
     let camera = below.camera(mesh.bounds_f64(), size).unwrap();
     // The mesh's triangles are stored in cluster order: where each file triangle is stored.
@@ -98,7 +99,7 @@ fn stored(
     let id = store
         .insert(&ctx.device, &ctx.queue, mesh, EdgeSelection::All)
         .unwrap();
-    let camera = CameraArgs::default()
+    let camera = CameraPlacement::default()
         .camera(mesh.bounds_f64(), size)
         .unwrap();
     let view = camera.to_view(f64::from(size.0) / f64::from(size.1));
@@ -212,7 +213,9 @@ fn outline_pieces_past_the_list_s_room_are_drawn_where_they_are_found() {
         }],
         objects: vec![object(-1.05, "#c03020"), object(1.05, "#2030c0")],
     };
-    let camera = CameraArgs::default().camera(world.bounds(), size).unwrap();
+    let camera = CameraPlacement::default()
+        .camera(world.bounds(), size)
+        .unwrap();
     let style = Style::default();
     let shot = Shot {
         world: &world,

@@ -16,7 +16,7 @@ pub struct GpuContext {
 }
 
 /// Features wirepass uses where the adapter has them; none is required.
-pub const OPTIONAL_FEATURES: wgpu::Features = wgpu::Features::PRIMITIVE_INDEX
+pub(crate) const OPTIONAL_FEATURES: wgpu::Features = wgpu::Features::PRIMITIVE_INDEX
     .union(wgpu::Features::TIMESTAMP_QUERY)
     .union(wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS)
     .union(wgpu::Features::POLYGON_MODE_LINE);

@@ -4,10 +4,9 @@
 use super::bindings::{self, store_resources, Compute, Res, Sources};
 use super::composite::{Composite, CompositePipeline, RenderTarget};
 use super::frame::{Canvas, FrameData};
-use super::host::{HostFrame, HostImport};
+use super::host_depth::{HostFrame, HostImport};
 use super::mesh_store::MeshStore;
-use super::raster;
-use super::targets::{TargetSpec, Targets, LIST_HEADER, RESULT_FORMAT};
+use super::targets::{self, TargetSpec, Targets, LIST_HEADER, RESULT_FORMAT};
 use super::visibility::Visibility;
 use super::{shaders, GpuTimer};
 use crate::error::{Error, Result};
@@ -1022,7 +1021,7 @@ fn clear_output(
 ) {
     encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: Some("wirepass edge clear"),
-        color_attachments: &[raster::cleared(view, color)],
+        color_attachments: &[targets::cleared(view, color)],
         depth_stencil_attachment: None,
         timestamp_writes: timer.and_then(|t| t.render_span("edge.clear")),
         occlusion_query_set: None,
@@ -1058,7 +1057,7 @@ fn dispatch(
 /// background already is a half, see `prepare`).
 fn background_value(format: wgpu::TextureFormat, background: [f32; 4]) -> wgpu::Color {
     let [r, g, b, a] = background;
-    let c = raster::clear_color(format, [r, g, b, a.max(0.0)]);
+    let c = targets::clear_color(format, [r, g, b, a.max(0.0)]);
     if format != wgpu::TextureFormat::Rgba8Unorm {
         return c;
     }

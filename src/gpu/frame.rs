@@ -8,13 +8,13 @@ use crate::camera::View;
 use crate::error::{Error, Result};
 use crate::scene::Scene;
 use crate::style::Style;
-use glam::{DMat3, DMat4, DVec3, DVec4, Mat4, Vec4};
+use glam::{DMat3, DMat4, DVec3, DVec4};
 use wgpu::util::DeviceExt;
 
 /// Mirror of WGSL `struct Frame`; field order and padding match it.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct FrameUniforms {
+pub(crate) struct FrameUniforms {
     image_size: [f32; 2],
     target_origin: [f32; 2],
     target_size: [f32; 2],
@@ -37,7 +37,7 @@ pub struct FrameUniforms {
 /// Mirror of WGSL `struct Instance`; field order and padding match it.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct InstanceRecord {
+pub(crate) struct InstanceRecord {
     clip: [[f32; 4]; 4],
     depth_row: [f32; 4],
     eye: [f32; 4],
@@ -86,15 +86,11 @@ impl FrameUniforms {
     }
 }
 
+#[cfg(test)]
 impl InstanceRecord {
     /// The f32 mesh-local → clip matrix the GPU uses (rows x, y, near, w).
-    pub fn clip(&self) -> Mat4 {
-        Mat4::from_cols_array_2d(&self.clip)
-    }
-
-    /// The reverse depth row.
-    pub fn depth_row(&self) -> Vec4 {
-        Vec4::from_array(self.depth_row)
+    pub fn clip(&self) -> glam::Mat4 {
+        glam::Mat4::from_cols_array_2d(&self.clip)
     }
 }
 

@@ -871,7 +871,7 @@ pub(crate) fn cluster_records(bounds: &[[f32; 8]], info: &[u32]) -> Vec<[f32; 8]
 
 /// A unit normal packed octahedrally into two 16-bit snorms (`unpack_normal` in
 /// common.wgsl is the inverse); a zero normal packs to `NO_NORMAL`.
-pub fn pack_normal(n: Vec3) -> u32 {
+pub(crate) fn pack_normal(n: Vec3) -> u32 {
     let sum = n.x.abs() + n.y.abs() + n.z.abs();
     if !(sum > 0.0) {
         return NO_NORMAL;
@@ -887,7 +887,8 @@ pub fn pack_normal(n: Vec3) -> u32 {
 
 /// Twin of `unpack_normal` in common.wgsl: the unit normal of a packed one (zero for
 /// `NO_NORMAL`).
-pub fn unpack_normal(packed: u32) -> Vec3 {
+#[cfg(test)]
+pub(crate) fn unpack_normal(packed: u32) -> Vec3 {
     if packed == NO_NORMAL {
         return Vec3::ZERO;
     }

@@ -1,35 +1,33 @@
 //! GPU side: device creation, the mesh store, the per-frame scene data and the passes.
 
+pub mod baselines;
 mod bindings;
 mod composite;
 mod context;
 mod deferred;
-mod forward;
 mod frame;
-mod host;
+mod host_depth;
 mod mesh_store;
-mod raster;
 mod readback;
 pub mod shaders;
 mod targets;
 mod timing;
-mod two_pass;
 mod visibility;
 
+pub use baselines::{
+    drawn_edges, EdgeLines, ForwardPass, RasterFrame, TwoPass, MAPS_DIAGNOSTIC_FORMAT,
+};
 pub use composite::{Composite, RenderTarget};
-pub use context::{GpuContext, OPTIONAL_FEATURES};
+pub use context::GpuContext;
 pub use deferred::{DeferredPass, EdgeWork, OutputTarget, PassOptions, PreparedFrame, TriangleIds};
-pub use forward::{forward_source, ForwardPass};
-pub use frame::{light_world_dir, Canvas, FrameUniforms, InstanceRecord, Window, MAX_INSTANCES};
-pub use host::{depth_quantum, HostDepth};
-pub use mesh_store::{pack_normal, unpack_normal, MeshId, MeshStore};
-pub use raster::{RasterFrame, MAPS_DIAGNOSTIC_FORMAT};
+pub use frame::{light_world_dir, Canvas, Window, MAX_INSTANCES};
+pub use host_depth::{depth_quantum, HostDepth};
+pub use mesh_store::{MeshId, MeshStore};
 pub use readback::read_texture;
 pub use targets::{
     DEPTH_FORMAT, DIAGNOSTIC_FORMAT, HOST_FORMAT, ID_FORMAT, RESOLVED_ID_FORMAT, RESULT_FORMAT,
 };
 pub use timing::GpuTimer;
-pub use two_pass::{drawn_edges, two_pass_source, EdgeLines, TwoPass, FILL_DEPTH_BIAS};
 
 use crate::error::{Error, Result};
 

@@ -241,10 +241,10 @@ pub fn variants() -> Vec<(String, String)> {
             F::Rgba16Float,
             F::Rgba32Float,
         ] {
-            if let Some(s) = super::forward_source(format, split) {
+            if let Some(s) = super::baselines::forward_source(format, split) {
                 out.push((format!("forward {format:?} split={split}"), s));
             }
-            if let Some(s) = super::two_pass_source(format, split) {
+            if let Some(s) = super::baselines::two_pass_source(format, split) {
                 out.push((format!("two-pass {format:?} split={split}"), s));
             }
         }

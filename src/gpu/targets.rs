@@ -4,6 +4,7 @@
 //! diagnostic maps.
 
 use crate::error::{Error, Result};
+use crate::style::linear_to_srgb;
 
 /// Format of the id target: (instance slot, triangle of its mesh); `u32::MAX` in the first
 /// channel marks background, `u32::MAX − 1` host geometry in front.
@@ -225,5 +226,33 @@ impl Targets {
             n += tex(h);
         }
         n
+    }
+}
+
+/// A colour attachment cleared to `color` when the pass begins, and stored.
+pub(crate) fn cleared(
+    view: &wgpu::TextureView,
+    color: wgpu::Color,
+) -> Option<wgpu::RenderPassColorAttachment<'_>> {
+    Some(wgpu::RenderPassColorAttachment {
+        view,
+        depth_slice: None,
+        resolve_target: None,
+        ops: wgpu::Operations {
+            load: wgpu::LoadOp::Clear(color),
+            store: wgpu::StoreOp::Store,
+        },
+    })
+}
+
+/// The clear colour of an output of `format` for the linear background `bg`.
+pub(crate) fn clear_color(format: wgpu::TextureFormat, bg: [f32; 4]) -> wgpu::Color {
+    let encode = format == wgpu::TextureFormat::Rgba8Unorm;
+    let c = |v: f32| f64::from(if encode { linear_to_srgb(v) } else { v });
+    wgpu::Color {
+        r: c(bg[0]),
+        g: c(bg[1]),
+        b: c(bg[2]),
+        a: f64::from(bg[3]),
     }
 }

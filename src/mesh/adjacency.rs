@@ -1,7 +1,7 @@
 //! Edge adjacency: which triangle lies across each triangle edge. Vertices are welded by
 //! exact position first, so split normals or texture seams do not cut the surface apart.
 
-use crate::par::*;
+use crate::mesh::par::*;
 use std::collections::HashMap;
 
 /// Marks an edge with no unique neighbour: a boundary, or an edge shared by three or more

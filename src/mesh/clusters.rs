@@ -16,7 +16,7 @@
 //! has an outline edge.
 
 use super::adjacency::{fold_bound, ANY_FOLD};
-use crate::par::*;
+use crate::mesh::par::*;
 use glam::DVec3;
 
 /// Triangles per cluster (the last may have fewer); the outline pass's workgroup size.

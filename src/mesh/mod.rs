@@ -4,31 +4,20 @@
 pub mod adjacency;
 pub mod clusters;
 #[cfg(feature = "formats")]
-pub mod gltf;
-#[cfg(feature = "formats")]
-mod load;
-#[cfg(feature = "formats")]
-mod obj;
+pub mod formats;
+mod par;
 pub mod patches;
 #[cfg(feature = "formats")]
-mod ply;
-#[cfg(feature = "formats")]
-mod polygon;
+pub(crate) mod polygon;
 mod procedural;
-#[cfg(feature = "formats")]
-mod stl;
 
 #[cfg(feature = "formats")]
-pub use load::{format_of, load, Format, FORMATS};
-#[cfg(feature = "formats")]
-pub use obj::load_obj;
-#[cfg(feature = "formats")]
-pub use ply::load_ply;
+pub use formats::{
+    format_of, load, load_gltf, load_gltf_mesh, load_obj, load_ply, load_stl, Format, FORMATS,
+};
 pub use procedural::{
     cube, default_parts, default_scene, grid, layers, sphere, torus, Procedural, LAYER_TRIANGLES,
 };
-#[cfg(feature = "formats")]
-pub use stl::load_stl;
 
 use crate::error::{Error, Result};
 use glam::Vec3;

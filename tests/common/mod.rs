@@ -7,7 +7,8 @@ use glam::{DVec2, Vec3};
 use std::path::PathBuf;
 use std::sync::OnceLock;
 use wirepass::gpu::{DeferredPass, GpuContext, PassOptions, TriangleIds};
-use wirepass::render::{render, Frame, Method, Shot, World};
+use wirepass::tools::offline::{render, Method};
+use wirepass::world::{Rendering, Shot, World};
 use wirepass::{edge_math, Camera, EdgeSelection, Mesh, Style};
 
 /// One device for the whole test binary. A missing adapter fails loudly: GPU tests never
@@ -73,7 +74,7 @@ pub fn shoot(
     size: (u32, u32),
     edges: EdgeSelection,
     method: Method,
-) -> Frame {
+) -> Rendering {
     let world = World::single(mesh.clone(), edges);
     shoot_world(
         &world,
@@ -91,7 +92,7 @@ pub fn shoot_world(
     style: &Style,
     size: (u32, u32),
     method: Method,
-) -> Frame {
+) -> Rendering {
     let shot = Shot {
         world,
         view,
@@ -140,14 +141,15 @@ impl TestScene {
         }
     }
 
-    pub fn draw(&self, method: Method) -> Frame {
+    pub fn draw(&self, method: Method) -> Rendering {
         render(gpu(), &self.shot(), method).unwrap_or_else(|e| panic!("{}: {e}", method.name()))
     }
 }
 
 /// The `n` pixels with the largest distance errors over `bound`, for failure messages.
-pub fn worst_pixels(truth: &Frame, frame: &Frame, bound: f64, n: usize) -> String {
-    let errors = wirepass::compare::distance_errors(truth, frame).unwrap_or_else(|e| panic!("{e}"));
+pub fn worst_pixels(truth: &Rendering, frame: &Rendering, bound: f64, n: usize) -> String {
+    let errors =
+        wirepass::tools::compare::distance_errors(truth, frame).unwrap_or_else(|e| panic!("{e}"));
     let mut worst: Vec<(usize, f64)> = errors
         .iter()
         .enumerate()

@@ -1,4 +1,6 @@
-//! Command-line parsing helpers shared by the `wirepass` binary's subcommands.
+//! Scenes from what a person names: a mesh file, a scene file, a glTF scene, a procedural
+//! mesh or the built-in scene; image sizes and vectors from text; the camera placed from
+//! the values given and the scene's bounds.
 
 // `!(a > b)` is deliberate throughout: NaN must take the rejecting branch.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -6,8 +8,8 @@
 use crate::camera::{Camera, View};
 use crate::error::{Error, Result};
 use crate::mesh::{self, EdgeSelection, Mesh, Procedural};
-use crate::render::World;
-use crate::scene_file::FileCamera;
+use crate::tools::scene_file::FileCamera;
+use crate::world::World;
 use glam::{DVec3, Vec3};
 use std::path::Path;
 
@@ -64,16 +66,16 @@ pub fn load_world(spec: Option<&str>, options: &WorldOptions) -> Result<Loaded> 
     let lower = spec.map(str::to_ascii_lowercase).unwrap_or_default();
     let (world, cameras, notes) = match spec {
         None => (
-            crate::render::default_world(edges.unwrap_or_default()),
+            crate::world::default_world(edges.unwrap_or_default()),
             Vec::new(),
             Vec::new(),
         ),
         Some(s) if lower.ends_with(".json") => {
-            let (world, camera) = crate::scene_file::load(Path::new(s), edges, &mesh_spec)?;
+            let (world, camera) = crate::tools::scene_file::load(Path::new(s), edges, &mesh_spec)?;
             (world, camera.into_iter().collect(), Vec::new())
         }
         Some(s) if lower.ends_with(".gltf") || lower.ends_with(".glb") => {
-            let doc = mesh::gltf::load_gltf(Path::new(s))?;
+            let doc = mesh::formats::gltf::load_gltf(Path::new(s))?;
             let cameras = doc.cameras.iter().map(|&c| FileCamera::Gltf(c)).collect();
             let notes = doc.notes.clone();
             let mut world = World::from_gltf(doc, edges);
@@ -132,38 +134,28 @@ pub fn parse_vec3(s: &str) -> Result<Vec3> {
     }
 }
 
-/// Camera options as given on the command line; unset ones come from the automatic framing.
-#[derive(Clone, Debug, Default, clap::Args)]
-pub struct CameraArgs {
+/// Where the camera goes, as a person gives it (the CLI's camera options): unset values
+/// come from the automatic framing.
+#[derive(Clone, Debug, Default)]
+pub struct CameraPlacement {
     /// Eye position x,y,z; without it the camera frames the mesh automatically.
-    #[arg(long, value_parser = parse_vec3_arg, allow_hyphen_values = true)]
     pub eye: Option<Vec3>,
     /// Point looked at, x,y,z (default: centre of the mesh bounds).
-    #[arg(long, value_parser = parse_vec3_arg, allow_hyphen_values = true)]
     pub target: Option<Vec3>,
     /// Up direction x,y,z (default 0,1,0).
-    #[arg(long, value_parser = parse_vec3_arg, allow_hyphen_values = true)]
     pub up: Option<Vec3>,
     /// Vertical field of view in degrees (default 40).
-    #[arg(long, allow_hyphen_values = true)]
     pub fov: Option<f32>,
     /// Near plane distance.
-    #[arg(long, allow_hyphen_values = true)]
     pub near: Option<f32>,
     /// Far plane distance.
-    #[arg(long, allow_hyphen_values = true)]
     pub far: Option<f32>,
     /// Use the file's N-th camera (a glTF file's, counting from 0 in node order); without
     /// it and the options above, the file's first camera, if it has one.
-    #[arg(long, value_name = "N", conflicts_with_all = ["eye", "target", "up", "fov", "near", "far"])]
     pub camera: Option<usize>,
 }
 
-fn parse_vec3_arg(s: &str) -> std::result::Result<Vec3, String> {
-    parse_vec3(s).map_err(|e| e.to_string())
-}
-
-impl CameraArgs {
+impl CameraPlacement {
     /// True when no camera placement option (eye, target, up, fov, near, far) is given.
     pub fn is_empty(&self) -> bool {
         self.eye.is_none()

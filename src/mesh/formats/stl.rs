@@ -7,9 +7,9 @@
 //! as a count of at least 0x09090909. The length is checked before any triangle is read, so
 //! a header that declares more triangles than the file holds fails at once.
 
-use super::load::{build, file_error, io_error, open};
-use super::Mesh;
+use super::read::{build, file_error, io_error, open};
 use crate::error::Result;
+use crate::mesh::Mesh;
 use glam::Vec3;
 use std::collections::HashMap;
 use std::io::{BufRead, BufReader, Read, Seek, SeekFrom};

@@ -2,10 +2,10 @@
 //! polygons are triangulated here (not by tobj, whose fan breaks concave faces) so that the
 //! diagonals the triangulation adds can be left out of the polygon edge mask.
 
-use super::load::{build, file_error, io_error, open};
-use super::polygon::{polygon_edges, triangulate};
-use super::Mesh;
+use super::read::{build, file_error, io_error, open};
 use crate::error::Result;
+use crate::mesh::polygon::{polygon_edges, triangulate};
+use crate::mesh::Mesh;
 use glam::Vec3;
 use std::io::Read;
 use std::path::Path;
@@ -81,7 +81,7 @@ fn parse_obj(path: &Path, bytes: &[u8]) -> Result<Mesh> {
             }
             for t in m.indices.chunks_exact(3) {
                 triangles.push([global(t[0])?, global(t[1])?, global(t[2])?]);
-                edges.push(super::ALL_EDGES);
+                edges.push(crate::mesh::ALL_EDGES);
             }
             continue;
         }

@@ -25,9 +25,9 @@
 use crate::edge_math;
 use crate::mesh::adjacency::NO_NEIGHBOUR;
 use crate::mesh::patches::Patches;
-use crate::raycast::{HostMap, Line, ObjectStyle, RayCaster, Rays};
-use crate::render::Shot;
 use crate::style::{depth_fade, line_intensity, line_key, line_reach};
+use crate::truth::raycast::{HostMap, Line, ObjectStyle, RayCaster, Rays};
+use crate::world::Shot;
 use glam::{DVec2, DVec4};
 use rayon::prelude::*;
 
@@ -379,7 +379,7 @@ fn keep_between(range: &mut (f64, f64), p0: f64, d: f64, (lo, hi): (f64, f64)) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::World;
+    use crate::world::World;
     use crate::{Camera, EdgeSelection, Mesh, Style};
     use glam::{DVec3, Vec3};
 

@@ -180,7 +180,7 @@ pub fn difference(a: Rgba<'_>, b: Rgba<'_>) -> Result<Difference> {
 /// as a PNG.
 pub fn heat_map(a: Rgba<'_>, b: Rgba<'_>, path: &Path) -> Result<()> {
     let rgba = flip_error_rgba(a, b)?;
-    crate::render::save_rgba_png(path, &rgba, a.size)
+    save_rgba_png(path, &rgba, a.size)
 }
 
 /// Reads a PNG (or any format the `image` crate was built with) as RGBA8; errors name the file.
@@ -247,7 +247,7 @@ fn check(
         if let Some(dir) = reference.parent() {
             create_dir(dir)?;
         }
-        crate::render::save_rgba_png(reference, actual.pixels, size)?;
+        save_rgba_png(reference, actual.pixels, size)?;
         return Ok(Outcome::Blessed(reference.to_owned()));
     }
     if !reference.exists() {
@@ -267,7 +267,7 @@ fn check(
     let actual_path = out_dir.join(format!("{name}.actual.png"));
     let diff_path = out_dir.join(format!("{name}.diff.png"));
     if ref_size != size {
-        crate::render::save_rgba_png(&actual_path, actual.pixels, size)?;
+        save_rgba_png(&actual_path, actual.pixels, size)?;
         return Err(Error::InvalidSetting(format!(
             "{}: reference is {}x{}, the render {}x{}; actual image: {}",
             reference.display(),
@@ -283,7 +283,7 @@ fn check(
         return Ok(Outcome::Pass(diff));
     };
     let why = format!("{diff}: {why}");
-    crate::render::save_rgba_png(&actual_path, actual.pixels, size)?;
+    save_rgba_png(&actual_path, actual.pixels, size)?;
     heat_map(expected, actual, &diff_path)?;
     Err(Error::InvalidSetting(format!(
         "{} differs from the render ({why}); actual image: {}, FLIP heat map: {}; if the \
@@ -298,6 +298,16 @@ fn create_dir(dir: &Path) -> Result<()> {
     std::fs::create_dir_all(dir).map_err(|source| Error::Io {
         path: dir.to_owned(),
         source,
+    })
+}
+
+/// Writes 8-bit RGBA pixels, row 0 at the top, as a PNG.
+pub fn save_rgba_png(path: &Path, rgba: &[u8], (width, height): (u32, u32)) -> Result<()> {
+    image::save_buffer(path, rgba, width, height, image::ColorType::Rgba8).map_err(|e| {
+        Error::Image {
+            path: path.to_owned(),
+            message: e.to_string(),
+        }
     })
 }
 

@@ -6,9 +6,10 @@ mod font;
 
 use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
-use crate::raycast::render_raycast;
-use crate::regression;
-use crate::render::{render, Frame, Method, Shot, BACKGROUND};
+use crate::tools::offline::{render, Method};
+use crate::tools::regression;
+use crate::truth::raycast::render_raycast;
+use crate::world::{Rendering, Shot, BACKGROUND};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -59,9 +60,9 @@ pub struct Metrics {
 }
 
 /// Checks that two frames can be compared pixel for pixel.
-fn check_same_shape(reference: &Frame, frame: &Frame) -> Result<()> {
+fn check_same_shape(reference: &Rendering, frame: &Rendering) -> Result<()> {
     let n = reference.size.0 as usize * reference.size.1 as usize;
-    let whole = |f: &Frame| {
+    let whole = |f: &Rendering| {
         f.ids.len() == n
             && f.edge_distance.len() == n
             && f.depth.len() == n
@@ -77,7 +78,7 @@ fn check_same_shape(reference: &Frame, frame: &Frame) -> Result<()> {
 }
 
 /// Compares `frame` against `reference` (the ground truth); an error if their sizes differ.
-pub fn metrics(reference: &Frame, frame: &Frame) -> Result<Metrics> {
+pub fn metrics(reference: &Rendering, frame: &Rendering) -> Result<Metrics> {
     let errors = distance_errors(reference, frame)?;
     let mut measured: Vec<f64> = errors.iter().flatten().copied().collect();
     measured.sort_by(f64::total_cmp);
@@ -129,7 +130,7 @@ fn percentile(sorted: &[f64], q: f64) -> Option<f64> {
 
 /// Per pixel, `|d − d_true|` where it is measured (ids agree, background included, which
 /// outlines reach; true distance finite and under [`DISTANCE_RANGE_PX`]), `None` elsewhere.
-pub fn distance_errors(reference: &Frame, frame: &Frame) -> Result<Vec<Option<f64>>> {
+pub fn distance_errors(reference: &Rendering, frame: &Rendering) -> Result<Vec<Option<f64>>> {
     check_same_shape(reference, frame)?;
     Ok((0..reference.ids.len())
         .map(|i| {
@@ -148,7 +149,7 @@ pub fn distance_errors(reference: &Frame, frame: &Frame) -> Result<Vec<Option<f6
         .collect())
 }
 
-fn rgba(frame: &Frame) -> regression::Rgba<'_> {
+fn rgba(frame: &Rendering) -> regression::Rgba<'_> {
     regression::Rgba {
         pixels: &frame.rgba,
         size: frame.size,
@@ -159,7 +160,7 @@ fn rgba(frame: &Frame) -> regression::Rgba<'_> {
 /// ([`regression::flip_map`]).
 ///
 /// An error if the frames differ in size.
-pub fn flip_map(reference: &Frame, frame: &Frame) -> Result<Vec<f32>> {
+pub fn flip_map(reference: &Rendering, frame: &Rendering) -> Result<Vec<f32>> {
     regression::flip_map(rgba(reference), rgba(frame))
 }
 
@@ -195,7 +196,7 @@ impl Image {
 
     /// Writes the image as a PNG.
     pub fn save_png(&self, path: &Path) -> Result<()> {
-        crate::render::save_rgba_png(path, &self.rgba, self.size)
+        crate::tools::regression::save_rgba_png(path, &self.rgba, self.size)
     }
 }
 
@@ -213,7 +214,7 @@ const BLACK: [u8; 4] = [0, 0, 0, 255];
 
 /// The edge-distance error as a heat map: magma on a log scale from 1e-6 px (dark) to 1 px
 /// and beyond (bright), grey where not measured, with a labelled scale below the image.
-pub fn distance_error_image(reference: &Frame, frame: &Frame) -> Result<Image> {
+pub fn distance_error_image(reference: &Rendering, frame: &Rendering) -> Result<Image> {
     let lut = magma();
     let (w, h) = reference.size;
     let (lo, hi) = HEAT_LOG10;
@@ -262,14 +263,14 @@ pub fn distance_error_image(reference: &Frame, frame: &Frame) -> Result<Image> {
 /// The FLIP error map through nv-flip's magma LUT ([`regression::flip_error_rgba`]).
 ///
 /// An error if the frames differ in size.
-pub fn flip_error_image(reference: &Frame, frame: &Frame) -> Result<Image> {
+pub fn flip_error_image(reference: &Rendering, frame: &Rendering) -> Result<Image> {
     Ok(Image {
         size: reference.size,
         rgba: regression::flip_error_rgba(rgba(reference), rgba(frame))?,
     })
 }
 
-fn frame_image(frame: &Frame) -> Image {
+fn frame_image(frame: &Rendering) -> Image {
     Image {
         size: frame.size,
         rgba: frame.rgba.clone(),
@@ -327,15 +328,15 @@ const TIMED_FRAMES: u32 = 20;
 const WARM_UP_FRAMES: u32 = 3;
 
 /// GPU time of each method's passes for `shot` in milliseconds (median over frames, methods
-/// interleaved frame by frame, see [`crate::bench`]), with a note on how it was taken.
+/// interleaved frame by frame, see [`crate::tools::bench`]), with a note on how it was taken.
 fn gpu_times(ctx: &GpuContext, shot: &Shot<'_>) -> (BTreeMap<String, f64>, String) {
-    let timing = crate::bench::Timing {
+    let timing = crate::tools::bench::Timing {
         frames: TIMED_FRAMES,
         warmup: WARM_UP_FRAMES,
         edges: Vec::new(),
         methods: Vec::new(),
     };
-    match crate::bench::bench_scene(ctx, "compare", shot, timing) {
+    match crate::tools::bench::bench_scene(ctx, "compare", shot, timing) {
         Ok(runs) => (
             runs.into_iter()
                 .map(|r| (r.method, r.total_median_ms))
@@ -530,9 +531,9 @@ pub fn table(report: &Report) -> String {
 mod tests {
     use super::*;
 
-    fn frame(ids: Vec<u32>, d: Vec<f32>) -> Frame {
+    fn frame(ids: Vec<u32>, d: Vec<f32>) -> Rendering {
         let n = ids.len();
-        Frame {
+        Rendering {
             size: (n as u32, 1),
             rgba: vec![200; 4 * n],
             ids,

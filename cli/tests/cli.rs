@@ -214,7 +214,10 @@ fn feature_edges_from_the_command_line() {
     let png = temp("fandisk.png");
     let (ok, err) = wirepass(&[
         "render",
-        concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/meshes/fandisk.obj"),
+        concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../tests/data/meshes/fandisk.obj"
+        ),
         "--edges",
         "feature:30",
         "--line-width",

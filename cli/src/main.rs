@@ -3,10 +3,12 @@
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
-use wirepass::cli::{load_world, parse_size, CameraArgs, WorldOptions};
+use wirepass::glam::Vec3;
 use wirepass::gpu::GpuContext;
-use wirepass::render::{render, Method, Shot, World};
 use wirepass::style::DepthFade;
+use wirepass::tools::load::{load_world, parse_size, parse_vec3, CameraPlacement, WorldOptions};
+use wirepass::tools::offline::{render, Method};
+use wirepass::world::{Shot, World};
 use wirepass::{Color, EdgeSelection, Result, Style, View};
 
 #[derive(Parser)]
@@ -128,8 +130,9 @@ impl SceneArgs {
         };
         let loaded = load_world(self.mesh.as_deref(), &options)?;
         print_notes(&loaded.notes);
-        let file_camera = loaded.camera.filter(|_| self.camera.is_empty());
-        if let Some(wirepass::scene_file::FileCamera::Gltf(c)) = &file_camera {
+        let placement = self.camera.placement();
+        let file_camera = loaded.camera.filter(|_| placement.is_empty());
+        if let Some(wirepass::tools::scene_file::FileCamera::Gltf(c)) = &file_camera {
             let image = f64::from(size.0) / f64::from(size.1);
             if let Some(a) = c.aspect().filter(|a| (a / image - 1.0).abs() > 0.01) {
                 print_notes(&[format!(
@@ -138,9 +141,7 @@ impl SceneArgs {
                 )]);
             }
         }
-        let view = self
-            .camera
-            .view(&loaded.world, file_camera.as_ref(), size)?;
+        let view = placement.view(&loaded.world, file_camera.as_ref(), size)?;
         Ok((loaded.world, view, style, size))
     }
 }
@@ -212,7 +213,7 @@ fn compare_command(args: &CompareArgs) -> Result<()> {
         style: &style,
         size,
     };
-    let report = wirepass::compare::run(&ctx, &shot, &args.out)?;
+    let report = wirepass::tools::compare::run(&ctx, &shot, &args.out)?;
     println!(
         "{}x{}, {} triangles, {}; ground truth (raycast) {:.2} s",
         size.0,
@@ -221,7 +222,7 @@ fn compare_command(args: &CompareArgs) -> Result<()> {
         ctx.describe(),
         report.reference_seconds
     );
-    println!("{}", wirepass::compare::table(&report));
+    println!("{}", wirepass::tools::compare::table(&report));
     eprintln!("wrote {}", args.out.join("report.json").display());
     Ok(())
 }
@@ -262,10 +263,10 @@ struct BenchArgs {
     /// Time only these methods, comma separated: floor, deferred, forward, two-pass
     /// [default: all of them].
     #[arg(long, value_delimiter = ',', value_parser = parse_timed)]
-    methods: Vec<wirepass::bench::Timed>,
+    methods: Vec<wirepass::tools::bench::Timed>,
 }
 
-fn parse_timed(s: &str) -> std::result::Result<wirepass::bench::Timed, String> {
+fn parse_timed(s: &str) -> std::result::Result<wirepass::tools::bench::Timed, String> {
     s.parse().map_err(|e: wirepass::Error| e.to_string())
 }
 
@@ -305,27 +306,27 @@ fn bench_command(args: &BenchArgs) -> Result<()> {
                 ..Style::default()
             };
             style.validate()?;
-            let timing = wirepass::bench::Timing {
+            let timing = wirepass::tools::bench::Timing {
                 frames: args.frames,
                 warmup: args.warmup,
                 edges: args.compare_edges.clone(),
                 methods: args.methods.clone(),
             };
-            runs.extend(wirepass::bench::bench(
+            runs.extend(wirepass::tools::bench::bench(
                 &ctx, name, &world, size, &style, timing,
             )?);
             progress.inc(1);
         }
     }
     progress.finish_and_clear();
-    let device = wirepass::bench::DeviceInfo::of(&ctx);
+    let device = wirepass::tools::bench::DeviceInfo::of(&ctx);
     println!("{}\n", device.describe());
-    println!("{}", wirepass::bench::markdown(&runs));
-    let by_edges = wirepass::bench::edges_markdown(&runs);
+    println!("{}", wirepass::tools::bench::markdown(&runs));
+    let by_edges = wirepass::tools::bench::edges_markdown(&runs);
     if !by_edges.is_empty() {
         println!("{by_edges}");
     }
-    wirepass::bench::write_outputs(&args.out, &device, &runs)?;
+    wirepass::tools::bench::write_outputs(&args.out, &device, &runs)?;
     eprintln!("wrote {}", args.out.display());
     Ok(())
 }
@@ -348,7 +349,7 @@ struct DiffArgs {
 }
 
 fn diff_command(args: &DiffArgs) -> Result<()> {
-    use wirepass::regression::{difference, heat_map, load_rgba, Rgba, Threshold};
+    use wirepass::tools::regression::{difference, heat_map, load_rgba, Rgba, Threshold};
     let (a, a_size) = load_rgba(&args.a)?;
     let (b, b_size) = load_rgba(&args.b)?;
     let (a, b) = (Rgba::new(&a, a_size)?, Rgba::new(&b, b_size)?);
@@ -391,6 +392,52 @@ fn main() -> ExitCode {
         Err(e) => {
             eprintln!("wirepass: error: {e}");
             ExitCode::FAILURE
+        }
+    }
+}
+
+/// Camera options as given on the command line; unset ones come from the automatic framing.
+#[derive(Clone, Debug, Default, clap::Args)]
+struct CameraArgs {
+    /// Eye position x,y,z; without it the camera frames the mesh automatically.
+    #[arg(long, value_parser = parse_vec3_arg, allow_hyphen_values = true)]
+    eye: Option<Vec3>,
+    /// Point looked at, x,y,z (default: centre of the mesh bounds).
+    #[arg(long, value_parser = parse_vec3_arg, allow_hyphen_values = true)]
+    target: Option<Vec3>,
+    /// Up direction x,y,z (default 0,1,0).
+    #[arg(long, value_parser = parse_vec3_arg, allow_hyphen_values = true)]
+    up: Option<Vec3>,
+    /// Vertical field of view in degrees (default 40).
+    #[arg(long, allow_hyphen_values = true)]
+    fov: Option<f32>,
+    /// Near plane distance.
+    #[arg(long, allow_hyphen_values = true)]
+    near: Option<f32>,
+    /// Far plane distance.
+    #[arg(long, allow_hyphen_values = true)]
+    far: Option<f32>,
+    /// Use the file's N-th camera (a glTF file's, counting from 0 in node order); without
+    /// it and the options above, the file's first camera, if it has one.
+    #[arg(long, value_name = "N", conflicts_with_all = ["eye", "target", "up", "fov", "near", "far"])]
+    camera: Option<usize>,
+}
+
+fn parse_vec3_arg(s: &str) -> std::result::Result<Vec3, String> {
+    parse_vec3(s).map_err(|e| e.to_string())
+}
+
+impl CameraArgs {
+    /// The placement these options give.
+    fn placement(&self) -> CameraPlacement {
+        CameraPlacement {
+            eye: self.eye,
+            target: self.target,
+            up: self.up,
+            fov: self.fov,
+            near: self.near,
+            far: self.far,
+            camera: self.camera,
         }
     }
 }

@@ -9,8 +9,9 @@ use crate::gpu::{
     OutputTarget, PassOptions, PreparedFrame, RasterFrame, TwoPass,
 };
 use crate::mesh::EdgeSelection;
-use crate::render::{Shot, Uploaded, World};
 use crate::style::Style;
+use crate::tools::offline::Uploaded;
+use crate::world::{Shot, World};
 use std::collections::BTreeMap;
 use std::sync::Arc;
 use std::time::Instant;

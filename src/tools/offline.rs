@@ -1,8 +1,5 @@
-//! Offscreen rendering for the CLI, tools and tests: a [`World`] of meshes and objects,
-//! drawn through one view with any [`Method`] into CPU images and maps.
-//!
-//! Triangle ids in every map are **global**: objects are numbered in the world's order, each
-//! object's triangles consecutive in the order its mesh file lists them.
+//! Offscreen frames for the CLI, tools and tests: a [`Shot`] of a world drawn with any
+//! [`Method`] into a [`Rendering`] (CPU image and maps, global triangle ids), and its dumps.
 
 use crate::camera::View;
 use crate::error::{Error, Result};
@@ -10,204 +7,9 @@ use crate::gpu::{
     read_texture, texture_2d, Canvas, DeferredPass, EdgeLines, ForwardPass, GpuContext, MeshId,
     MeshStore, OutputTarget, PassOptions, TwoPass,
 };
-use crate::mesh::{EdgeSelection, Mesh};
-use crate::scene::{Instance, InstanceStyle, Scene};
-use crate::style::Style;
-use glam::{DMat4, DVec3};
+use crate::scene::{Instance, Scene};
+use crate::world::{Rendering, Shot, World, BACKGROUND, HOST};
 use std::path::Path;
-use std::sync::Arc;
-
-/// Id of pixels that show no triangle.
-pub const BACKGROUND: u32 = u32::MAX;
-/// Id of pixels where the host's own geometry is in front.
-pub const HOST: u32 = u32::MAX - 1;
-
-/// A mesh of a world, with the edges drawn on it.
-#[derive(Clone, Debug)]
-pub struct WorldMesh {
-    /// The mesh, in its own coordinates.
-    pub mesh: Arc<Mesh>,
-    /// Which of its edges are drawn.
-    pub edges: EdgeSelection,
-    /// Where it came from, for messages.
-    pub name: String,
-}
-
-/// One placement of a world mesh.
-#[derive(Clone, Debug)]
-pub struct Object {
-    /// Index into [`World::meshes`].
-    pub mesh: usize,
-    /// Model → world.
-    pub transform: DMat4,
-    /// Style overrides.
-    pub style: InstanceStyle,
-}
-
-/// Meshes and their placements: what tools render, compare and time.
-#[derive(Clone, Debug, Default)]
-pub struct World {
-    /// The distinct meshes (each uploaded once).
-    pub meshes: Vec<WorldMesh>,
-    /// The objects, in order; several may share a mesh.
-    pub objects: Vec<Object>,
-}
-
-impl World {
-    /// One mesh, placed once at the origin.
-    pub fn single(mesh: Mesh, edges: EdgeSelection) -> World {
-        World {
-            meshes: vec![WorldMesh {
-                mesh: Arc::new(mesh),
-                edges,
-                name: "mesh".into(),
-            }],
-            objects: vec![Object {
-                mesh: 0,
-                transform: DMat4::IDENTITY,
-                style: InstanceStyle::default(),
-            }],
-        }
-    }
-
-    /// Checks the objects' meshes and that every global id fits the id maps.
-    pub fn validate(&self) -> Result<()> {
-        for (i, o) in self.objects.iter().enumerate() {
-            if o.mesh >= self.meshes.len() {
-                return Err(Error::InvalidScene(format!(
-                    "object {i} refers to mesh {} of {}",
-                    o.mesh,
-                    self.meshes.len()
-                )));
-            }
-        }
-        let total = self.triangle_count();
-        if total >= u64::from(HOST) {
-            return Err(Error::InvalidScene(format!(
-                "{total} triangles over all objects: global ids must stay below {HOST}"
-            )));
-        }
-        Ok(())
-    }
-
-    /// Triangles over all objects.
-    pub fn triangle_count(&self) -> u64 {
-        self.objects
-            .iter()
-            .map(|o| self.meshes[o.mesh].mesh.triangle_count() as u64)
-            .sum()
-    }
-
-    /// The global id of each object's first triangle.
-    pub fn first_ids(&self) -> Vec<u32> {
-        let mut next = 0u64;
-        self.objects
-            .iter()
-            .map(|o| {
-                let first = next;
-                next += self.meshes[o.mesh].mesh.triangle_count() as u64;
-                first as u32
-            })
-            .collect()
-    }
-
-    /// The object and triangle of global id `id`.
-    pub fn locate(&self, first_ids: &[u32], id: u32) -> (usize, u32) {
-        let o = first_ids.partition_point(|&f| f <= id).saturating_sub(1);
-        (o, id - first_ids[o])
-    }
-
-    /// Axis-aligned world bounds of every object (its mesh's bounding box, transformed).
-    pub fn bounds(&self) -> (DVec3, DVec3) {
-        let mut lo = DVec3::splat(f64::INFINITY);
-        let mut hi = DVec3::splat(f64::NEG_INFINITY);
-        for o in &self.objects {
-            let (a, b) = self.meshes[o.mesh].mesh.bounds_f64();
-            for i in 0..8 {
-                let c = DVec3::new(
-                    if i & 1 == 0 { a.x } else { b.x },
-                    if i & 2 == 0 { a.y } else { b.y },
-                    if i & 4 == 0 { a.z } else { b.z },
-                );
-                let p = o.transform.transform_point3(c);
-                lo = lo.min(p);
-                hi = hi.max(p);
-            }
-        }
-        (lo, hi)
-    }
-}
-
-impl World {
-    /// A glTF scene as a world: each glTF mesh once, an object per instance in node order,
-    /// with the file's line width where it gives one. Each mesh draws `edges`, or, when that
-    /// is `None`, its authored edges where it has them (polygon edges otherwise); see
-    /// [`Mesh::resolve_edges`] for what an explicit selection does to the file's outline mask.
-    pub fn from_gltf(doc: crate::mesh::gltf::Document, edges: Option<EdgeSelection>) -> World {
-        let widths: Vec<Option<f32>> = doc.meshes.iter().map(|m| m.line_width).collect();
-        let meshes = doc
-            .meshes
-            .into_iter()
-            .map(|m| {
-                let (mesh, edges) = m.mesh.resolve_edges(edges.or(m.edges));
-                WorldMesh {
-                    mesh: Arc::new(mesh),
-                    edges,
-                    name: m.name,
-                }
-            })
-            .collect();
-        let objects = doc
-            .instances
-            .into_iter()
-            .map(|(mesh, transform)| Object {
-                mesh,
-                transform,
-                style: InstanceStyle {
-                    line_width: widths[mesh],
-                    ..InstanceStyle::default()
-                },
-            })
-            .collect();
-        World { meshes, objects }
-    }
-}
-
-/// The built-in scene: a torus and a sphere, two meshes drawing `edges`.
-pub fn default_world(edges: EdgeSelection) -> World {
-    let mut world = World::default();
-    // The parts are constant and valid (tests check it); an error cannot occur here.
-    for (i, (mesh, transform)) in crate::mesh::default_parts()
-        .into_iter()
-        .flatten()
-        .enumerate()
-    {
-        world.meshes.push(WorldMesh {
-            mesh: Arc::new(mesh),
-            edges,
-            name: ["torus", "sphere"][i].into(),
-        });
-        world.objects.push(Object {
-            mesh: i,
-            transform,
-            style: InstanceStyle::default(),
-        });
-    }
-    world
-}
-
-/// What one render draws: a world, through a view, in a style, at a size.
-#[derive(Clone, Copy, Debug)]
-pub struct Shot<'a> {
-    /// The meshes and objects.
-    pub world: &'a World,
-    /// How they are seen.
-    pub view: View,
-    /// Colours, line width, lighting.
-    pub style: &'a Style,
-    /// Image size in pixels.
-    pub size: (u32, u32),
-}
 
 /// A world uploaded to the GPU: its meshes in one store.
 pub struct Uploaded {
@@ -272,27 +74,6 @@ impl Uploaded {
     }
 }
 
-/// One rendered frame on the CPU. Maps are row-major, row 0 at the top.
-#[derive(Clone, Debug)]
-pub struct Frame {
-    /// Width and height in pixels.
-    pub size: (u32, u32),
-    /// 8-bit sRGB RGBA image.
-    pub rgba: Vec<u8>,
-    /// Global id of the visible triangle per pixel: [`BACKGROUND`] where none is.
-    pub ids: Vec<u32>,
-    /// Depth in the standard convention: 0 at the near plane, 1 at the far plane and on
-    /// background.
-    pub depth: Vec<f32>,
-    /// Pixels to the line that colours the pixel most (a drawn edge of the visible triangle,
-    /// or, with outlines, an outline within reach; background pixels included): with lines
-    /// of one width and no depth fade, the nearest line. `inf` where there is none.
-    /// [`Method::Forward`] reports its interpolated altitudes as they come (NaN where they
-    /// are NaN); [`Method::TwoPass`] measures no distance and reports 0 where it drew a line
-    /// fragment, `inf` elsewhere.
-    pub edge_distance: Vec<f32>,
-}
-
 /// A way of drawing the wireframe.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Method {
@@ -342,9 +123,9 @@ impl std::str::FromStr for Method {
 }
 
 /// Renders `shot` with `method` and reads back the image and all maps.
-pub fn render(ctx: &GpuContext, shot: &Shot<'_>, method: Method) -> Result<Frame> {
+pub fn render(ctx: &GpuContext, shot: &Shot<'_>, method: Method) -> Result<Rendering> {
     match method {
-        Method::Raycast => crate::raycast::render_raycast(shot),
+        Method::Raycast => crate::truth::raycast::render_raycast(shot),
         Method::Deferred => render_deferred(ctx, shot),
         Method::Forward => render_forward(ctx, shot),
         Method::TwoPass => render_two_pass(ctx, shot),
@@ -352,7 +133,7 @@ pub fn render(ctx: &GpuContext, shot: &Shot<'_>, method: Method) -> Result<Frame
 }
 
 /// Renders `shot` with the deferred pass and reads back the image and all maps.
-pub fn render_deferred(ctx: &GpuContext, shot: &Shot<'_>) -> Result<Frame> {
+pub fn render_deferred(ctx: &GpuContext, shot: &Shot<'_>) -> Result<Rendering> {
     let up = Uploaded::new(ctx, shot.world)?;
     let pass = DeferredPass::new(&ctx.device, PassOptions::default())?.with_diagnostics();
     render_deferred_with(ctx, shot, &up, pass)
@@ -365,7 +146,7 @@ pub fn render_deferred_with(
     shot: &Shot<'_>,
     up: &Uploaded,
     pass: DeferredPass,
-) -> Result<Frame> {
+) -> Result<Rendering> {
     render_deferred_on(ctx, shot, up, pass, Canvas::new(shot.size))
 }
 
@@ -378,7 +159,7 @@ pub fn render_deferred_on(
     up: &Uploaded,
     mut pass: DeferredPass,
     canvas: Canvas<'_>,
-) -> Result<Frame> {
+) -> Result<Rendering> {
     let device = &ctx.device;
     let window = canvas.window;
     if window.image != shot.size {
@@ -430,7 +211,7 @@ pub fn render_deferred_on(
 /// Reads a rendered frame back: the 8-bit output, the `Rg32Uint` (slot, triangle) ids and
 /// the diagnostic map, four f32 per pixel (`Rgba32Float`, or their bits in `Rgba32Uint` for
 /// the forward passes; r = distance in pixels, ≥ 1e38 meaning none; g = reverse depth),
-/// converted to [`Frame`]'s conventions.
+/// converted to [`Rendering`]'s conventions.
 fn read_frame(
     ctx: &GpuContext,
     shot: &Shot<'_>,
@@ -438,7 +219,7 @@ fn read_frame(
     order: &[u32],
     output: &wgpu::Texture,
     (ids, diagnostic): (&wgpu::Texture, &wgpu::Texture),
-) -> Result<Frame> {
+) -> Result<Rendering> {
     let device = &ctx.device;
     let all = wgpu::TextureAspect::All;
     let rgba = read_texture(device, &ctx.queue, output, all)?;
@@ -454,7 +235,7 @@ fn read_frame(
         .chunks_exact(per_pixel / 4)
         .map(|w| [w[0], w[1]])
         .collect();
-    Ok(Frame {
+    Ok(Rendering {
         size,
         rgba,
         ids: up.global_ids(shot.world, order, &raw)?,
@@ -481,7 +262,7 @@ fn forward_output(device: &wgpu::Device, size: (u32, u32)) -> wgpu::Texture {
 
 /// Renders `shot` with the forward single-pass baseline and reads back the image and maps.
 /// Its distance map is the interpolated altitudes' minimum (NaN where the method gives NaN).
-pub fn render_forward(ctx: &GpuContext, shot: &Shot<'_>) -> Result<Frame> {
+pub fn render_forward(ctx: &GpuContext, shot: &Shot<'_>) -> Result<Rendering> {
     let device = &ctx.device;
     let up = Uploaded::new(ctx, shot.world)?;
     let options = PassOptions {
@@ -510,7 +291,7 @@ pub fn render_forward(ctx: &GpuContext, shot: &Shot<'_>) -> Result<Frame> {
 
 /// Renders `shot` with the two-pass baseline and reads back the image and maps. It measures
 /// no distance: its `edge_distance` is 0 where a line was drawn and `inf` elsewhere.
-pub fn render_two_pass(ctx: &GpuContext, shot: &Shot<'_>) -> Result<Frame> {
+pub fn render_two_pass(ctx: &GpuContext, shot: &Shot<'_>) -> Result<Rendering> {
     let device = &ctx.device;
     let up = Uploaded::new(ctx, shot.world)?;
     let lines = up.edge_lines(ctx, shot.world)?;
@@ -538,20 +319,10 @@ pub fn render_two_pass(ctx: &GpuContext, shot: &Shot<'_>) -> Result<Frame> {
     )
 }
 
-/// Writes 8-bit RGBA pixels, row 0 at the top, as a PNG.
-pub fn save_rgba_png(path: &Path, rgba: &[u8], (width, height): (u32, u32)) -> Result<()> {
-    image::save_buffer(path, rgba, width, height, image::ColorType::Rgba8).map_err(|e| {
-        Error::Image {
-            path: path.to_owned(),
-            message: e.to_string(),
-        }
-    })
-}
-
-impl Frame {
+impl Rendering {
     /// Writes the image as an sRGB PNG.
     pub fn save_png(&self, path: &Path) -> Result<()> {
-        save_rgba_png(path, &self.rgba, self.size)
+        crate::tools::regression::save_rgba_png(path, &self.rgba, self.size)
     }
 
     /// Writes `ids.npy`, `depth.npy`, `edge_distance.npy` and `camera.json` into `dir`.

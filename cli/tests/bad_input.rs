@@ -12,7 +12,7 @@ use std::process::Command;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use wirepass::mesh::{load, load_obj};
 
-#[path = "common/gltf_file.rs"]
+#[path = "../../tests/common/gltf_file.rs"]
 mod gltf_file;
 
 /// The system allocator, recording the largest single request: a loader that reserves for
@@ -44,7 +44,7 @@ static ALLOCATOR: Recording = Recording;
 
 fn bad(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data/bad")
+        .join("../tests/data/bad")
         .join(name)
 }
 

@@ -7,10 +7,10 @@
 //! that declares billions of vertices over a few bytes of data fails at once, and no
 //! buffer is reserved for a count the file cannot hold.
 
-use super::load::{build, file_error, io_error, open};
-use super::polygon::{polygon_edges, triangulate};
-use super::{Mesh, ALL_EDGES};
+use super::read::{build, file_error, io_error, open};
 use crate::error::{Error, Result};
+use crate::mesh::polygon::{polygon_edges, triangulate};
+use crate::mesh::{Mesh, ALL_EDGES};
 use glam::Vec3;
 use ply_rs_bw::parser::{ParseError, Parser, Reader};
 use ply_rs_bw::ply::{

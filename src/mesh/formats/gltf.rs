@@ -36,11 +36,11 @@
 // `!(a > b)` is deliberate throughout: NaN must take the rejecting branch.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-use super::adjacency::NO_NEIGHBOUR;
-use super::load::{file_error, io_error, open};
-use super::{EdgeSelection, Mesh};
+use super::read::{file_error, io_error, open};
 use crate::camera::{DepthRange, View};
 use crate::error::{Error, Result};
+use crate::mesh::adjacency::NO_NEIGHBOUR;
+use crate::mesh::{EdgeSelection, Mesh};
 use glam::dcamera::rh::{proj::directx as proj, view::look_at_mat4};
 use glam::{DMat3, DMat4, DQuat, DVec3, DVec4, Vec3};
 use gltf::accessor::{DataType, Dimensions};
@@ -1154,7 +1154,7 @@ fn finish(b: Builder, what: &str, name: String) -> Res<GltfMesh> {
     };
     let normals = if any_normals {
         if normals.iter().any(|n| n.x.is_nan()) {
-            let smooth = super::smooth_normals(&positions, &triangles);
+            let smooth = crate::mesh::smooth_normals(&positions, &triangles);
             for (n, s) in normals.iter_mut().zip(smooth) {
                 if n.x.is_nan() {
                     *n = s;

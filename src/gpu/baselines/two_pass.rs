@@ -9,13 +9,13 @@
 //! and it runs on every adapter. So it needs no optional feature and never returns
 //! [`Error::MissingFeature`] for one.
 
-use super::mesh_store::VERTEX_BYTES;
 use super::raster::{
     check_vertex_storage, color_targets, depth_state, encode_snippet, pipeline_layout, slot_layout,
     RasterFrame,
 };
-use super::{shaders, GpuTimer, MeshId, MeshStore, PassOptions};
 use crate::error::{Error, Result};
+use crate::gpu::mesh_store::VERTEX_BYTES;
+use crate::gpu::{shaders, GpuTimer, MeshId, MeshStore, PassOptions};
 use crate::mesh::{EdgeSelection, Mesh};
 use crate::scene::Scene;
 use crate::style::Style;
@@ -31,7 +31,7 @@ use wgpu::util::DeviceExt;
 /// term pushes a triangle behind the surface behind it, so near silhouettes the fill's ids
 /// differ from the deferred pass's (0.4 % of Suzanne's pixels at 256²) and hidden lines can
 /// show through.
-pub const FILL_DEPTH_BIAS: wgpu::DepthBiasState = wgpu::DepthBiasState {
+pub(crate) const FILL_DEPTH_BIAS: wgpu::DepthBiasState = wgpu::DepthBiasState {
     constant: -1,
     slope_scale: -1.0,
     clamp: 0.0,
@@ -39,7 +39,7 @@ pub const FILL_DEPTH_BIAS: wgpu::DepthBiasState = wgpu::DepthBiasState {
 
 /// The two-pass module for an output of `format`: common.wgsl, scene.wgsl, forward.wgsl
 /// and two_pass.wgsl.
-pub fn two_pass_source(format: wgpu::TextureFormat, split: bool) -> Option<String> {
+pub(crate) fn two_pass_source(format: wgpu::TextureFormat, split: bool) -> Option<String> {
     if !two_pass_format(format) {
         return None;
     }

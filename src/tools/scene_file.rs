@@ -37,9 +37,9 @@
 use crate::camera::{Camera, DepthRange, View};
 use crate::error::{Error, Result};
 use crate::mesh::EdgeSelection;
-use crate::render::{Object, World, WorldMesh};
 use crate::scene::InstanceStyle;
 use crate::style::Color;
+use crate::world::{Object, World, WorldMesh};
 use glam::{DMat4, DQuat, DVec3, EulerRot};
 use serde_json::Value;
 use std::collections::HashMap;
@@ -69,7 +69,7 @@ pub enum FileCamera {
     /// The renderer's own matrices, used as they are.
     Matrices(View),
     /// A glTF file's camera.
-    Gltf(crate::mesh::gltf::GltfCamera),
+    Gltf(crate::mesh::formats::gltf::GltfCamera),
 }
 
 impl FileCamera {

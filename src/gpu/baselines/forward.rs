@@ -8,15 +8,15 @@ use super::raster::{
     check_vertex_storage, color_targets, depth_state, encode_snippet, pipeline_layout, slot_layout,
     RasterFrame,
 };
-use super::{shaders, GpuTimer, MeshStore, PassOptions};
 use crate::error::{Error, Result};
+use crate::gpu::{shaders, GpuTimer, MeshStore, PassOptions};
 use crate::scene::Scene;
 use crate::style::Style;
 use std::sync::atomic::{AtomicU32, Ordering};
 
 /// The forward single-pass module for an output of `format`: common.wgsl, scene.wgsl and
 /// forward.wgsl.
-pub fn forward_source(format: wgpu::TextureFormat, split: bool) -> Option<String> {
+pub(crate) fn forward_source(format: wgpu::TextureFormat, split: bool) -> Option<String> {
     let encode = encode_snippet(format)?;
     let flags: &[&str] = if split { &["SPLIT"] } else { &[] };
     Some(shaders::assemble(
@@ -234,8 +234,8 @@ impl ForwardPass {
 
 #[cfg(test)]
 mod tests {
-    use super::super::raster::clear_color;
     use super::*;
+    use crate::gpu::targets::clear_color;
     use crate::style::linear_to_srgb;
 
     #[test]

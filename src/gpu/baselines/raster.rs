@@ -3,14 +3,14 @@
 //! frames. Their scene data is the deferred pass's ([`FrameData`]), bound through the same
 //! scaffolding.
 
-use super::bindings::{self, store_resources, Res, Sources};
-use super::frame::{FrameData, Window};
-use super::mesh_store::MeshStore;
-use super::targets::{DEPTH_FORMAT, ID_FORMAT};
-use super::texture_2d;
 use crate::error::{Error, Result};
+use crate::gpu::bindings::{self, store_resources, Res, Sources};
+use crate::gpu::frame::{FrameData, Window};
+use crate::gpu::mesh_store::MeshStore;
+use crate::gpu::targets::{clear_color, cleared, DEPTH_FORMAT, ID_FORMAT};
+use crate::gpu::texture_2d;
 use crate::scene::Scene;
-use crate::style::{linear_to_srgb, Style};
+use crate::style::Style;
 
 /// The distance the shaders write where no edge is drawn (WGSL `NO_EDGE`).
 const NO_EDGE: f32 = 3.0e38;
@@ -30,41 +30,15 @@ pub(super) fn encode_snippet(format: wgpu::TextureFormat) -> Option<&'static str
     match format {
         F::Rgba8Unorm | F::Rgba8UnormSrgb | F::Rgba16Float | F::Rgba32Float => {
             // Only Rgba8Unorm holds encoded values the hardware does not encode itself.
-            Some(super::shaders::encode_output(if format == F::Rgba8Unorm {
-                F::Rgba8Unorm
-            } else {
-                F::Rgba32Float
-            }))
+            Some(crate::gpu::shaders::encode_output(
+                if format == F::Rgba8Unorm {
+                    F::Rgba8Unorm
+                } else {
+                    F::Rgba32Float
+                },
+            ))
         }
         _ => None,
-    }
-}
-
-/// A colour attachment cleared to `color` when the pass begins, and stored.
-pub(super) fn cleared(
-    view: &wgpu::TextureView,
-    color: wgpu::Color,
-) -> Option<wgpu::RenderPassColorAttachment<'_>> {
-    Some(wgpu::RenderPassColorAttachment {
-        view,
-        depth_slice: None,
-        resolve_target: None,
-        ops: wgpu::Operations {
-            load: wgpu::LoadOp::Clear(color),
-            store: wgpu::StoreOp::Store,
-        },
-    })
-}
-
-/// The clear colour of an output of `format` for the linear background `bg`.
-pub(super) fn clear_color(format: wgpu::TextureFormat, bg: [f32; 4]) -> wgpu::Color {
-    let encode = format == wgpu::TextureFormat::Rgba8Unorm;
-    let c = |v: f32| f64::from(if encode { linear_to_srgb(v) } else { v });
-    wgpu::Color {
-        r: c(bg[0]),
-        g: c(bg[1]),
-        b: c(bg[2]),
-        a: f64::from(bg[3]),
     }
 }
 
@@ -93,11 +67,11 @@ pub(super) fn pipeline_layout(
 pub(super) fn slot_layout() -> wgpu::VertexBufferLayout<'static> {
     const SLOT: [wgpu::VertexAttribute; 1] = [wgpu::VertexAttribute {
         format: wgpu::VertexFormat::Uint32,
-        offset: super::frame::INSTANCE_INDEX_OFFSET,
+        offset: crate::gpu::frame::INSTANCE_INDEX_OFFSET,
         shader_location: 7,
     }];
     wgpu::VertexBufferLayout {
-        array_stride: std::mem::size_of::<super::frame::InstanceRecord>() as u64,
+        array_stride: std::mem::size_of::<crate::gpu::frame::InstanceRecord>() as u64,
         step_mode: wgpu::VertexStepMode::Instance,
         attributes: &SLOT,
     }

@@ -25,8 +25,8 @@ use crate::edge_math;
 use crate::error::{Error, Result};
 use crate::gpu::light_world_dir;
 use crate::mesh::{patches::Patches, ALL_EDGES};
-use crate::render::{Frame, Shot, World, BACKGROUND, HOST};
 use crate::style::{self, Color};
+use crate::world::{Rendering, Shot, World, BACKGROUND, HOST};
 use glam::{DMat3, DMat4, DVec2, DVec3, DVec4, Vec3A};
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::Bvh2;
@@ -552,8 +552,8 @@ impl HostMap {
 }
 
 /// Renders `shot` by ray casting on the CPU in f64: the reference every GPU method is
-/// measured against. Fills every map of the [`Frame`].
-pub fn render_raycast(shot: &Shot<'_>) -> Result<Frame> {
+/// measured against. Fills every map of the [`Rendering`].
+pub fn render_raycast(shot: &Shot<'_>) -> Result<Rendering> {
     render_raycast_over(shot, None)
 }
 
@@ -561,7 +561,7 @@ pub fn render_raycast(shot: &Shot<'_>) -> Result<Frame> {
 /// [`HOST`] and its lines are hidden; an outline point is hidden where the pixel containing
 /// it shows the host and the host's depth there is nearer, and no outline is drawn into a
 /// pixel that shows the host where the host is nearer than the outline's point.
-pub fn render_raycast_over(shot: &Shot<'_>, host: Option<&HostOccluders<'_>>) -> Result<Frame> {
+pub fn render_raycast_over(shot: &Shot<'_>, host: Option<&HostOccluders<'_>>) -> Result<Rendering> {
     let (width, height) = shot.size;
     if width == 0 || height == 0 {
         return Err(Error::InvalidSetting(format!(
@@ -601,8 +601,14 @@ pub fn render_raycast_over(shot: &Shot<'_>, host: Option<&HostOccluders<'_>>) ->
         .iter()
         .map(|o| edge_math::local_eye(o.transform, shot.view.eye()))
         .collect();
-    let outline =
-        crate::outline::outline_map(&caster, &rays, shot, &styles, &patches, host_map.as_ref());
+    let outline = crate::truth::outline::outline_map(
+        &caster,
+        &rays,
+        shot,
+        &styles,
+        &patches,
+        host_map.as_ref(),
+    );
 
     let pixels = u64::from(width) * u64::from(height);
     let bar = progress_bar(u64::from(height), pixels);
@@ -633,7 +639,7 @@ pub fn render_raycast_over(shot: &Shot<'_>, host: Option<&HostOccluders<'_>>) ->
     bar.finish_and_clear();
 
     let n = pixels as usize;
-    let mut frame = Frame {
+    let mut frame = Rendering {
         size: shot.size,
         rgba: Vec::with_capacity(4 * n),
         ids: Vec::with_capacity(n),
@@ -910,7 +916,7 @@ mod tests {
         // Two copies of the quad: one moved back and mirrored; rays see the nearer first,
         // and the farther one's ids follow the first's.
         let mut world = World::single(quad(), EdgeSelection::All);
-        world.objects.push(crate::render::Object {
+        world.objects.push(crate::world::Object {
             mesh: 0,
             transform: DMat4::from_translation(DVec3::new(0.5, 0.0, -2.0))
                 * DMat4::from_scale(DVec3::new(-1.0, 1.0, 1.0)),

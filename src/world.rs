@@ -1,0 +1,232 @@
+//! The CPU description of what tools draw and compare: a [`World`] of meshes placed as
+//! objects, a [`Shot`] of it (view, style, size), and the [`Rendering`] a method makes of a
+//! shot (image, ids, depth, edge distances). The ground truth and the offline GPU
+//! frames both speak in these terms.
+//!
+//! Triangle ids in every map are **global**: objects are numbered in the world's order, each
+//! object's triangles consecutive in the order its mesh file lists them.
+
+use crate::camera::View;
+use crate::error::{Error, Result};
+use crate::mesh::{EdgeSelection, Mesh};
+use crate::scene::InstanceStyle;
+use crate::style::Style;
+use glam::{DMat4, DVec3};
+use std::sync::Arc;
+
+/// Id of pixels that show no triangle.
+pub const BACKGROUND: u32 = u32::MAX;
+/// Id of pixels where the host's own geometry is in front.
+pub const HOST: u32 = u32::MAX - 1;
+
+/// A mesh of a world, with the edges drawn on it.
+#[derive(Clone, Debug)]
+pub struct WorldMesh {
+    /// The mesh, in its own coordinates.
+    pub mesh: Arc<Mesh>,
+    /// Which of its edges are drawn.
+    pub edges: EdgeSelection,
+    /// Where it came from, for messages.
+    pub name: String,
+}
+
+/// One placement of a world mesh.
+#[derive(Clone, Debug)]
+pub struct Object {
+    /// Index into [`World::meshes`].
+    pub mesh: usize,
+    /// Model → world.
+    pub transform: DMat4,
+    /// Style overrides.
+    pub style: InstanceStyle,
+}
+
+/// Meshes and their placements: what tools render, compare and time.
+#[derive(Clone, Debug, Default)]
+pub struct World {
+    /// The distinct meshes (each uploaded once).
+    pub meshes: Vec<WorldMesh>,
+    /// The objects, in order; several may share a mesh.
+    pub objects: Vec<Object>,
+}
+
+impl World {
+    /// One mesh, placed once at the origin.
+    pub fn single(mesh: Mesh, edges: EdgeSelection) -> World {
+        World {
+            meshes: vec![WorldMesh {
+                mesh: Arc::new(mesh),
+                edges,
+                name: "mesh".into(),
+            }],
+            objects: vec![Object {
+                mesh: 0,
+                transform: DMat4::IDENTITY,
+                style: InstanceStyle::default(),
+            }],
+        }
+    }
+
+    /// Checks the objects' meshes and that every global id fits the id maps.
+    pub fn validate(&self) -> Result<()> {
+        for (i, o) in self.objects.iter().enumerate() {
+            if o.mesh >= self.meshes.len() {
+                return Err(Error::InvalidScene(format!(
+                    "object {i} refers to mesh {} of {}",
+                    o.mesh,
+                    self.meshes.len()
+                )));
+            }
+        }
+        let total = self.triangle_count();
+        if total >= u64::from(HOST) {
+            return Err(Error::InvalidScene(format!(
+                "{total} triangles over all objects: global ids must stay below {HOST}"
+            )));
+        }
+        Ok(())
+    }
+
+    /// Triangles over all objects.
+    pub fn triangle_count(&self) -> u64 {
+        self.objects
+            .iter()
+            .map(|o| self.meshes[o.mesh].mesh.triangle_count() as u64)
+            .sum()
+    }
+
+    /// The global id of each object's first triangle.
+    pub fn first_ids(&self) -> Vec<u32> {
+        let mut next = 0u64;
+        self.objects
+            .iter()
+            .map(|o| {
+                let first = next;
+                next += self.meshes[o.mesh].mesh.triangle_count() as u64;
+                first as u32
+            })
+            .collect()
+    }
+
+    /// The object and triangle of global id `id`.
+    pub fn locate(&self, first_ids: &[u32], id: u32) -> (usize, u32) {
+        let o = first_ids.partition_point(|&f| f <= id).saturating_sub(1);
+        (o, id - first_ids[o])
+    }
+
+    /// Axis-aligned world bounds of every object (its mesh's bounding box, transformed).
+    pub fn bounds(&self) -> (DVec3, DVec3) {
+        let mut lo = DVec3::splat(f64::INFINITY);
+        let mut hi = DVec3::splat(f64::NEG_INFINITY);
+        for o in &self.objects {
+            let (a, b) = self.meshes[o.mesh].mesh.bounds_f64();
+            for i in 0..8 {
+                let c = DVec3::new(
+                    if i & 1 == 0 { a.x } else { b.x },
+                    if i & 2 == 0 { a.y } else { b.y },
+                    if i & 4 == 0 { a.z } else { b.z },
+                );
+                let p = o.transform.transform_point3(c);
+                lo = lo.min(p);
+                hi = hi.max(p);
+            }
+        }
+        (lo, hi)
+    }
+}
+
+#[cfg(feature = "formats")]
+impl World {
+    /// A glTF scene as a world: each glTF mesh once, an object per instance in node order,
+    /// with the file's line width where it gives one. Each mesh draws `edges`, or, when that
+    /// is `None`, its authored edges where it has them (polygon edges otherwise); see
+    /// [`Mesh::resolve_edges`] for what an explicit selection does to the file's outline mask.
+    pub fn from_gltf(
+        doc: crate::mesh::formats::gltf::Document,
+        edges: Option<EdgeSelection>,
+    ) -> World {
+        let widths: Vec<Option<f32>> = doc.meshes.iter().map(|m| m.line_width).collect();
+        let meshes = doc
+            .meshes
+            .into_iter()
+            .map(|m| {
+                let (mesh, edges) = m.mesh.resolve_edges(edges.or(m.edges));
+                WorldMesh {
+                    mesh: Arc::new(mesh),
+                    edges,
+                    name: m.name,
+                }
+            })
+            .collect();
+        let objects = doc
+            .instances
+            .into_iter()
+            .map(|(mesh, transform)| Object {
+                mesh,
+                transform,
+                style: InstanceStyle {
+                    line_width: widths[mesh],
+                    ..InstanceStyle::default()
+                },
+            })
+            .collect();
+        World { meshes, objects }
+    }
+}
+
+/// The built-in scene: a torus and a sphere, two meshes drawing `edges`.
+pub fn default_world(edges: EdgeSelection) -> World {
+    let mut world = World::default();
+    // The parts are constant and valid (tests check it); an error cannot occur here.
+    for (i, (mesh, transform)) in crate::mesh::default_parts()
+        .into_iter()
+        .flatten()
+        .enumerate()
+    {
+        world.meshes.push(WorldMesh {
+            mesh: Arc::new(mesh),
+            edges,
+            name: ["torus", "sphere"][i].into(),
+        });
+        world.objects.push(Object {
+            mesh: i,
+            transform,
+            style: InstanceStyle::default(),
+        });
+    }
+    world
+}
+
+/// What one render draws: a world, through a view, in a style, at a size.
+#[derive(Clone, Copy, Debug)]
+pub struct Shot<'a> {
+    /// The meshes and objects.
+    pub world: &'a World,
+    /// How they are seen.
+    pub view: View,
+    /// Colours, line width, lighting.
+    pub style: &'a Style,
+    /// Image size in pixels.
+    pub size: (u32, u32),
+}
+
+/// What one method drew of a shot, on the CPU. Maps are row-major, row 0 at the top.
+#[derive(Clone, Debug)]
+pub struct Rendering {
+    /// Width and height in pixels.
+    pub size: (u32, u32),
+    /// 8-bit sRGB RGBA image.
+    pub rgba: Vec<u8>,
+    /// Global id of the visible triangle per pixel: [`BACKGROUND`] where none is.
+    pub ids: Vec<u32>,
+    /// Depth in the standard convention: 0 at the near plane, 1 at the far plane and on
+    /// background.
+    pub depth: Vec<f32>,
+    /// Pixels to the line that colours the pixel most (a drawn edge of the visible triangle,
+    /// or, with outlines, an outline within reach; background pixels included): with lines
+    /// of one width and no depth fade, the nearest line. `inf` where there is none.
+    /// The forward method reports its interpolated altitudes as they come (NaN where they
+    /// are NaN); the two-pass method measures no distance and reports 0 where it drew a line
+    /// fragment, `inf` elsewhere.
+    pub edge_distance: Vec<f32>,
+}
