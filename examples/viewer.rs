@@ -239,13 +239,7 @@ impl Viewer {
                 ..Default::default()
             },
         )?;
-        let forward = match ForwardPass::new(
-            &device,
-            PassOptions {
-                output_format: wgpu::TextureFormat::Rgba8UnormSrgb,
-                ..Default::default()
-            },
-        ) {
+        let forward = match ForwardPass::new(&device, wgpu::TextureFormat::Rgba8UnormSrgb) {
             Ok(pass) => Some((pass, Blit::new(&device, view_format))),
             Err(e) => {
                 eprintln!("viewer: the forward method is unavailable: {e}");

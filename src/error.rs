@@ -2,8 +2,10 @@
 
 use std::path::PathBuf;
 
-/// Everything that can go wrong in wirepass, from a malformed file to a lost device.
+/// Everything that can go wrong in wirepass, from a malformed file to a lost device. New
+/// variants may come with new features, so a `match` needs a catch-all arm.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum Error {
     /// No adapter matched the request (backend, name) on this machine.
     #[error("no GPU adapter found: {0}")]
@@ -37,6 +39,7 @@ pub enum Error {
     #[error("invalid scene: {0}")]
     InvalidScene(String),
     /// A scene file could not be read; the message names the field.
+    #[cfg(feature = "tools")]
     #[error("{}: {message}", path.display())]
     SceneFile {
         /// The file that was read.
@@ -76,6 +79,7 @@ pub enum Error {
         source: std::io::Error,
     },
     /// Encoding or decoding an image failed.
+    #[cfg(feature = "regression")]
     #[error("{}: {message}", path.display())]
     Image {
         /// The file concerned.

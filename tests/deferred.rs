@@ -5,7 +5,7 @@ mod common;
 
 use common::{camera, cpu_distance, framing, gpu, load, shoot};
 use glam::{DMat4, Vec3};
-use wirepass::gpu::{DeferredPass, MeshStore, OutputTarget, PassOptions};
+use wirepass::gpu::{DeferredPass, EncodeOptions, MeshStore, OutputTarget, PassOptions};
 use wirepass::tools::offline::Method;
 use wirepass::world::{Rendering, BACKGROUND};
 use wirepass::{Camera, EdgeSelection, Instance, Mesh, Scene, Style};
@@ -296,12 +296,16 @@ fn overlay_blends_lines_over_the_host_image_and_resizes() {
             },
         )
         .unwrap();
-        pass.encode_edges(
+        pass.encode_with(
             device,
             &mut encoder,
             &store,
             &frame,
             OutputTarget::Diagnostic,
+            EncodeOptions {
+                reuse_ids: true,
+                ..Default::default()
+            },
         )
         .unwrap();
         ctx.queue.submit([encoder.finish()]);
@@ -368,13 +372,16 @@ fn timer_reports_every_pass() {
         .expect("software adapters expose TIMESTAMP_QUERY");
     for _ in 0..2 {
         let mut encoder = device.create_command_encoder(&Default::default());
-        pass.encode_timed(
+        pass.encode_with(
             device,
             &mut encoder,
             &store,
             &frame,
             OutputTarget::Diagnostic,
-            &mut timer,
+            EncodeOptions {
+                timer: Some(&mut timer),
+                ..Default::default()
+            },
         )
         .unwrap();
         timer.resolve(&mut encoder);

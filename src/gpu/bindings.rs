@@ -37,7 +37,10 @@ pub(crate) enum Res {
     OutColor = 20,
     /// The host's colour image, for overlay.
     HostColor = 21,
+    // The diagnostic maps: written only with the diagnostics feature.
+    #[cfg_attr(not(feature = "diagnostics"), allow(dead_code))]
     OutDiagnostic = 22,
+    #[cfg_attr(not(feature = "diagnostics"), allow(dead_code))]
     OutIds = 23,
     /// The edge pass's list of tiles for `tile_main`.
     TilesRw = 24,

@@ -8,6 +8,8 @@ use super::host_depth::{HostFrame, HostImport};
 use super::mesh_store::MeshStore;
 use super::targets::{self, TargetSpec, Targets, LIST_HEADER, RESULT_FORMAT};
 use super::visibility::Visibility;
+#[cfg(feature = "diagnostics")]
+use super::EncodeOptions;
 use super::{shaders, GpuTimer};
 use crate::error::{Error, Result};
 use crate::scene::Scene;
@@ -87,9 +89,11 @@ pub enum OutputTarget<'a> {
     /// [`DeferredPass::with_diagnostics`]): the distance in pixels to the line and the
     /// reverse depth of the visible point, and the (instance slot, triangle) after the exact
     /// coverage test.
+    #[cfg(feature = "diagnostics")]
     Diagnostic,
     /// The benchmark floor: reads each pixel's id and writes the fill or background colour
     /// into the output, doing none of the edge work. What a deferred pass cannot go below.
+    #[cfg(feature = "diagnostics")]
     Floor(&'a wgpu::TextureView),
     /// The frame's own result, which [`DeferredPass::render`] then draws into the host's
     /// render pass (needs [`PassOptions::render_target`]).
@@ -100,8 +104,13 @@ pub enum OutputTarget<'a> {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 enum Mode {
     Shade,
-    Overlay { encoded: bool },
-    Result { shaded: bool },
+    Overlay {
+        encoded: bool,
+    },
+    Result {
+        shaded: bool,
+    },
+    #[cfg(feature = "diagnostics")]
     Diagnostic,
 }
 
@@ -161,6 +170,7 @@ pub struct PreparedFrame {
 
 /// How much of a frame the edge pass's later dispatches took on (see
 /// [`PreparedFrame::edge_work`]).
+#[cfg(feature = "diagnostics")]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct EdgeWork {
     /// 8×8 output tiles holding foreground, which the tile dispatch visited.
@@ -186,6 +196,7 @@ pub struct EdgeWork {
     pub piece_room: u32,
 }
 
+#[cfg(feature = "diagnostics")]
 impl PreparedFrame {
     /// What the outline pass and the edge pass's tile and refine dispatches took on in the
     /// last encode of this frame, read back from the GPU (it waits for the work submitted so
@@ -220,7 +231,9 @@ impl PreparedFrame {
             piece_room: t.piece_room(),
         })
     }
+}
 
+impl PreparedFrame {
     /// The output size.
     pub fn output_size(&self) -> (u32, u32) {
         self.targets.output
@@ -239,11 +252,13 @@ impl PreparedFrame {
 
     /// The (instance slot, triangle) each output pixel centre sees after the exact coverage
     /// test, written by [`OutputTarget::Diagnostic`].
+    #[cfg(feature = "diagnostics")]
     pub fn resolved_id_texture(&self) -> Option<&wgpu::Texture> {
         self.targets.diagnostic.as_ref().map(|d| &d.1)
     }
 
     /// The diagnostic map written by [`OutputTarget::Diagnostic`].
+    #[cfg(feature = "diagnostics")]
     pub fn diagnostic_texture(&self) -> Option<&wgpu::Texture> {
         self.targets.diagnostic.as_ref().map(|d| &d.0)
     }
@@ -323,6 +338,8 @@ pub struct DeferredPass {
     host: HostImport,
     edge: Mutex<HashMap<(Mode, Variant), Arc<EdgePipelines>>>,
     outline: Mutex<HashMap<Variant, Arc<OutlinePipelines>>>,
+    /// The benchmark floor's pipeline ([`OutputTarget::Floor`]).
+    #[cfg(feature = "diagnostics")]
     floor: Compute,
     composite: Option<(CompositePipeline, Composite)>,
     /// Counts the encodes that write a result for [`render`](Self::render).
@@ -361,10 +378,10 @@ impl DeferredPass {
         }
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let visibility = Visibility::new(device, pulled)?;
-        let floor_module = edge_module(device, format, &["MODE_FLOOR"]);
+        #[cfg(feature = "diagnostics")]
         let floor = Compute::new(
             device,
-            &floor_module,
+            &edge_module(device, format, &["MODE_FLOOR"]),
             "floor_main",
             vec![Res::Frame, Res::Ids, Res::OutColor],
             format,
@@ -388,6 +405,7 @@ impl DeferredPass {
             host: HostImport::new(),
             edge: Mutex::default(),
             outline: Mutex::default(),
+            #[cfg(feature = "diagnostics")]
             floor,
             composite,
             results: AtomicU64::new(0),
@@ -400,6 +418,7 @@ impl DeferredPass {
 
     /// Enables [`OutputTarget::Diagnostic`], which needs 24 more bytes of targets per pixel;
     /// tools and tests use it, a renderer does not need it.
+    #[cfg(feature = "diagnostics")]
     pub fn with_diagnostics(mut self) -> Self {
         self.diagnostics = true;
         self.targets = None;
@@ -526,7 +545,9 @@ impl DeferredPass {
                 frame.data.uniforms.background(),
             )),
             Mode::Result { .. } => Some(wgpu::Color::TRANSPARENT),
-            Mode::Overlay { .. } | Mode::Diagnostic => None,
+            Mode::Overlay { .. } => None,
+            #[cfg(feature = "diagnostics")]
+            Mode::Diagnostic => None,
         }
     }
 
@@ -575,6 +596,7 @@ impl DeferredPass {
                 }
                 (vec![Res::OutColor], RESULT_FORMAT)
             }
+            #[cfg(feature = "diagnostics")]
             Mode::Diagnostic => {
                 flags.push("MODE_DIAGNOSTIC");
                 (vec![Res::OutDiagnostic, Res::OutIds], self.format)
@@ -710,34 +732,29 @@ impl DeferredPass {
         self.encode_inner(device, encoder, store, frame, target, None, true)
     }
 
-    /// [`encode`](Self::encode) with GPU timestamps around each pass, named
-    /// `"visibility"`, `"outline.cull"`, `"outline.draw"` and `"outline.pieces"` (when outlines
-    /// are drawn), and `"edge.classify"`, `"edge.border"`, `"edge.clear"` or
-    /// `"edge.background"` (whichever lays down the background), `"edge.outlined"` (with
-    /// outlines), `"edge.tiles"` and `"edge.refine"`, in `timer`.
-    pub fn encode_timed(
+    /// [`encode`](Self::encode) with what tools add (see [`EncodeOptions`]): timestamps
+    /// around each pass, or a second output over the ids the last encode of this frame
+    /// rasterized.
+    #[cfg(feature = "diagnostics")]
+    pub fn encode_with(
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
         store: &MeshStore,
         frame: &PreparedFrame,
         target: OutputTarget<'_>,
-        timer: &mut GpuTimer,
+        options: EncodeOptions<'_>,
     ) -> Result<()> {
-        self.encode_inner(device, encoder, store, frame, target, Some(timer), true)
-    }
-
-    /// Records the outline and edge passes only, over the ids the last encode of this frame
-    /// rasterized: e.g. a second output of the same frame.
-    pub fn encode_edges(
-        &self,
-        device: &wgpu::Device,
-        encoder: &mut wgpu::CommandEncoder,
-        store: &MeshStore,
-        frame: &PreparedFrame,
-        target: OutputTarget<'_>,
-    ) -> Result<()> {
-        self.encode_inner(device, encoder, store, frame, target, None, false)
+        let visibility = !options.reuse_ids;
+        self.encode_inner(
+            device,
+            encoder,
+            store,
+            frame,
+            target,
+            options.timer,
+            visibility,
+        )
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -781,10 +798,12 @@ impl DeferredPass {
                 let shaded = *content == Composite::Shaded;
                 (Some(Mode::Result { shaded }), Some(&result_view), None)
             }
+            #[cfg(feature = "diagnostics")]
             OutputTarget::Floor(v) => {
                 check_storage_output(v, self.format, t.output, "the output texture")?;
                 (None, Some(*v), None)
             }
+            #[cfg(feature = "diagnostics")]
             OutputTarget::Diagnostic => {
                 if t.diagnostic.is_none() {
                     return Err(Error::Misuse(
@@ -832,12 +851,22 @@ impl DeferredPass {
             ..Sources::frame(&frame.data)
         };
         let (w, h) = t.output;
-        let Some(mode) = mode else {
+        // Only the floor has no edge mode.
+        #[cfg(feature = "diagnostics")]
+        let Some(mode) = mode
+        else {
             let group = self.floor.bind(device, &sources)?;
             let names = ("wirepass floor", "edge.floor");
             let size = Size::Grid(w.div_ceil(TILE), h.div_ceil(TILE));
             dispatch(encoder, timer, names, (&self.floor, &group), size);
             return Ok(());
+        };
+        #[cfg(not(feature = "diagnostics"))]
+        let Some(mode) = mode
+        else {
+            return Err(Error::Misuse(
+                "the floor needs the diagnostics feature".into(),
+            ));
         };
         let variant = self.variant(frame);
         if variant.outlines {

@@ -5,12 +5,15 @@ mod bindings;
 mod composite;
 mod context;
 mod deferred;
+#[cfg(feature = "diagnostics")]
+mod diagnostics;
 mod frame;
 mod host_depth;
 mod mesh_store;
 mod readback;
 pub mod shaders;
 mod targets;
+#[cfg_attr(not(feature = "diagnostics"), allow(dead_code))]
 mod timing;
 mod visibility;
 
@@ -19,7 +22,11 @@ pub use baselines::{
 };
 pub use composite::{Composite, RenderTarget};
 pub use context::GpuContext;
-pub use deferred::{DeferredPass, EdgeWork, OutputTarget, PassOptions, PreparedFrame, TriangleIds};
+#[cfg(feature = "diagnostics")]
+pub use deferred::EdgeWork;
+pub use deferred::{DeferredPass, OutputTarget, PassOptions, PreparedFrame, TriangleIds};
+#[cfg(feature = "diagnostics")]
+pub use diagnostics::EncodeOptions;
 pub use frame::{light_world_dir, Canvas, Window, MAX_INSTANCES};
 pub use host_depth::{depth_quantum, HostDepth};
 pub use mesh_store::{MeshId, MeshStore};
@@ -27,7 +34,10 @@ pub use readback::read_texture;
 pub use targets::{
     DEPTH_FORMAT, DIAGNOSTIC_FORMAT, HOST_FORMAT, ID_FORMAT, RESOLVED_ID_FORMAT, RESULT_FORMAT,
 };
+#[cfg(feature = "diagnostics")]
 pub use timing::GpuTimer;
+#[cfg(not(feature = "diagnostics"))]
+use timing::GpuTimer;
 
 use crate::error::{Error, Result};
 

@@ -54,6 +54,7 @@ pub fn read_texture(
 
 /// Reads `size` bytes of `buffer` from `offset` (both multiples of 4), once the work
 /// submitted before has finished.
+#[cfg(feature = "diagnostics")]
 pub(crate) fn read_buffer(
     device: &wgpu::Device,
     queue: &wgpu::Queue,

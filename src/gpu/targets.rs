@@ -84,6 +84,7 @@ impl Targets {
         }
     }
 
+    #[cfg(feature = "diagnostics")]
     /// Pieces the outline pass's list has room for (outline.wgsl, `piece_room`).
     pub fn piece_room(&self) -> u32 {
         let room = (self.acc.size() - self.acc_pieces - LIST_HEADER) / PIECE_BYTES;

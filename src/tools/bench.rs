@@ -5,8 +5,8 @@
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::gpu::{
-    texture_2d, DeferredPass, EdgeLines, ForwardPass, GpuContext, GpuTimer, MeshStore,
-    OutputTarget, PassOptions, PreparedFrame, RasterFrame, TwoPass,
+    texture_2d, DeferredPass, EdgeLines, EncodeOptions, ForwardPass, GpuContext, GpuTimer,
+    MeshStore, OutputTarget, PassOptions, PreparedFrame, RasterFrame, TwoPass,
 };
 use crate::mesh::EdgeSelection;
 use crate::style::Style;
@@ -122,25 +122,75 @@ impl Subject {
             Subject::Floor(pass, frame, out) => {
                 let view = out.create_view(&Default::default());
                 let target = OutputTarget::Floor(&view);
-                pass.encode_timed(device, encoder, store, frame, target, timer)
+                pass.encode_with(
+                    device,
+                    encoder,
+                    store,
+                    frame,
+                    target,
+                    EncodeOptions {
+                        timer: Some(timer),
+                        ..Default::default()
+                    },
+                )
             }
             Subject::Deferred(pass, frame, out) => {
                 let view = out.create_view(&Default::default());
                 let target = OutputTarget::Shaded(&view);
-                pass.encode_timed(device, encoder, store, frame, target, timer)
+                pass.encode_with(
+                    device,
+                    encoder,
+                    store,
+                    frame,
+                    target,
+                    EncodeOptions {
+                        timer: Some(timer),
+                        ..Default::default()
+                    },
+                )
             }
             Subject::Edges(_, up, pass, frame, out) => {
                 let view = out.create_view(&Default::default());
                 let target = OutputTarget::Shaded(&view);
-                pass.encode_timed(device, encoder, &up.store, frame, target, timer)
+                pass.encode_with(
+                    device,
+                    encoder,
+                    &up.store,
+                    frame,
+                    target,
+                    EncodeOptions {
+                        timer: Some(timer),
+                        ..Default::default()
+                    },
+                )
             }
             Subject::Forward(pass, frame, out) => {
                 let view = out.create_view(&Default::default());
-                pass.encode_timed(device, encoder, store, frame, &view, timer)
+                pass.encode_with(
+                    device,
+                    encoder,
+                    store,
+                    frame,
+                    &view,
+                    EncodeOptions {
+                        timer: Some(timer),
+                        ..Default::default()
+                    },
+                )
             }
             Subject::TwoPass(pass, frame, out) => {
                 let view = out.create_view(&Default::default());
-                pass.encode_timed(device, encoder, (store, lines), frame, &view, timer)
+                pass.encode_with(
+                    device,
+                    encoder,
+                    (store, lines),
+                    frame,
+                    &view,
+                    EncodeOptions {
+                        timer: Some(timer),
+                        ..Default::default()
+                    },
+                )
             }
         }
     }
@@ -278,19 +328,10 @@ pub fn bench_scene(
             usage,
         )
     };
-    let forward_options = PassOptions {
-        output_format: wgpu::TextureFormat::Rgba8UnormSrgb,
-        ..Default::default()
-    };
+    let forward_format = wgpu::TextureFormat::Rgba8UnormSrgb;
     let attachment = || {
         let usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
-        texture_2d(
-            device,
-            "wirepass bench output",
-            size,
-            forward_options.output_format,
-            usage,
-        )
+        texture_2d(device, "wirepass bench output", size, forward_format, usage)
     };
     let mut subjects = Vec::new();
     for floor in [true, false] {
@@ -319,12 +360,12 @@ pub fn bench_scene(
         subjects.push(Subject::Edges(selection, up, pass, frame, storage()));
     }
     if timed(Timed::Forward) {
-        let mut forward = ForwardPass::new(device, forward_options)?;
+        let mut forward = ForwardPass::new(device, forward_format)?;
         let frame = forward.prepare(device, &up.store, &scene, shot.style, size)?;
         subjects.push(Subject::Forward(forward, frame, attachment()));
     }
     if timed(Timed::TwoPass) {
-        let mut two_pass = TwoPass::new(device, forward_options)?;
+        let mut two_pass = TwoPass::new(device, forward_format)?;
         let frame = two_pass.prepare(device, &up.store, &scene, shot.style, size)?;
         subjects.push(Subject::TwoPass(two_pass, frame, attachment()));
     }

@@ -4,8 +4,8 @@
 use crate::camera::View;
 use crate::error::{Error, Result};
 use crate::gpu::{
-    read_texture, texture_2d, Canvas, DeferredPass, EdgeLines, ForwardPass, GpuContext, MeshId,
-    MeshStore, OutputTarget, PassOptions, TwoPass,
+    read_texture, texture_2d, Canvas, DeferredPass, EdgeLines, EncodeOptions, ForwardPass,
+    GpuContext, MeshId, MeshStore, OutputTarget, PassOptions, TwoPass,
 };
 use crate::scene::{Instance, Scene};
 use crate::world::{Rendering, Shot, World, BACKGROUND, HOST};
@@ -190,12 +190,16 @@ pub fn render_deferred_on(
         &frame,
         OutputTarget::Shaded(&view),
     )?;
-    pass.encode_edges(
+    pass.encode_with(
         device,
         &mut encoder,
         &up.store,
         &frame,
         OutputTarget::Diagnostic,
+        EncodeOptions {
+            reuse_ids: true,
+            ..Default::default()
+        },
     )?;
     ctx.queue.submit([encoder.finish()]);
     ctx.finish()?;
@@ -265,17 +269,23 @@ fn forward_output(device: &wgpu::Device, size: (u32, u32)) -> wgpu::Texture {
 pub fn render_forward(ctx: &GpuContext, shot: &Shot<'_>) -> Result<Rendering> {
     let device = &ctx.device;
     let up = Uploaded::new(ctx, shot.world)?;
-    let options = PassOptions {
-        output_format: FORWARD_OUTPUT,
-        ..Default::default()
-    };
-    let mut pass = ForwardPass::new(device, options)?;
+    let mut pass = ForwardPass::new(device, FORWARD_OUTPUT)?;
     let scene = up.scene(shot.world, shot.view);
     let frame = pass.prepare(device, &up.store, &scene, shot.style, shot.size)?;
     let output = forward_output(device, shot.size);
     let view = output.create_view(&Default::default());
     let mut encoder = device.create_command_encoder(&Default::default());
-    pass.encode_with_maps(device, &mut encoder, &up.store, &frame, &view)?;
+    pass.encode_with(
+        device,
+        &mut encoder,
+        &up.store,
+        &frame,
+        &view,
+        EncodeOptions {
+            maps: true,
+            ..Default::default()
+        },
+    )?;
     ctx.queue.submit([encoder.finish()]);
     ctx.finish()?;
     let maps = (frame.id_texture(), frame.diagnostic_texture());
@@ -295,17 +305,23 @@ pub fn render_two_pass(ctx: &GpuContext, shot: &Shot<'_>) -> Result<Rendering> {
     let device = &ctx.device;
     let up = Uploaded::new(ctx, shot.world)?;
     let lines = up.edge_lines(ctx, shot.world)?;
-    let options = PassOptions {
-        output_format: FORWARD_OUTPUT,
-        ..Default::default()
-    };
-    let mut pass = TwoPass::new(device, options)?;
+    let mut pass = TwoPass::new(device, FORWARD_OUTPUT)?;
     let scene = up.scene(shot.world, shot.view);
     let frame = pass.prepare(device, &up.store, &scene, shot.style, shot.size)?;
     let output = forward_output(device, shot.size);
     let view = output.create_view(&Default::default());
     let mut encoder = device.create_command_encoder(&Default::default());
-    pass.encode_with_maps(device, &mut encoder, (&up.store, &lines), &frame, &view)?;
+    pass.encode_with(
+        device,
+        &mut encoder,
+        (&up.store, &lines),
+        &frame,
+        &view,
+        EncodeOptions {
+            maps: true,
+            ..Default::default()
+        },
+    )?;
     ctx.queue.submit([encoder.finish()]);
     ctx.finish()?;
     let maps = (frame.id_texture(), frame.diagnostic_texture());

@@ -9,7 +9,9 @@ use super::raster::{
     RasterFrame,
 };
 use crate::error::{Error, Result};
-use crate::gpu::{shaders, GpuTimer, MeshStore, PassOptions};
+#[cfg(feature = "diagnostics")]
+use crate::gpu::EncodeOptions;
+use crate::gpu::{shaders, GpuTimer, MeshStore};
 use crate::scene::Scene;
 use crate::style::Style;
 use std::sync::atomic::{AtomicU32, Ordering};
@@ -59,13 +61,12 @@ pub struct ForwardPass {
 }
 
 impl ForwardPass {
-    /// Builds the pipelines for an output of `options.output_format`: `Rgba8Unorm` (written
+    /// Builds the pipelines for an output of `format`: `Rgba8Unorm` (written
     /// sRGB-encoded by the shader, as the deferred pass does), `Rgba8UnormSrgb` (encoded by
     /// the hardware), `Rgba16Float` or `Rgba32Float` (linear). The output needs
     /// `RENDER_ATTACHMENT` usage.
-    pub fn new(device: &wgpu::Device, options: PassOptions) -> Result<Self> {
+    pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat) -> Result<Self> {
         static NEXT: AtomicU32 = AtomicU32::new(1);
-        let format = options.output_format;
         if encode_snippet(format).is_none() {
             return Err(Error::InvalidSetting(format!(
                 "output format {format:?} is not one the forward pass can render to \
@@ -172,29 +173,20 @@ impl ForwardPass {
         self.record(device, encoder, store, frame, output, false, None)
     }
 
-    /// [`encode`](Self::encode) with GPU timestamps around the pass, named `"draw"`.
-    pub fn encode_timed(
+    /// [`encode`](Self::encode) with what tools add: timestamps around the pass (the span
+    /// `"draw"`), and the id and diagnostic maps.
+    #[cfg(feature = "diagnostics")]
+    pub fn encode_with(
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
         store: &MeshStore,
         frame: &RasterFrame,
         output: &wgpu::TextureView,
-        timer: &mut GpuTimer,
+        options: EncodeOptions<'_>,
     ) -> Result<()> {
-        self.record(device, encoder, store, frame, output, false, Some(timer))
-    }
-
-    /// Like [`encode`](Self::encode), and also writes the ids and the diagnostic map.
-    pub fn encode_with_maps(
-        &self,
-        device: &wgpu::Device,
-        encoder: &mut wgpu::CommandEncoder,
-        store: &MeshStore,
-        frame: &RasterFrame,
-        output: &wgpu::TextureView,
-    ) -> Result<()> {
-        self.record(device, encoder, store, frame, output, true, None)
+        let (maps, timer) = (options.maps, options.timer);
+        self.record(device, encoder, store, frame, output, maps, timer)
     }
 
     #[allow(clippy::too_many_arguments)]

@@ -15,7 +15,9 @@ use super::raster::{
 };
 use crate::error::{Error, Result};
 use crate::gpu::mesh_store::VERTEX_BYTES;
-use crate::gpu::{shaders, GpuTimer, MeshId, MeshStore, PassOptions};
+#[cfg(feature = "diagnostics")]
+use crate::gpu::EncodeOptions;
+use crate::gpu::{shaders, GpuTimer, MeshId, MeshStore};
 use crate::mesh::{EdgeSelection, Mesh};
 use crate::scene::Scene;
 use crate::style::Style;
@@ -180,12 +182,11 @@ pub struct TwoPass {
 }
 
 impl TwoPass {
-    /// Builds the pipelines for an output of `options.output_format`: `Rgba8Unorm`,
+    /// Builds the pipelines for an output of `format`: `Rgba8Unorm`,
     /// `Rgba8UnormSrgb` or `Rgba16Float` (the line pass blends, which `Rgba32Float` cannot
     /// without an extra feature). The output needs `RENDER_ATTACHMENT` usage.
-    pub fn new(device: &wgpu::Device, options: PassOptions) -> Result<Self> {
+    pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat) -> Result<Self> {
         static NEXT: AtomicU32 = AtomicU32::new(1);
-        let format = options.output_format;
         if two_pass_source(format, false).is_none() {
             return Err(Error::InvalidSetting(format!(
                 "output format {format:?} is not one the two-pass method can render to \
@@ -332,38 +333,20 @@ impl TwoPass {
         self.record(device, encoder, (store, lines), frame, output, false, None)
     }
 
-    /// [`encode`](Self::encode) with GPU timestamps around the pass (fill and lines share
-    /// one render pass), named `"draw"`.
-    pub fn encode_timed(
+    /// [`encode`](Self::encode) with what tools add: timestamps (fill and lines share one
+    /// render pass, the span `"draw"`), and the id and diagnostic maps.
+    #[cfg(feature = "diagnostics")]
+    pub fn encode_with(
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
         (store, lines): (&MeshStore, &EdgeLines),
         frame: &RasterFrame,
         output: &wgpu::TextureView,
-        timer: &mut GpuTimer,
+        options: EncodeOptions<'_>,
     ) -> Result<()> {
-        self.record(
-            device,
-            encoder,
-            (store, lines),
-            frame,
-            output,
-            false,
-            Some(timer),
-        )
-    }
-
-    /// Like [`encode`](Self::encode), and also writes the ids and the diagnostic map.
-    pub fn encode_with_maps(
-        &self,
-        device: &wgpu::Device,
-        encoder: &mut wgpu::CommandEncoder,
-        (store, lines): (&MeshStore, &EdgeLines),
-        frame: &RasterFrame,
-        output: &wgpu::TextureView,
-    ) -> Result<()> {
-        self.record(device, encoder, (store, lines), frame, output, true, None)
+        let (maps, timer) = (options.maps, options.timer);
+        self.record(device, encoder, (store, lines), frame, output, maps, timer)
     }
 
     #[allow(clippy::too_many_arguments)]
