@@ -78,9 +78,8 @@ struct Instance {
 const INSTANCE_EDGES: u32 = 1u;
 const INSTANCE_OUTLINES: u32 = 2u;
 
-// Instance ids of the id target: background, and host geometry in front (host depth).
-const BACKGROUND_ID: u32 = 0xffffffffu;
-const HOST_ID: u32 = 0xfffffffeu;
+// Instance ids of the id target, BACKGROUND_ID (background) and HOST_ID (host geometry in
+// front), are written before this file from `gpu::BACKGROUND_ID` and `gpu::HOST_ID`.
 
 // Host geometry hides a point only when it is nearer by more than this margin (in reverse
 // depth, for a host depth of reverse value `r` and format step `quantum`), so a host that

@@ -92,10 +92,13 @@ pub struct DepthFade {
 /// and the outline pass look around a pixel.
 pub const MAX_LINE_WIDTH: f32 = 256.0;
 
+/// The line width of [`Style::default`], in pixels.
+pub const DEFAULT_LINE_WIDTH: f32 = 1.5;
+
 impl Default for Style {
     fn default() -> Self {
         Style {
-            line_width: 1.5,
+            line_width: DEFAULT_LINE_WIDTH,
             wire_color: Color([0.005, 0.01, 0.02, 1.0]),
             fill_color: Color([0.55, 0.62, 0.72, 1.0]),
             background: Color([1.0, 1.0, 1.0, 1.0]),

@@ -14,10 +14,10 @@ use crate::style::Style;
 use glam::{DMat4, DVec3};
 use std::sync::Arc;
 
-/// Id of pixels that show no triangle.
-pub const BACKGROUND: u32 = u32::MAX;
-/// Id of pixels where the host's own geometry is in front.
-pub const HOST: u32 = u32::MAX - 1;
+/// Id of pixels that show no triangle (the id target's [`crate::gpu::BACKGROUND_ID`]).
+pub const BACKGROUND: u32 = crate::gpu::BACKGROUND_ID;
+/// Id of pixels where the host's own geometry is in front ([`crate::gpu::HOST_ID`]).
+pub const HOST: u32 = crate::gpu::HOST_ID;
 
 /// A mesh of a world, with the edges drawn on it.
 #[derive(Clone, Debug)]

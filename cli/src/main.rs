@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use wirepass::glam::Vec3;
 use wirepass::gpu::GpuContext;
-use wirepass::style::DepthFade;
+use wirepass::style::{DepthFade, DEFAULT_LINE_WIDTH};
 use wirepass::tools::load::{load_world, parse_size, parse_vec3, CameraPlacement, WorldOptions};
 use wirepass::tools::offline::{render, Method};
 use wirepass::world::{Shot, World};
@@ -98,9 +98,6 @@ fn parse_fade(s: &str) -> std::result::Result<DepthFade, String> {
         end: number(end)?,
     })
 }
-
-/// The line width when neither the command line nor the file gives one.
-const DEFAULT_LINE_WIDTH: f32 = 1.5;
 
 /// Prints the loader's notes, one line each.
 fn print_notes(notes: &[String]) {

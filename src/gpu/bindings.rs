@@ -236,6 +236,9 @@ pub(crate) struct Sources<'a> {
     pub host_color: Option<&'a wgpu::TextureView>,
     pub out_diagnostic: Option<&'a wgpu::TextureView>,
     pub out_ids: Option<&'a wgpu::TextureView>,
+    /// `out_color` and `host_color` are the host's views, which wgpu may reject (another
+    /// device's, say): a bind group holding them is checked under an error scope.
+    pub from_host: bool,
 }
 
 impl<'a> Sources<'a> {
@@ -253,6 +256,7 @@ impl<'a> Sources<'a> {
             host_color: None,
             out_diagnostic: None,
             out_ids: None,
+            from_host: false,
         }
     }
 }
@@ -341,12 +345,18 @@ pub(crate) fn bind_group(
             resource,
         });
     }
-    super::bind_host_resources(
-        device,
-        &wgpu::BindGroupDescriptor {
-            label: Some("wirepass"),
-            layout,
-            entries: &entries,
-        },
-    )
+    let desc = wgpu::BindGroupDescriptor {
+        label: Some("wirepass"),
+        layout,
+        entries: &entries,
+    };
+    let holds_host = resources
+        .iter()
+        .any(|r| matches!(r, Res::OutColor | Res::HostColor));
+    if sources.from_host && holds_host {
+        super::bind_host_resources(device, &desc)
+    } else {
+        // The pass's own resources only: nothing wgpu could reject.
+        Ok(device.create_bind_group(&desc))
+    }
 }

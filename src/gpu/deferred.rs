@@ -7,6 +7,7 @@ use super::frame::{Canvas, FrameData};
 use super::host_depth::{HostFrame, HostImport};
 use super::mesh_store::MeshStore;
 use super::targets::{self, TargetSpec, Targets, LIST_HEADER, RESULT_FORMAT};
+use super::variants::{Mode, Variant};
 use super::visibility::Visibility;
 #[cfg(feature = "diagnostics")]
 use super::EncodeOptions;
@@ -98,34 +99,6 @@ pub enum OutputTarget<'a> {
     /// The frame's own result, which [`DeferredPass::render`] then draws into the host's
     /// render pass (needs [`PassOptions::render_target`]).
     RenderPass,
-}
-
-/// What the edge pass writes, which selects its pipeline.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-enum Mode {
-    Shade,
-    Overlay {
-        encoded: bool,
-    },
-    Result {
-        shaded: bool,
-    },
-    #[cfg(feature = "diagnostics")]
-    Diagnostic,
-}
-
-/// Settings constant over a frame that specialise the compute pipelines.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-struct Variant {
-    split: bool,
-    outlines: bool,
-    patches: bool,
-    colors: bool,
-    host: bool,
-    /// The instance records are bound as a uniform array.
-    uniform_instances: bool,
-    /// The frame has exactly one instance.
-    one_instance: bool,
 }
 
 struct EdgePipelines {
@@ -239,8 +212,9 @@ impl PreparedFrame {
         self.targets.output
     }
 
-    /// The id target (`Rg32Uint`: instance slot, triangle; `u32::MAX` in the first channel
-    /// on background), covering the output and its guard band.
+    /// The id target (`Rg32Uint`: instance slot, triangle; [`BACKGROUND_ID`](super::BACKGROUND_ID)
+    /// in the first channel on background, [`HOST_ID`](super::HOST_ID) where the host's
+    /// geometry is in front), covering the output and its guard band.
     pub fn id_texture(&self) -> &wgpu::Texture {
         &self.targets.ids
     }
@@ -381,7 +355,7 @@ impl DeferredPass {
         #[cfg(feature = "diagnostics")]
         let floor = Compute::new(
             device,
-            &edge_module(device, format, &["MODE_FLOOR"]),
+            &edge_module(device, format, super::variants::FLOOR_FLAGS),
             "floor_main",
             vec![Res::Frame, Res::Ids, Res::OutColor],
             format,
@@ -576,31 +550,14 @@ impl DeferredPass {
         if let Some(p) = cache.get(&(mode, v)) {
             return Ok(p.clone());
         }
-        let mut flags = variant_flags(v);
+        let mut flags = v.flags();
+        flags.extend_from_slice(mode.flags());
         let (out, color) = match mode {
-            Mode::Shade => {
-                flags.push("MODE_SHADE");
-                (vec![Res::OutColor], self.format)
-            }
-            Mode::Overlay { encoded } => {
-                flags.push("MODE_OVERLAY");
-                if encoded {
-                    flags.push("HOST_ENCODED");
-                }
-                (vec![Res::OutColor, Res::HostColor], self.format)
-            }
-            Mode::Result { shaded } => {
-                flags.push("MODE_RESULT");
-                if shaded {
-                    flags.push("SHADED");
-                }
-                (vec![Res::OutColor], RESULT_FORMAT)
-            }
+            Mode::Shade => (vec![Res::OutColor], self.format),
+            Mode::Overlay { .. } => (vec![Res::OutColor, Res::HostColor], self.format),
+            Mode::Result { .. } => (vec![Res::OutColor], RESULT_FORMAT),
             #[cfg(feature = "diagnostics")]
-            Mode::Diagnostic => {
-                flags.push("MODE_DIAGNOSTIC");
-                (vec![Res::OutDiagnostic, Res::OutIds], self.format)
-            }
+            Mode::Diagnostic => (vec![Res::OutDiagnostic, Res::OutIds], self.format),
         };
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let module = edge_module(device, self.format, &flags);
@@ -679,7 +636,7 @@ impl DeferredPass {
             return Ok(p.clone());
         }
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let source = shaders::outline_source(&variant_flags(v));
+        let source = shaders::outline_source(&v.flags());
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("wirepass outline pass"),
             source: wgpu::ShaderSource::Wgsl(source.into()),
@@ -848,6 +805,7 @@ impl DeferredPass {
             host_color,
             out_diagnostic: diag.as_ref(),
             out_ids: resolved.as_ref(),
+            from_host: !matches!(target, OutputTarget::RenderPass),
             ..Sources::frame(&frame.data)
         };
         let (w, h) = t.output;
@@ -1112,32 +1070,6 @@ fn round_to_half(x: f32) -> f32 {
         return f32::INFINITY.copysign(x);
     }
     r
-}
-
-fn variant_flags(v: Variant) -> Vec<&'static str> {
-    let mut flags = Vec::new();
-    if v.split {
-        flags.push("SPLIT");
-    }
-    if v.outlines {
-        flags.push("OUTLINES");
-    }
-    if v.patches {
-        flags.push("PATCHES");
-    }
-    if v.colors {
-        flags.push("COLORS");
-    }
-    if v.host {
-        flags.push("HOST");
-    }
-    if v.uniform_instances {
-        flags.push("UNIFORM_INSTANCES");
-    }
-    if v.one_instance {
-        flags.push("ONE_INSTANCE");
-    }
-    flags
 }
 
 fn edge_module(

@@ -15,6 +15,7 @@ pub mod shaders;
 mod targets;
 #[cfg_attr(not(feature = "diagnostics"), allow(dead_code))]
 mod timing;
+mod variants;
 mod visibility;
 
 pub use baselines::{
@@ -32,7 +33,8 @@ pub use host_depth::{depth_quantum, HostDepth};
 pub use mesh_store::{MeshId, MeshStore};
 pub use readback::read_texture;
 pub use targets::{
-    DEPTH_FORMAT, DIAGNOSTIC_FORMAT, HOST_FORMAT, ID_FORMAT, RESOLVED_ID_FORMAT, RESULT_FORMAT,
+    BACKGROUND_ID, DEPTH_FORMAT, DIAGNOSTIC_FORMAT, HOST_FORMAT, HOST_ID, ID_FORMAT,
+    RESOLVED_ID_FORMAT, RESULT_FORMAT,
 };
 #[cfg(feature = "diagnostics")]
 pub use timing::GpuTimer;

@@ -7,6 +7,8 @@
 //! rasterizer would still pay for, and no binding a device with default limits cannot
 //! afford).
 
+use super::variants::{Mode, Variant};
+
 /// Definitions shared by every pass; the Rust twins live in `edge_math`, `style` and
 /// `gpu::mesh_store`.
 pub const COMMON: &str = include_str!("../../shaders/common.wgsl");
@@ -92,10 +94,20 @@ pub fn assemble(parts: &[&str], flags: &[&str]) -> String {
         .lines()
         .partition(|l| l.trim_start().starts_with("enable "));
     format!(
-        "{}\n{}\n{}\n",
+        "{}\n{}\n{}\n{}\n",
         enables.join("\n"),
+        constants(),
         specialise(COMMON, flags),
         rest.join("\n")
+    )
+}
+
+/// The constants the shaders share with the Rust side, declared from their Rust values.
+fn constants() -> String {
+    format!(
+        "const BACKGROUND_ID: u32 = {}u;\nconst HOST_ID: u32 = {}u;",
+        super::BACKGROUND_ID,
+        super::HOST_ID
     )
 }
 
@@ -141,16 +153,9 @@ pub fn host_depth_source(multisampled: bool) -> String {
     assemble(&[HOST_DEPTH], flags)
 }
 
-/// How the compute passes read the instance records: from storage (many instances), from a
-/// uniform array, or from its only record.
-const INSTANCE_FLAGS: [&[&str]; 3] = [
-    &[],
-    &["UNIFORM_INSTANCES"],
-    &["UNIFORM_INSTANCES", "ONE_INSTANCE"],
-];
-
 /// Every module the crate builds, named by its settings: each pass in each of its
-/// specialisations, for validation without a GPU.
+/// specialisations (the edge and outline passes in every [`Mode`] and [`Variant`] a frame
+/// can select), for validation without a GPU.
 pub fn variants() -> Vec<(String, String)> {
     use wgpu::TextureFormat as F;
     let mut out = vec![("composite".to_string(), COMPOSITE.to_string())];
@@ -168,73 +173,28 @@ pub fn variants() -> Vec<(String, String)> {
             ));
         }
     }
-    let storage = [F::Rgba8Unorm, F::Rgba16Float, F::Rgba32Float];
-    let modes: &[&[&str]] = &[
-        &["MODE_SHADE"],
-        &["MODE_OVERLAY"],
-        &["MODE_OVERLAY", "HOST_ENCODED"],
-        &["MODE_RESULT"],
-        &["MODE_RESULT", "SHADED"],
-        &["MODE_DIAGNOSTIC"],
-        &["MODE_FLOOR"],
-    ];
-    for format in storage {
-        for mode in modes {
-            for split in [false, true] {
-                for (outlines, colors, host) in [
-                    (false, false, false),
-                    (true, false, false),
-                    (true, true, false),
-                    (true, false, true),
-                    (false, false, true),
-                ] {
-                    let mut flags = mode.to_vec();
-                    if split {
-                        flags.push("SPLIT");
-                    }
-                    if host {
-                        flags.push("HOST");
-                    }
-                    if outlines {
-                        flags.push("OUTLINES");
-                    }
-                    if colors {
-                        flags.push("COLORS");
-                    }
-                    // Patch searches with and without outlines, split or not.
-                    if outlines != host {
-                        flags.push("PATCHES");
-                    }
-                    for instances in INSTANCE_FLAGS {
-                        let mut flags = flags.clone();
-                        flags.extend_from_slice(instances);
-                        out.push((
-                            format!("edge {format:?} {flags:?}"),
-                            edge_source(format, &flags),
-                        ));
-                    }
-                }
+    let variants = Variant::all();
+    for format in [F::Rgba8Unorm, F::Rgba16Float, F::Rgba32Float] {
+        out.push((
+            format!("floor {format:?}"),
+            edge_source(format, super::variants::FLOOR_FLAGS),
+        ));
+        for mode in Mode::all() {
+            for v in &variants {
+                let mut flags = v.flags();
+                flags.extend_from_slice(mode.flags());
+                out.push((
+                    format!("edge {format:?} {flags:?}"),
+                    edge_source(format, &flags),
+                ));
             }
         }
     }
+    for v in variants.iter().filter(|v| v.outlines) {
+        let flags = v.flags();
+        out.push((format!("outline {flags:?}"), outline_source(&flags)));
+    }
     for split in [false, true] {
-        for (colors, host) in [(false, false), (true, false), (false, true), (true, true)] {
-            let mut flags = vec![];
-            if split {
-                flags.push("SPLIT");
-            }
-            if host {
-                flags.push("HOST");
-            }
-            if colors {
-                flags.push("COLORS");
-            }
-            for instances in INSTANCE_FLAGS {
-                let mut flags = flags.clone();
-                flags.extend_from_slice(instances);
-                out.push((format!("outline {flags:?}"), outline_source(&flags)));
-            }
-        }
         for format in [
             F::Rgba8Unorm,
             F::Rgba8UnormSrgb,

@@ -6,8 +6,14 @@
 use crate::error::{Error, Result};
 use crate::style::linear_to_srgb;
 
-/// Format of the id target: (instance slot, triangle of its mesh); `u32::MAX` in the first
-/// channel marks background, `u32::MAX − 1` host geometry in front.
+/// The id target's first channel where no triangle is: background.
+pub const BACKGROUND_ID: u32 = u32::MAX;
+/// The id target's first channel where the host's own geometry is in front (with host
+/// depth).
+pub const HOST_ID: u32 = u32::MAX - 1;
+
+/// Format of the id target: (instance slot, triangle of its mesh); [`BACKGROUND_ID`] in the
+/// first channel marks background, [`HOST_ID`] host geometry in front.
 pub const ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Uint;
 /// Format of the depth target (reverse depth: 1 at the near plane, 0 at the far plane).
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;

@@ -4,12 +4,9 @@
 use super::bindings::{self, Res, Sources};
 use super::frame::{FrameData, INSTANCE_BASES_OFFSET, INSTANCE_INDEX_OFFSET};
 use super::mesh_store::VERTEX_BYTES;
-use super::targets::{Targets, DEPTH_FORMAT, ID_FORMAT};
+use super::targets::{Targets, BACKGROUND_ID, DEPTH_FORMAT, ID_FORMAT};
 use super::{shaders, GpuTimer};
 use crate::error::Result;
-
-/// Clear value of the id target's first channel: background.
-pub(crate) const BACKGROUND: u32 = u32::MAX;
 
 /// The visibility pipelines: instanced with `@builtin(primitive_index)`, or vertex-pulled
 /// (`TriangleIds`; then also in a variant for a split store).
@@ -190,7 +187,7 @@ impl Visibility {
                         wgpu::LoadOp::Load
                     } else {
                         wgpu::LoadOp::Clear(wgpu::Color {
-                            r: f64::from(BACKGROUND),
+                            r: f64::from(BACKGROUND_ID),
                             g: 0.0,
                             b: 0.0,
                             a: 0.0,

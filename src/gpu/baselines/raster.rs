@@ -7,7 +7,7 @@ use crate::error::{Error, Result};
 use crate::gpu::bindings::{self, store_resources, Res, Sources};
 use crate::gpu::frame::{FrameData, Window};
 use crate::gpu::mesh_store::MeshStore;
-use crate::gpu::targets::{clear_color, cleared, DEPTH_FORMAT, ID_FORMAT};
+use crate::gpu::targets::{clear_color, cleared, BACKGROUND_ID, DEPTH_FORMAT, ID_FORMAT};
 use crate::gpu::texture_2d;
 use crate::scene::Scene;
 use crate::style::Style;
@@ -179,7 +179,7 @@ impl RasterFrame {
         self.data.window.size
     }
 
-    /// The id map (`Rg32Uint`: instance slot, triangle; `u32::MAX` first on background).
+    /// The id map (`Rg32Uint`: instance slot, triangle; [`BACKGROUND_ID`](crate::gpu::BACKGROUND_ID) first on background).
     pub fn id_texture(&self) -> &wgpu::Texture {
         &self.ids
     }
@@ -276,7 +276,7 @@ impl RasterFrame {
                 b: 0.0,
                 a: 0.0,
             };
-            colors.push(cleared(&ids, uint(u32::MAX)));
+            colors.push(cleared(&ids, uint(BACKGROUND_ID)));
             colors.push(cleared(
                 &diagnostic,
                 wgpu::Color {

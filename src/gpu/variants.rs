@@ -1,0 +1,112 @@
+//! The settings constant over a frame that specialise the compute pipelines, and the WGSL
+//! `#if` flags each one sets. The deferred pass picks its pipelines by them, and
+//! [`shaders::variants`](super::shaders::variants) validates every module they can select,
+//! so the two cannot drift apart.
+
+/// What the edge pass writes, which selects its pipeline.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) enum Mode {
+    Shade,
+    Overlay {
+        encoded: bool,
+    },
+    Result {
+        shaded: bool,
+    },
+    #[cfg(feature = "diagnostics")]
+    Diagnostic,
+}
+
+impl Mode {
+    /// Every mode.
+    pub(crate) fn all() -> Vec<Mode> {
+        #[allow(unused_mut)]
+        let mut all = vec![
+            Mode::Shade,
+            Mode::Overlay { encoded: false },
+            Mode::Overlay { encoded: true },
+            Mode::Result { shaded: false },
+            Mode::Result { shaded: true },
+        ];
+        #[cfg(feature = "diagnostics")]
+        all.push(Mode::Diagnostic);
+        all
+    }
+
+    /// The WGSL flags of this mode.
+    pub(crate) fn flags(self) -> &'static [&'static str] {
+        match self {
+            Mode::Shade => &["MODE_SHADE"],
+            Mode::Overlay { encoded: false } => &["MODE_OVERLAY"],
+            Mode::Overlay { encoded: true } => &["MODE_OVERLAY", "HOST_ENCODED"],
+            Mode::Result { shaded: false } => &["MODE_RESULT"],
+            Mode::Result { shaded: true } => &["MODE_RESULT", "SHADED"],
+            #[cfg(feature = "diagnostics")]
+            Mode::Diagnostic => &["MODE_DIAGNOSTIC"],
+        }
+    }
+}
+
+/// The WGSL flag of the benchmark floor, the edge module's one pipeline without a [`Mode`].
+pub(crate) const FLOOR_FLAGS: &[&str] = &["MODE_FLOOR"];
+
+/// Settings constant over a frame that specialise the outline and edge pipelines.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) struct Variant {
+    pub split: bool,
+    pub outlines: bool,
+    pub patches: bool,
+    /// Outline colours differ between instances; only with outlines.
+    pub colors: bool,
+    pub host: bool,
+    /// The instance records are bound as a uniform array.
+    pub uniform_instances: bool,
+    /// The frame has exactly one instance; only with uniform instances.
+    pub one_instance: bool,
+}
+
+impl Variant {
+    /// Every variant a frame can select: `colors` needs `outlines`, `one_instance` needs
+    /// `uniform_instances`.
+    pub(crate) fn all() -> Vec<Variant> {
+        let mut all = Vec::new();
+        for split in [false, true] {
+            for (outlines, colors) in [(false, false), (true, false), (true, true)] {
+                for patches in [false, true] {
+                    for host in [false, true] {
+                        for (uniform_instances, one_instance) in
+                            [(false, false), (true, false), (true, true)]
+                        {
+                            all.push(Variant {
+                                split,
+                                outlines,
+                                patches,
+                                colors,
+                                host,
+                                uniform_instances,
+                                one_instance,
+                            });
+                        }
+                    }
+                }
+            }
+        }
+        all
+    }
+
+    /// The WGSL flags of this variant.
+    pub(crate) fn flags(self) -> Vec<&'static str> {
+        [
+            (self.split, "SPLIT"),
+            (self.outlines, "OUTLINES"),
+            (self.patches, "PATCHES"),
+            (self.colors, "COLORS"),
+            (self.host, "HOST"),
+            (self.uniform_instances, "UNIFORM_INSTANCES"),
+            (self.one_instance, "ONE_INSTANCE"),
+        ]
+        .into_iter()
+        .filter_map(|(on, flag)| on.then_some(flag))
+        .collect()
+    }
+}
