@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Duration;
 use wirepass::mesh::{adjacency, load, load_obj};
-use wirepass::truth::raycast::{render_raycast, RayCaster};
+use wirepass::truth::raycast::{draw_raycast, RayCaster};
 use wirepass::world::{Shot, World};
 use wirepass::{Camera, EdgeSelection, Style};
 
@@ -45,7 +45,7 @@ fn cpu(c: &mut Criterion) {
         size: (320, 240),
     };
     group.bench_function("ray cast 320x240", |b| {
-        b.iter(|| render_raycast(black_box(&shot)))
+        b.iter(|| draw_raycast(black_box(&shot)))
     });
     group.finish();
 }

@@ -1,15 +1,16 @@
-// Forward single-pass wireframe (Bærentzen et al. 2006, NVIDIA "Solid Wireframe" 2007; seeds
-// 000-004), with vertex pulling in place of the seeds' geometry shader. Assembled after
+// Forward single-pass wireframe (Bærentzen et al. 2006, "Single-pass wireframe rendering";
+// NVIDIA's "Solid Wireframe" white paper, 2007), with vertex pulling in place of their
+// geometry shader. Assembled after
 // common.wgsl and scene.wgsl; the Rust side appends `encode_output` for the output format.
 //
 // One non-indexed instanced draw of 3 × triangles vertices per mesh: invocation k reads
 // triangle k / 3's three vertices, projects all three, and computes the screen-space altitude
-// of its own corner k % 3 exactly as the seeds' geometry shader does, with the corrected
-// WIN_SCALE (half the image size; seed 000's reader comment). The three distances are
+// of its own corner k % 3 exactly as the published geometry shader does, with the corrected
+// WIN_SCALE (half the image size, not the whole of it). The three distances are
 // interpolated without perspective (`@interpolate(linear)` = GLSL `noperspective`), and the
 // fragment's distance to the nearest edge is their minimum.
 //
-// Like the seeds, this DIVIDES BY w. It is the baseline as published, and its failure for
+// As published, this DIVIDES BY w. It is the baseline as published, and its failure for
 // triangles that cross the near plane (w <= 0 behind the eye: the projected corners jump to
 // the other side, the altitudes are wrong, inf or NaN) is part of what the comparison with
 // the deferred pass and the ground truth shows. Do not "fix" it here.
@@ -19,7 +20,7 @@
 // three distances on some triangles their clipper cuts (the same values interpolated with
 // perspective are fine), so those triangles lose their lines; tests/forward.rs pins how often.
 
-// Seed 004's Q ("max edge width", 100 there): the distance a masked edge's component
+// The "Solid Wireframe" quad variant's Q ("max edge width", 100 there): the distance a masked edge's component
 // carries. Beyond the reach of any line a sane width draws, and small enough that the
 // rasteriser interpolates it without precision trouble.
 const MASKED: f32 = 1.0e6;
@@ -53,7 +54,7 @@ fn vs_main(@builtin(vertex_index) k: u32, @location(7) slot: u32) -> Varyings {
     let a2 = vertex_at(v.z);
     let clip = instances[slot].clip;
 
-    // The seeds' geometry shader, with WIN_SCALE = half the image size.
+    // The published geometry shader, with WIN_SCALE = half the image size.
     let win_scale = 0.5 * frame.image_size;
     let c0 = clip * vec4<f32>(a0.xyz, 1.0);
     let c1 = clip * vec4<f32>(a1.xyz, 1.0);
@@ -72,7 +73,7 @@ fn vs_main(@builtin(vertex_index) k: u32, @location(7) slot: u32) -> Varyings {
     let mask = drawn_mask(slot, t);
     let drawn = vec3<bool>((mask & 2u) != 0u, (mask & 4u) != 0u, (mask & 1u) != 0u);
     // A drawn edge's component is the corner's altitude at its own corner and 0 at the two
-    // corners on the edge. A masked edge's component is Q at all three corners (seed 004 puts
+    // corners on the edge. A masked edge's component is Q at all three corners (the quad variant puts
     // Q at the other two corners and keeps the altitude at the own one; a constant Q keeps
     // the edge out of the minimum everywhere, as the deferred pass's NO_EDGE does).
     var dist = select(vec3<f32>(MASKED), vec3<f32>(0.0), drawn);

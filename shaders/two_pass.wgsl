@@ -1,4 +1,4 @@
-// Two-pass wireframe, the "standard" approach the seeds set out to beat: a shaded fill with a
+// Two-pass wireframe, the "standard" approach that Bærentzen et al. 2006 ("Single-pass wireframe rendering") set out to beat: a shaded fill with a
 // depth bias that pushes it back, then the drawn edges as 1-pixel hardware lines over it.
 // Assembled as common.wgsl + scene.wgsl + forward.wgsl + this file: it reuses forward.wgsl's
 // vertex pulling and shading, but not its altitude computation.

@@ -62,11 +62,20 @@
 //!
 //! ## Features
 //!
-//! With `default-features = false` the crate is the pass alone (wgpu without backends, which
-//! the host picks through its own wgpu dependency, glam, bytemuck, thiserror, pollster).
-//! `formats` adds the mesh loaders (OBJ, STL, PLY, glTF), `parallel` preprocessing on all
-//! cores, `regression` FLIP image comparison, `tools` the ray-cast ground truth, compare and
-//! bench, and `cli` (the default) the `wirepass` command line.
+//! By default the crate is the pass alone (wgpu without backends, which the host picks
+//! through its own wgpu dependency, glam, bytemuck, thiserror, pollster). `formats` adds the
+//! mesh loaders (OBJ, STL, PLY, glTF), `parallel` preprocessing on all cores, `regression`
+//! FLIP image comparison, `diagnostics` what tools measure the pass with (the benchmark
+//! floor, diagnostic maps, timestamps: [`gpu::EncodeOptions`]), `truth` the ray-cast ground
+//! truth, and `tools` all of them with offline frames, compare and bench. The `wirepass`
+//! command is the workspace's `wirepass-cli` package.
+//!
+//! ## Layers
+//!
+//! Each depends only on those before it: the frame's terms ([`camera`], [`scene`],
+//! [`style`], [`edge_math`], [`error`]); [`mesh`] and its loaders (`mesh::formats`); the
+//! pass ([`gpu`]); the world of meshes tools draw and the ground truth (`world`, `truth`);
+//! the tools (`tools`).
 
 #![warn(missing_docs)]
 

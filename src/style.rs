@@ -250,7 +250,7 @@ mod tests {
         assert_eq!(line_intensity(0.0, 4.0), 1.0);
         assert_eq!(line_intensity(1.0, 4.0), 1.0);
         assert_eq!(line_intensity(line_reach(4.0), 4.0), 0.0);
-        // The seeds' exp2(-2 d^2) is the 2 px case.
+        // NVIDIA's "Solid Wireframe" exp2(-2 d^2) is the 2 px case.
         assert!((line_intensity(0.7, 2.0) - (-2.0_f64 * 0.49).exp2()).abs() < 1e-12);
         // Thin lines fade rather than vanish.
         assert!((line_intensity(0.0, 0.5) - 0.25).abs() < 1e-12);

@@ -13,7 +13,7 @@ use std::collections::BTreeSet;
 use std::path::PathBuf;
 use std::sync::OnceLock;
 use wirepass::gpu::{drawn_edges, GpuContext};
-use wirepass::tools::offline::{render, Method};
+use wirepass::tools::offline::{self, Method};
 use wirepass::world::{Rendering, Shot, World};
 use wirepass::{Camera, Color, EdgeSelection, Mesh, Style};
 
@@ -72,7 +72,7 @@ fn draw_edges(
         style,
         size,
     };
-    render(gpu(), &shot, method).unwrap_or_else(|e| panic!("{}: {e}", method.name()))
+    offline::draw(gpu(), &shot, method).unwrap_or_else(|e| panic!("{}: {e}", method.name()))
 }
 
 /// How two frames of the same scene differ.

@@ -20,9 +20,9 @@ use wirepass::gpu::{
 };
 use wirepass::style::line_reach;
 use wirepass::tools::compare::metrics;
-use wirepass::tools::offline::{render_deferred_on, Uploaded};
+use wirepass::tools::offline::{draw_deferred_on, Uploaded};
 use wirepass::tools::regression::{difference, Rgba, Threshold};
-use wirepass::truth::raycast::{render_raycast_over, HostOccluders};
+use wirepass::truth::raycast::{draw_raycast_over, HostOccluders};
 use wirepass::world::{Object, Rendering, Shot, World, WorldMesh, BACKGROUND, HOST};
 use wirepass::{wgpu, DepthRange, EdgeSelection, Error, Instance, InstanceStyle, Scene, Style};
 
@@ -182,7 +182,7 @@ fn host_case(
         texture: &targets.depth,
         view: host_view,
     });
-    let frame = render_deferred_on(ctx, &shot, &up, pass, canvas).unwrap();
+    let frame = draw_deferred_on(ctx, &shot, &up, pass, canvas).unwrap();
     ctx.finish().unwrap();
 
     let occluders = match samples {
@@ -192,7 +192,7 @@ fn host_case(
     }
     .with_format(format)
     .with_view(host_view);
-    let truth = render_raycast_over(&shot, Some(&occluders)).unwrap();
+    let truth = draw_raycast_over(&shot, Some(&occluders)).unwrap();
 
     let m = metrics(&truth, &frame).unwrap();
     let d = m.distance_error_px;
@@ -662,7 +662,7 @@ fn shaded_composite_keeps_the_host_image_where_no_instance_shows() {
         texture: &targets.depth,
         view,
     });
-    let ids = render_deferred_on(device(), &shot, &up, pass, canvas)
+    let ids = draw_deferred_on(device(), &shot, &up, pass, canvas)
         .unwrap()
         .ids;
     let (mut on_instances, mut on_host, mut outlined) = (0, 0, 0);

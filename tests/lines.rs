@@ -12,9 +12,9 @@ mod common;
 
 use common::{cpu_distance, framing, load, shoot};
 use glam::{DVec3, Vec3};
-use wirepass::gpu::{DeferredPass, PassOptions, Window};
+use wirepass::gpu::{DeferredPass, PassOptions, Region};
 use wirepass::tools::compare::metrics;
-use wirepass::tools::offline::{render_deferred_on, Method, Uploaded};
+use wirepass::tools::offline::{draw_deferred_on, Method, Uploaded};
 use wirepass::world::{Rendering, Shot, World};
 use wirepass::{style, Camera, EdgeSelection, Mesh, Style};
 
@@ -370,12 +370,12 @@ fn quads_of_a_dense_sphere_are_drawn_whole() {
 }
 
 /// The deferred frame of `window` of `shot`'s image.
-fn render_window(shot: &Shot<'_>, up: &Uploaded, window: Window) -> Rendering {
+fn render_window(shot: &Shot<'_>, up: &Uploaded, window: Region) -> Rendering {
     let ctx = common::gpu();
     let pass = DeferredPass::new(&ctx.device, PassOptions::default())
         .unwrap_or_else(|e| panic!("{e}"))
         .with_diagnostics();
-    render_deferred_on(ctx, shot, up, pass, window.into()).unwrap_or_else(|e| panic!("{e}"))
+    draw_deferred_on(ctx, shot, up, pass, window.into()).unwrap_or_else(|e| panic!("{e}"))
 }
 
 #[test]
@@ -418,11 +418,11 @@ fn tiles_stitch_into_the_whole_image() {
             size,
         };
         let up = Uploaded::new(common::gpu(), &world).unwrap_or_else(|e| panic!("{e}"));
-        let whole = render_window(&shot, &up, Window::whole(size));
+        let whole = render_window(&shot, &up, Region::whole(size));
         let (cx, cy) = (137, 101);
         for (x0, w) in [(0, cx), (cx, size.0 - cx)] {
             for (y0, h) in [(0, cy), (cy, size.1 - cy)] {
-                let window = Window {
+                let window = Region {
                     image: size,
                     origin: (x0, y0),
                     size: (w, h),
@@ -524,8 +524,8 @@ fn set_edges_redraws_a_stored_mesh_as_a_fresh_upload_would() {
             .set_edges(&ctx.queue, id, &mesh, edges)
             .unwrap_or_else(|e| panic!("{e}"));
         let fresh = Uploaded::new(ctx, &world).unwrap_or_else(|e| panic!("{e}"));
-        let a = render_window(&shot, &switched, Window::whole(size));
-        let b = render_window(&shot, &fresh, Window::whole(size));
+        let a = render_window(&shot, &switched, Region::whole(size));
+        let b = render_window(&shot, &fresh, Region::whole(size));
         assert_eq!(a.ids, b.ids, "{edges:?}");
         assert!(
             a.edge_distance

@@ -12,7 +12,7 @@ mod common;
 use common::{gpu, load};
 use glam::Vec3;
 use std::path::PathBuf;
-use wirepass::tools::offline::{render, Method};
+use wirepass::tools::offline::{draw, Method};
 use wirepass::tools::regression::{check_against_reference, Outcome, Threshold};
 use wirepass::world::{Shot, World};
 use wirepass::{Camera, EdgeSelection, Mesh, Style};
@@ -206,7 +206,7 @@ fn every_case_matches_its_reference() {
                         mode.replace(':', ""),
                         view.name()
                     );
-                    let frame = match render(ctx, &shot, method) {
+                    let frame = match draw(ctx, &shot, method) {
                         Ok(frame) => frame,
                         Err(e) => {
                             failures.push(format!("{case}: render failed: {e}"));

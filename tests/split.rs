@@ -10,7 +10,7 @@ use std::sync::{Arc, Mutex, MutexGuard};
 use wirepass::gpu::{DeferredPass, GpuContext, MeshStore, OutputTarget, PassOptions};
 use wirepass::mesh::Procedural;
 use wirepass::tools::load::CameraPlacement;
-use wirepass::tools::offline::{render, Method, Uploaded};
+use wirepass::tools::offline::{draw, Method, Uploaded};
 use wirepass::world::{Object, Shot, World, WorldMesh, BACKGROUND};
 use wirepass::{Color, EdgeSelection, Error, Instance, InstanceStyle, Scene, Style};
 
@@ -64,8 +64,8 @@ fn a_mesh_split_over_two_bindings_renders_as_if_whole() {
         size,
     };
     for method in [Method::Deferred, Method::Forward, Method::TwoPass] {
-        let whole = render(gpu(), &shot, method).unwrap();
-        let split = render(&small, &shot, method).unwrap();
+        let whole = draw(gpu(), &shot, method).unwrap();
+        let split = draw(&small, &shot, method).unwrap();
         assert!(whole.ids.iter().filter(|&&id| id != BACKGROUND).count() > 2000);
         // Both halves are drawn: triangles on either side of the split appear.
         let high = split
@@ -259,8 +259,8 @@ fn outline_pieces_past_the_list_s_room_are_drawn_where_they_are_found() {
         "{work:?}"
     );
 
-    let whole = render(gpu(), &shot, Method::Deferred).unwrap();
-    let cramped = render(&small, &shot, Method::Deferred).unwrap();
+    let whole = draw(gpu(), &shot, Method::Deferred).unwrap();
+    let cramped = draw(&small, &shot, Method::Deferred).unwrap();
     let lines = whole.edge_distance.iter().filter(|&&d| d < 2.0).count();
     assert!(lines > 1500, "{lines} pixels near a line");
     let differ = |a: &[u8], b: &[u8]| a.iter().zip(b).filter(|(x, y)| x != y).count();

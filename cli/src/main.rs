@@ -7,7 +7,7 @@ use wirepass::glam::Vec3;
 use wirepass::gpu::GpuContext;
 use wirepass::style::{DepthFade, DEFAULT_LINE_WIDTH};
 use wirepass::tools::load::{load_world, parse_size, parse_vec3, CameraPlacement, WorldOptions};
-use wirepass::tools::offline::{render, Method};
+use wirepass::tools::offline::{draw, Method};
 use wirepass::world::{Shot, World};
 use wirepass::{Color, EdgeSelection, Result, Style, View};
 
@@ -148,7 +148,7 @@ struct RenderArgs {
     #[command(flatten)]
     scene: SceneArgs,
     /// How to draw: deferred (visibility buffer + compute edge pass), forward (single-pass
-    /// altitudes, Bærentzen et al. 2006; divides by w like the seeds), two-pass (biased fill,
+    /// altitudes, Bærentzen et al. 2006; divides by w as published), two-pass (biased fill,
     /// then 1 px edge lines), raycast (the f64 CPU ground truth; slow).
     #[arg(long, default_value = "deferred", value_parser = parse_method)]
     method: Method,
@@ -174,7 +174,7 @@ fn render_command(args: &RenderArgs) -> Result<()> {
         style: &style,
         size,
     };
-    let frame = render(&ctx, &shot, args.method)?;
+    let frame = draw(&ctx, &shot, args.method)?;
     frame.save_png(&args.output)?;
     if let Some(dir) = &args.dump {
         frame.dump(dir, &view)?;

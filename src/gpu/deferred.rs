@@ -56,9 +56,9 @@ impl Default for PassOptions {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum TriangleIds {
     /// [`VertexPulling`](TriangleIds::VertexPulling) on a CPU adapter, whose rasterizer
-    /// takes a slower path for a fragment shader that reads the primitive index (lavapipe:
-    /// the visibility pass of a 2 M-triangle sphere at 1280×720 takes 326 ms that way, 228
-    /// pulled), and on a device without `Features::PRIMITIVE_INDEX`;
+    /// takes a slower path for a fragment shader that reads the primitive index (the README's
+    /// speed section has lavapipe's figures), and on a device without
+    /// `Features::PRIMITIVE_INDEX`;
     /// [`PrimitiveIndex`](TriangleIds::PrimitiveIndex) elsewhere.
     #[default]
     Auto,
@@ -409,7 +409,7 @@ impl DeferredPass {
         self.targets.as_ref().map_or(0, Targets::bytes)
     }
 
-    /// Prepares `scene` for `canvas` (an image size, a window of a larger image, and
+    /// Prepares `scene` for `canvas` (an image size, a region of a larger image, and
     /// optionally the host's depth): checks it, writes its uniforms and instance records,
     /// and makes the targets (rebuilt only when the size changes).
     pub fn prepare<'c>(
@@ -421,7 +421,7 @@ impl DeferredPass {
         canvas: impl Into<Canvas<'c>>,
     ) -> Result<PreparedFrame> {
         let canvas = canvas.into();
-        let window = canvas.window;
+        let region = canvas.region;
         // An Rgba16Float output holds the background as its nearest half, so that a clear and
         // the shader's store (whose conversion may round either way) give the same bits.
         let held;
@@ -434,14 +434,14 @@ impl DeferredPass {
         } else {
             style
         };
-        let data = FrameData::new(device, store, scene, style, window, true)?;
+        let data = FrameData::new(device, store, scene, style, region, true)?;
         let host = match &canvas.host_depth {
-            Some(h) => Some(self.host.prepare(device, h, &scene.view, window.image)?),
+            Some(h) => Some(self.host.prepare(device, h, &scene.view, region.image)?),
             None => None,
         };
         let spec = TargetSpec {
             size: data.target_size(),
-            output: window.size,
+            output: region.size,
             acc_colors: data.mixed_colors,
             result: self.composite.is_some(),
             diagnostic: self.diagnostics,

@@ -98,7 +98,7 @@ impl InstanceRecord {
 /// the scene: lines whose edges lie just outside the output reach into it, the outline pass
 /// tests their visibility against the ids one pixel around each point, and the coverage
 /// search reads the ids around each pixel. So the output is the same whether the image is
-/// drawn whole or as tiles ([`Window`]). (An output within a band of the device's largest
+/// drawn whole or as tiles ([`Region`]). (An output within a band of the device's largest
 /// texture side gets what room is left.)
 pub fn guard_band(scene: &Scene<'_>, style: &Style) -> u32 {
     let widest = scene
@@ -114,7 +114,7 @@ pub fn guard_band(scene: &Scene<'_>, style: &Style) -> u32 {
 /// are found). Every pixel is addressed in full-image coordinates, so a tile computes
 /// exactly what the whole image computes there.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Window {
+pub struct Region {
     /// The full image the projection maps onto, in pixels.
     pub image: (u32, u32),
     /// The output's first pixel in the full image.
@@ -123,43 +123,43 @@ pub struct Window {
     pub size: (u32, u32),
 }
 
-impl Window {
+impl Region {
     /// The whole image.
-    pub fn whole(size: (u32, u32)) -> Window {
-        Window {
+    pub fn whole(size: (u32, u32)) -> Region {
+        Region {
             image: size,
             origin: (0, 0),
             size,
         }
     }
 
-    /// Checks that the window lies inside its image.
+    /// Checks that the region lies inside its image.
     pub fn validate(&self) -> Result<()> {
         let (w, h) = self.size;
         let (x, y) = self.origin;
         let (iw, ih) = self.image;
         if w == 0 || h == 0 || iw == 0 || ih == 0 {
             return Err(Error::InvalidSetting(format!(
-                "image size {iw}x{ih} or window size {w}x{h} has a zero side"
+                "image size {iw}x{ih} or region size {w}x{h} has a zero side"
             )));
         }
         if u64::from(x) + u64::from(w) > u64::from(iw)
             || u64::from(y) + u64::from(h) > u64::from(ih)
         {
             return Err(Error::InvalidSetting(format!(
-                "the window {w}x{h} at ({x}, {y}) reaches past the {iw}x{ih} image"
+                "the region {w}x{h} at ({x}, {y}) reaches past the {iw}x{ih} image"
             )));
         }
         Ok(())
     }
 }
 
-/// What a frame draws onto: an image, or a window of a larger one, and optionally the
+/// What a frame draws onto: an image, or a region of a larger one, and optionally the
 /// host's depth buffer. An image size converts into one: `pass.prepare(.., (800, 600))`.
 #[derive(Clone, Copy, Debug)]
 pub struct Canvas<'a> {
     /// The image, or the part of it the frame draws.
-    pub window: Window,
+    pub region: Region,
     /// The host's depth: host geometry nearer than a wireframed surface hides its lines.
     pub host_depth: Option<super::HostDepth<'a>>,
 }
@@ -167,7 +167,7 @@ pub struct Canvas<'a> {
 impl<'a> Canvas<'a> {
     /// A whole image of `size` pixels.
     pub fn new(size: (u32, u32)) -> Canvas<'a> {
-        Window::whole(size).into()
+        Region::whole(size).into()
     }
 
     /// This canvas over the host's depth buffer.
@@ -179,10 +179,10 @@ impl<'a> Canvas<'a> {
     }
 }
 
-impl From<Window> for Canvas<'_> {
-    fn from(window: Window) -> Self {
+impl From<Region> for Canvas<'_> {
+    fn from(region: Region) -> Self {
         Canvas {
-            window,
+            region,
             host_depth: None,
         }
     }
@@ -215,7 +215,7 @@ pub(crate) struct FrameData {
     pub order: Vec<u32>,
     pub store: StoreBuffers,
     pub store_version: (u32, u64),
-    pub window: Window,
+    pub region: Region,
     /// Pixels of guard band around the output in the targets.
     pub guard: u32,
     /// Whether the outline pass runs: an instance draws outlines, or edges of a mesh with
@@ -233,28 +233,28 @@ pub(crate) struct FrameData {
 }
 
 impl FrameData {
-    /// Validates the scene, style and window against the device and the store, and builds
+    /// Validates the scene, style and region against the device and the store, and builds
     /// the frame's GPU data; with `guarded`, the targets have a guard band ([`guard_band`]).
     pub fn new(
         device: &wgpu::Device,
         store: &MeshStore,
         scene: &Scene<'_>,
         style: &Style,
-        window: Window,
+        region: Region,
         guarded: bool,
     ) -> Result<FrameData> {
-        window.validate()?;
+        region.validate()?;
         scene.validate()?;
         style.validate()?;
-        super::check_size(device, window.size)?;
+        super::check_size(device, region.size)?;
         // Where the device's largest texture leaves no room for the whole band, a narrower one.
-        let room = device.limits().max_texture_dimension_2d - window.size.0.max(window.size.1);
+        let room = device.limits().max_texture_dimension_2d - region.size.0.max(region.size.1);
         let guard = if guarded {
             guard_band(scene, style).min(room / 2)
         } else {
             0
         };
-        let target = (window.size.0 + 2 * guard, window.size.1 + 2 * guard);
+        let target = (region.size.0 + 2 * guard, region.size.1 + 2 * guard);
         // Group instances by mesh (stable, so each mesh's instances keep the scene's order),
         // so every mesh is one instanced draw.
         let mut order: Vec<u32> = (0..scene.instances.len() as u32).collect();
@@ -329,12 +329,12 @@ impl FrameData {
 
         let buffers = store.buffers();
         let (gx, gy) = (guard as f64, guard as f64);
-        let (iw, ih) = (f64::from(window.image.0), f64::from(window.image.1));
+        let (iw, ih) = (f64::from(region.image.0), f64::from(region.image.1));
         let (tw, th) = (f64::from(target.0), f64::from(target.1));
         // Clip → target NDC: target pixel (0, 0) is image pixel origin − guard.
         let (ox, oy) = (
-            f64::from(window.origin.0) - gx,
-            f64::from(window.origin.1) - gy,
+            f64::from(region.origin.0) - gx,
+            f64::from(region.origin.1) - gy,
         );
         let crop = [
             iw / tw,
@@ -347,7 +347,7 @@ impl FrameData {
             target_origin: [ox as f32, oy as f32],
             target_size: [target.0 as f32, target.1 as f32],
             output_offset: [guard as f32; 2],
-            output_size: [window.size.0 as f32, window.size.1 as f32],
+            output_size: [region.size.0 as f32, region.size.1 as f32],
             fade: style.fade_range(),
             crop: crop.map(|v| v as f32),
             light_dir: light.as_vec3().extend(0.0).to_array(),
@@ -396,7 +396,7 @@ impl FrameData {
             order,
             store: buffers,
             store_version: (store.store_id(), store.version()),
-            window,
+            region,
             guard,
             outlines,
             patches,
@@ -420,8 +420,8 @@ impl FrameData {
     /// Size of the id and depth targets.
     pub fn target_size(&self) -> (u32, u32) {
         (
-            self.window.size.0 + 2 * self.guard,
-            self.window.size.1 + 2 * self.guard,
+            self.region.size.0 + 2 * self.guard,
+            self.region.size.1 + 2 * self.guard,
         )
     }
 
@@ -522,7 +522,7 @@ mod tests {
 
     #[test]
     fn crop_maps_the_image_onto_the_targets() {
-        // A 4-pixel guard band around a 100x50 window at (20, 10) of a 200x100 image: the
+        // A 4-pixel guard band around a 100x50 region at (20, 10) of a 200x100 image: the
         // image point at pixel x lands at target pixel x - (20 - 4).
         let (iw, ih, tw, th, ox, oy): (f64, f64, f64, f64, f64, f64) =
             (200.0, 100.0, 108.0, 58.0, 16.0, 6.0);

@@ -1,4 +1,9 @@
-//! GPU side: device creation, the mesh store, the per-frame scene data and the passes.
+//! The pass on the GPU: the mesh store, a frame's scene data and targets, and the passes.
+//! [`DeferredPass`] orchestrates a frame's sub-passes, each in a file of its own
+//! (`visibility`, `host_depth`, the outline and edge dispatches, `composite`); the
+//! forward methods it is measured against are in [`baselines`]. It uses the frame's terms
+//! (camera, scene, style, edge math) and the meshes, nothing of the loaders, the ground truth
+//! or the tools.
 
 pub mod baselines;
 mod bindings;
@@ -28,7 +33,7 @@ pub use deferred::EdgeWork;
 pub use deferred::{DeferredPass, OutputTarget, PassOptions, PreparedFrame, TriangleIds};
 #[cfg(feature = "diagnostics")]
 pub use diagnostics::EncodeOptions;
-pub use frame::{light_world_dir, Canvas, Window, MAX_INSTANCES};
+pub use frame::{light_world_dir, Canvas, Region, MAX_INSTANCES};
 pub use host_depth::{depth_quantum, HostDepth};
 pub use mesh_store::{MeshId, MeshStore};
 pub use readback::read_texture;

@@ -6,9 +6,9 @@ mod font;
 
 use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
-use crate::tools::offline::{render, Method};
+use crate::tools::offline::{draw, Method};
 use crate::tools::regression;
-use crate::truth::raycast::render_raycast;
+use crate::truth::raycast::draw_raycast;
 use crate::world::{Rendering, Shot, BACKGROUND};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -361,7 +361,7 @@ pub fn run(ctx: &GpuContext, shot: &Shot<'_>, out: &Path) -> Result<Report> {
         source,
     })?;
     let start = Instant::now();
-    let reference = render_raycast(shot)?;
+    let reference = draw_raycast(shot)?;
     let reference_seconds = start.elapsed().as_secs_f64();
     reference.save_png(&out.join(format!("{}.png", Method::Raycast.name())))?;
 
@@ -374,7 +374,7 @@ pub fn run(ctx: &GpuContext, shot: &Shot<'_>, out: &Path) -> Result<Report> {
         }
         let name = method.name();
         let start = Instant::now();
-        let report = match render(ctx, shot, method) {
+        let report = match draw(ctx, shot, method) {
             Err(e) => {
                 panels.push((name.to_string(), None));
                 MethodReport::Skipped {

@@ -82,7 +82,7 @@ pub enum Method {
     /// Visibility buffer + compute edge pass (the subject of this crate).
     Deferred,
     /// Forward single-pass baseline (Bærentzen et al. 2006): interpolated screen-space
-    /// altitudes, vertex-pulled; divides by w like the seeds.
+    /// altitudes, vertex-pulled; divides by w as the published method does.
     Forward,
     /// Two-pass baseline: shaded fill with depth bias, then the drawn edges as 1 px lines.
     TwoPass,
@@ -123,37 +123,37 @@ impl std::str::FromStr for Method {
 }
 
 /// Renders `shot` with `method` and reads back the image and all maps.
-pub fn render(ctx: &GpuContext, shot: &Shot<'_>, method: Method) -> Result<Rendering> {
+pub fn draw(ctx: &GpuContext, shot: &Shot<'_>, method: Method) -> Result<Rendering> {
     match method {
-        Method::Raycast => crate::truth::raycast::render_raycast(shot),
-        Method::Deferred => render_deferred(ctx, shot),
-        Method::Forward => render_forward(ctx, shot),
-        Method::TwoPass => render_two_pass(ctx, shot),
+        Method::Raycast => crate::truth::raycast::draw_raycast(shot),
+        Method::Deferred => draw_deferred(ctx, shot),
+        Method::Forward => draw_forward(ctx, shot),
+        Method::TwoPass => draw_two_pass(ctx, shot),
     }
 }
 
 /// Renders `shot` with the deferred pass and reads back the image and all maps.
-pub fn render_deferred(ctx: &GpuContext, shot: &Shot<'_>) -> Result<Rendering> {
+pub fn draw_deferred(ctx: &GpuContext, shot: &Shot<'_>) -> Result<Rendering> {
     let up = Uploaded::new(ctx, shot.world)?;
     let pass = DeferredPass::new(&ctx.device, PassOptions::default())?.with_diagnostics();
-    render_deferred_with(ctx, shot, &up, pass)
+    draw_deferred_with(ctx, shot, &up, pass)
 }
 
-/// [`render_deferred`] with a pass and upload of the caller's (a pass with lowered limits,
+/// [`draw_deferred`] with a pass and upload of the caller's (a pass with lowered limits,
 /// or vertex pulling, say).
-pub fn render_deferred_with(
+pub fn draw_deferred_with(
     ctx: &GpuContext,
     shot: &Shot<'_>,
     up: &Uploaded,
     pass: DeferredPass,
 ) -> Result<Rendering> {
-    render_deferred_on(ctx, shot, up, pass, Canvas::new(shot.size))
+    draw_deferred_on(ctx, shot, up, pass, Canvas::new(shot.size))
 }
 
-/// [`render_deferred_with`] onto a canvas of the caller's: over the host's depth buffer, say
-/// (its pixels where the host is in front get the id [`HOST`]), or a window of the shot's
-/// image (a tile: the frame is the window's size).
-pub fn render_deferred_on(
+/// [`draw_deferred_with`] onto a canvas of the caller's: over the host's depth buffer, say
+/// (its pixels where the host is in front get the id [`HOST`]), or a region of the shot's
+/// image (a tile: the frame is the region's size).
+pub fn draw_deferred_on(
     ctx: &GpuContext,
     shot: &Shot<'_>,
     up: &Uploaded,
@@ -161,10 +161,10 @@ pub fn render_deferred_on(
     canvas: Canvas<'_>,
 ) -> Result<Rendering> {
     let device = &ctx.device;
-    let window = canvas.window;
-    if window.image != shot.size {
+    let region = canvas.region;
+    if region.image != shot.size {
         return Err(Error::Misuse(format!(
-            "the canvas is {window:?}, a window of another image than the shot's {}x{}",
+            "the canvas is {region:?}, a region of another image than the shot's {}x{}",
             shot.size.0, shot.size.1
         )));
     }
@@ -177,7 +177,7 @@ pub fn render_deferred_on(
     let output = texture_2d(
         device,
         "wirepass output",
-        window.size,
+        region.size,
         pass.output_format(),
         usage,
     );
@@ -208,7 +208,7 @@ pub fn render_deferred_on(
         frame.resolved_id_texture().ok_or_else(missing)?,
         frame.diagnostic_texture().ok_or_else(missing)?,
     );
-    let out = (window.size, up);
+    let out = (region.size, up);
     read_frame(ctx, shot, out, frame.instance_order(), &output, maps)
 }
 
@@ -266,7 +266,7 @@ fn forward_output(device: &wgpu::Device, size: (u32, u32)) -> wgpu::Texture {
 
 /// Renders `shot` with the forward single-pass baseline and reads back the image and maps.
 /// Its distance map is the interpolated altitudes' minimum (NaN where the method gives NaN).
-pub fn render_forward(ctx: &GpuContext, shot: &Shot<'_>) -> Result<Rendering> {
+pub fn draw_forward(ctx: &GpuContext, shot: &Shot<'_>) -> Result<Rendering> {
     let device = &ctx.device;
     let up = Uploaded::new(ctx, shot.world)?;
     let mut pass = ForwardPass::new(device, FORWARD_OUTPUT)?;
@@ -301,7 +301,7 @@ pub fn render_forward(ctx: &GpuContext, shot: &Shot<'_>) -> Result<Rendering> {
 
 /// Renders `shot` with the two-pass baseline and reads back the image and maps. It measures
 /// no distance: its `edge_distance` is 0 where a line was drawn and `inf` elsewhere.
-pub fn render_two_pass(ctx: &GpuContext, shot: &Shot<'_>) -> Result<Rendering> {
+pub fn draw_two_pass(ctx: &GpuContext, shot: &Shot<'_>) -> Result<Rendering> {
     let device = &ctx.device;
     let up = Uploaded::new(ctx, shot.world)?;
     let lines = up.edge_lines(ctx, shot.world)?;

@@ -152,7 +152,7 @@ pub fn statistics(map: &[f32]) -> Difference {
 /// [`Error::InvalidSetting`] naming both.
 ///
 /// ```
-/// use wirepass::regression::{difference, Rgba, Threshold};
+/// use wirepass::tools::regression::{difference, Rgba, Threshold};
 ///
 /// let grey = vec![128u8; 4 * 32 * 32];
 /// let same = difference(Rgba::new(&grey, (32, 32))?, Rgba::new(&grey, (32, 32))?)?;

@@ -10,4 +10,4 @@
 pub mod outline;
 pub mod raycast;
 
-pub use raycast::{render_raycast, render_raycast_over, HostOccluders, RayCaster};
+pub use raycast::{draw_raycast, draw_raycast_over, HostOccluders, RayCaster};

@@ -553,15 +553,15 @@ impl HostMap {
 
 /// Renders `shot` by ray casting on the CPU in f64: the reference every GPU method is
 /// measured against. Fills every map of the [`Rendering`].
-pub fn render_raycast(shot: &Shot<'_>) -> Result<Rendering> {
-    render_raycast_over(shot, None)
+pub fn draw_raycast(shot: &Shot<'_>) -> Result<Rendering> {
+    draw_raycast_over(shot, None)
 }
 
-/// [`render_raycast`] over the host's own geometry: where the host is nearer, a pixel shows
+/// [`draw_raycast`] over the host's own geometry: where the host is nearer, a pixel shows
 /// [`HOST`] and its lines are hidden; an outline point is hidden where the pixel containing
 /// it shows the host and the host's depth there is nearer, and no outline is drawn into a
 /// pixel that shows the host where the host is nearer than the outline's point.
-pub fn render_raycast_over(shot: &Shot<'_>, host: Option<&HostOccluders<'_>>) -> Result<Rendering> {
+pub fn draw_raycast_over(shot: &Shot<'_>, host: Option<&HostOccluders<'_>>) -> Result<Rendering> {
     let (width, height) = shot.size;
     if width == 0 || height == 0 {
         return Err(Error::InvalidSetting(format!(
@@ -948,7 +948,7 @@ mod tests {
             style: &style,
             size: (64, 48),
         };
-        let frame = render_raycast(&shot).unwrap();
+        let frame = draw_raycast(&shot).unwrap();
         assert_eq!(frame.rgba.len(), 64 * 48 * 4);
         // The corner pixel is background; the centre is covered at the right depth.
         assert_eq!(frame.ids[0], BACKGROUND);
@@ -989,7 +989,7 @@ mod tests {
                 style: &style,
                 size: (32, 32),
             };
-            let frame = render_raycast(&shot).unwrap();
+            let frame = draw_raycast(&shot).unwrap();
             // The quad fills the middle of the image.
             assert!(frame.ids[16 * 32 + 16] < 2, "{view:?}");
             assert_eq!(frame.ids[0], BACKGROUND);

@@ -7,7 +7,7 @@ use glam::{DVec2, Vec3};
 use std::path::PathBuf;
 use std::sync::OnceLock;
 use wirepass::gpu::{DeferredPass, GpuContext, PassOptions, TriangleIds};
-use wirepass::tools::offline::{render, Method};
+use wirepass::tools::offline::{draw, Method};
 use wirepass::world::{Rendering, Shot, World};
 use wirepass::{edge_math, Camera, EdgeSelection, Mesh, Style};
 
@@ -99,7 +99,7 @@ pub fn shoot_world(
         style,
         size,
     };
-    render(gpu(), &shot, method).unwrap_or_else(|e| panic!("{}: {e}", method.name()))
+    draw(gpu(), &shot, method).unwrap_or_else(|e| panic!("{}: {e}", method.name()))
 }
 
 /// The camera that frames `mesh` for an image of `size`.
@@ -142,7 +142,7 @@ impl TestScene {
     }
 
     pub fn draw(&self, method: Method) -> Rendering {
-        render(gpu(), &self.shot(), method).unwrap_or_else(|e| panic!("{}: {e}", method.name()))
+        draw(gpu(), &self.shot(), method).unwrap_or_else(|e| panic!("{}: {e}", method.name()))
     }
 }
 

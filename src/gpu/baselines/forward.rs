@@ -38,9 +38,10 @@ struct Pipelines {
 /// Each triangle's vertices are pulled from the [`MeshStore`] by a non-indexed instanced
 /// draw of `3 × triangles` vertices per mesh; each vertex invocation projects its triangle's
 /// three corners, divides by `w` and computes its own corner's altitude in pixels with the
-/// seeds' corrected `WIN_SCALE` (half the image size). The fragment's distance to the
-/// nearest drawn edge is the minimum of the three altitudes interpolated without perspective;
-/// masked edges carry a large constant distance (seed 004). Shading, the line profile and
+/// published geometry shader's `WIN_SCALE`, corrected to half the image size. The
+/// fragment's distance to the nearest drawn edge is the minimum of the three altitudes
+/// interpolated without perspective; masked edges carry a large constant distance, as in
+/// NVIDIA's "Solid Wireframe" for quads. Shading, the line profile and
 /// reverse depth are the deferred pass's, so on ordinary cameras both draw the same pixels.
 ///
 /// **The division by `w` is kept on purpose**: it is the published method, and it breaks

@@ -5,7 +5,7 @@
 
 use crate::error::{Error, Result};
 use crate::gpu::bindings::{self, store_resources, Res, Sources};
-use crate::gpu::frame::{FrameData, Window};
+use crate::gpu::frame::{FrameData, Region};
 use crate::gpu::mesh_store::MeshStore;
 use crate::gpu::targets::{clear_color, cleared, BACKGROUND_ID, DEPTH_FORMAT, ID_FORMAT};
 use crate::gpu::texture_2d;
@@ -149,7 +149,7 @@ impl RasterFrame {
         style: &Style,
         size: (u32, u32),
     ) -> Result<RasterFrame> {
-        let data = FrameData::new(device, store, scene, style, Window::whole(size), false)?;
+        let data = FrameData::new(device, store, scene, style, Region::whole(size), false)?;
         let make = |label, format, usage| texture_2d(device, label, size, format, usage);
         use wgpu::TextureUsages as U;
         Ok(RasterFrame {
@@ -176,7 +176,7 @@ impl RasterFrame {
 
     /// The output size.
     pub fn size(&self) -> (u32, u32) {
-        self.data.window.size
+        self.data.region.size
     }
 
     /// The id map (`Rg32Uint`: instance slot, triangle; [`BACKGROUND_ID`](crate::gpu::BACKGROUND_ID) first on background).

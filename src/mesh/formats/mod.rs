@@ -1,5 +1,6 @@
-//! One entry point for mesh files: the loader is chosen by the file's extension, from a
-//! table that a new format joins with one row.
+//! The mesh file loaders (OBJ, STL, PLY, glTF), and one entry point for them: the loader is
+//! chosen by the file's extension, from a table that a new format joins with one row. Each
+//! loader builds on the helpers in `read.rs` and on [`crate::mesh`], never on this table.
 
 pub mod gltf;
 mod obj;
