@@ -3,7 +3,7 @@
 // (One, OneMinusSrcAlpha). The host's colour attachment decides the encoding: sRGB formats
 // store sRGB and blend in linear light, float formats hold linear values. Self-contained.
 
-@group(0) @binding(0) var result: texture_2d<f32>;
+@group(0) @binding(34) var result: texture_2d<f32>;
 
 @vertex
 fn vs_main(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {

@@ -14,9 +14,9 @@
 // Bound as unfilterable float (its depth in x), which every backend can load from; GLSL
 // has no texel fetch from depth textures.
 #if MULTISAMPLED
-@group(0) @binding(30) var host_depth: texture_multisampled_2d<f32>;
+@group(0) @binding(30) var host_source: texture_multisampled_2d<f32>;
 #else
-@group(0) @binding(30) var host_depth: texture_2d<f32>;
+@group(0) @binding(30) var host_source: texture_2d<f32>;
 #endif
 
 // How host depth maps to the pass's reverse depth (src/gpu/host.rs, HostParams).
@@ -51,7 +51,7 @@ fn resolve_main(@builtin(global_invocation_id) gid: vec3<u32>) {
 fn host_value(xy: vec2<u32>) -> u32 {
     // The image pixel this target pixel is; the host's depth covers the image only.
     let image = vec2<i32>(xy) + vec2<i32>(frame.target_origin);
-    let size = vec2<i32>(textureDimensions(host_depth));
+    let size = vec2<i32>(textureDimensions(host_source));
     if any(image < vec2<i32>(0)) || any(image >= size) {
         return 0xffffffffu;
     }
@@ -61,12 +61,12 @@ fn host_value(xy: vec2<u32>) -> u32 {
 #if MULTISAMPLED
     // The texture's own count, not a uniform: a loop bound by uniform values alone is
     // re-specialised by lavapipe at every dispatch (see common.wgsl).
-    for (var s = 0u; s < textureNumSamples(host_depth); s++) {
-        let x = textureLoad(host_depth, image, i32(s)).x;
+    for (var s = 0u; s < textureNumSamples(host_source); s++) {
+        let x = textureLoad(host_source, image, i32(s)).x;
         d = select(max(d, x), min(d, x), host.reversed == 1u);
     }
 #else
-    d = textureLoad(host_depth, image, 0).x;
+    d = textureLoad(host_source, image, 0).x;
 #endif
     if d == far {
         return 0xffffffffu;
@@ -81,7 +81,7 @@ fn host_value(xy: vec2<u32>) -> u32 {
     return bitcast<u32>(clamp(reverse - host_margin(reverse, host.quantum), 0.0, 1.0));
 }
 
-@group(0) @binding(33) var host_in: texture_2d<u32>;
+@group(0) @binding(17) var host_depth: texture_2d<u32>;
 
 @vertex
 fn vs_main(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
@@ -97,7 +97,7 @@ struct Seed {
 
 @fragment
 fn fs_main(@builtin(position) position: vec4<f32>) -> Seed {
-    let v = textureLoad(host_in, vec2<u32>(position.xy), 0).x;
+    let v = textureLoad(host_depth, vec2<u32>(position.xy), 0).x;
     if v == 0xffffffffu {
         return Seed(0.0, vec2<u32>(BACKGROUND_ID, 0u));
     }

@@ -7,6 +7,7 @@
 
 use super::frame::{FrameData, INSTANCE_BYTES, UNIFORM_INSTANCE_CAPACITY};
 use super::mesh_store::{TRIANGLE_BYTES, VERTEX_BYTES};
+use super::GpuTimer;
 use crate::error::{Error, Result};
 
 /// A shader resource and its binding number in group 0.
@@ -45,10 +46,21 @@ pub(crate) enum Res {
     /// The edge pass's list of tiles for `tile_main`.
     TilesRw = 24,
     Tiles = 25,
+    /// The host's own depth texture, which the host-depth pass resolves into [`Res::HostDepth`]
+    /// (read as unfilterable float; multisampled or not).
+    HostSource = 30,
+    /// The host-depth pass's parameters.
+    HostParams = 31,
+    /// The host-depth pass's output, the target [`Res::HostDepth`] then reads.
+    HostOut = 32,
+    /// A frame's result, which the composite draws into the host's render pass.
+    Result = 34,
 }
 
 impl Res {
-    fn layout_entry(
+    /// The layout entry of this resource, visible to `stages`; `color` is the format of
+    /// [`Res::OutColor`].
+    pub(crate) fn layout_entry(
         self,
         stages: wgpu::ShaderStages,
         color: wgpu::TextureFormat,
@@ -72,11 +84,15 @@ impl Res {
         };
         use Res::*;
         let ty = match self {
-            Frame | UniformInstances => buffer(wgpu::BufferBindingType::Uniform),
+            Frame | UniformInstances | HostParams => buffer(wgpu::BufferBindingType::Uniform),
             AccRw | CullRw | WorkRw | TilesRw => write,
             Ids | HostDepth => texture(wgpu::TextureSampleType::Uint),
-            HostColor => texture(wgpu::TextureSampleType::Float { filterable: false }),
+            // Unfilterable float: what every backend can load a depth texture as.
+            HostColor | HostSource | Result => {
+                texture(wgpu::TextureSampleType::Float { filterable: false })
+            }
             OutColor => storage_texture(color),
+            HostOut => storage_texture(super::targets::HOST_FORMAT),
             OutDiagnostic => storage_texture(super::targets::DIAGNOSTIC_FORMAT),
             OutIds => storage_texture(super::targets::RESOLVED_ID_FORMAT),
             _ => read,
@@ -105,6 +121,10 @@ impl Res {
                         | OutColor
                         | OutDiagnostic
                         | OutIds
+                        | HostSource
+                        | HostParams
+                        | HostOut
+                        | Result
                 )
             })
             .count() as u32
@@ -339,6 +359,8 @@ pub(crate) fn bind_group(
             OutIds => {
                 wgpu::BindingResource::TextureView(sources.out_ids.ok_or_else(|| missing(r))?)
             }
+            // Bound by the host-depth pass and the composite themselves.
+            HostSource | HostParams | HostOut | Result => return Err(missing(r)),
         };
         entries.push(wgpu::BindGroupEntry {
             binding: r as u32,
@@ -358,5 +380,102 @@ pub(crate) fn bind_group(
     } else {
         // The pass's own resources only: nothing wgpu could reject.
         Ok(device.create_bind_group(&desc))
+    }
+}
+
+/// How a dispatch is sized: a grid of workgroups, or by the size an earlier dispatch left in
+/// a buffer, at a byte offset.
+pub(crate) enum Size<'b> {
+    Grid(u32, u32),
+    Indirect(&'b wgpu::Buffer, u64),
+}
+
+/// Records one dispatch as a compute pass of its own, labelled `names.0` and timed as the
+/// span `names.1`.
+pub(crate) fn dispatch(
+    encoder: &mut wgpu::CommandEncoder,
+    timer: Option<&mut GpuTimer>,
+    names: (&str, &'static str),
+    (pipeline, group): (&Compute, &wgpu::BindGroup),
+    size: Size<'_>,
+) {
+    let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+        label: Some(names.0),
+        timestamp_writes: timer.and_then(|t| t.compute_span(names.1)),
+    });
+    pass.set_pipeline(&pipeline.pipeline);
+    pass.set_bind_group(0, group, &[]);
+    match size {
+        Size::Grid(x, y) => pass.dispatch_workgroups(x, y, 1),
+        Size::Indirect(buffer, offset) => pass.dispatch_workgroups_indirect(buffer, offset),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Res;
+
+    /// The resource a WGSL global of this name is, and so its binding number.
+    fn resource(name: &str, uniform: bool) -> Option<Res> {
+        use Res::*;
+        Some(match name {
+            "frame" => Frame,
+            "instances" if uniform => UniformInstances,
+            "instances" => Instances,
+            "vertices" => Vertices,
+            "vertices_hi" => VerticesHi,
+            "indices" => Indices,
+            "indices_hi" => IndicesHi,
+            "neighbours" => Neighbours,
+            "neighbours_hi" => NeighboursHi,
+            "info" => Info,
+            "clusters" => Clusters,
+            "ids" => Ids,
+            "acc_rw" => AccRw,
+            "acc" => Acc,
+            "cull_rw" => CullRw,
+            "cull" => Cull,
+            "work_rw" => WorkRw,
+            "work" => Work,
+            "host_depth" => HostDepth,
+            "out_color" => OutColor,
+            "host_color" => HostColor,
+            "out_diagnostic" => OutDiagnostic,
+            "out_ids" => OutIds,
+            "tiles_rw" => TilesRw,
+            "tiles" => Tiles,
+            "host_source" => HostSource,
+            "host" => HostParams,
+            "host_out" => HostOut,
+            "result" => Result,
+            _ => return None,
+        })
+    }
+
+    /// Every binding of every module the crate builds is the number `Res` gives its
+    /// resource: the WGSL files and the Rust layouts cannot disagree.
+    #[test]
+    fn every_wgsl_binding_is_its_resource_number() {
+        let mut seen = std::collections::HashSet::new();
+        for (name, source) in super::super::shaders::variants() {
+            let module = naga::front::wgsl::parse_str(&source)
+                .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&source)));
+            for (_, var) in module.global_variables.iter() {
+                let Some(binding) = &var.binding else {
+                    continue;
+                };
+                let var_name = var.name.as_deref().unwrap_or("?");
+                let uniform = var.space == naga::AddressSpace::Uniform;
+                let res = resource(var_name, uniform)
+                    .unwrap_or_else(|| panic!("{name}: no resource for the global {var_name}"));
+                assert_eq!(binding.group, 0, "{name}: {var_name}");
+                assert_eq!(binding.binding, res as u32, "{name}: {var_name} is {res:?}");
+                seen.insert(res);
+            }
+        }
+        assert!(
+            seen.len() >= 29,
+            "every resource is bound somewhere: {seen:?}"
+        );
     }
 }

@@ -2,6 +2,7 @@
 //! shaded surface with its lines, in any renderable colour format (sRGB ones included),
 //! with the host's sample count and depth-stencil format.
 
+use super::bindings::Res;
 use super::shaders;
 use super::targets::RESULT_FORMAT;
 use crate::error::{Error, Result};
@@ -82,16 +83,7 @@ impl CompositePipeline {
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("wirepass composite"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Texture {
-                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                    view_dimension: wgpu::TextureViewDimension::D2,
-                    multisampled: false,
-                },
-                count: None,
-            }],
+            entries: &[Res::Result.layout_entry(wgpu::ShaderStages::FRAGMENT, RESULT_FORMAT)],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("wirepass composite"),
@@ -160,7 +152,7 @@ impl CompositePipeline {
             label: Some("wirepass composite"),
             layout: &self.layout,
             entries: &[wgpu::BindGroupEntry {
-                binding: 0,
+                binding: Res::Result as u32,
                 resource: wgpu::BindingResource::TextureView(&view),
             }],
         })

@@ -15,6 +15,7 @@
 //! the ground). Where an instance shows, the host hides nothing drawn there, so a host that
 //! draws its own copy of a wireframed mesh keeps that mesh's outlines whole.
 
+use super::bindings::Res;
 use super::frame::FrameData;
 use super::targets::{Targets, DEPTH_FORMAT, HOST_FORMAT, ID_FORMAT};
 use super::{shaders, GpuTimer};
@@ -193,19 +194,19 @@ impl HostImport {
                 layout: resolve_layout,
                 entries: &[
                     wgpu::BindGroupEntry {
-                        binding: 0,
+                        binding: Res::Frame as u32,
                         resource: frame.frame.as_entire_binding(),
                     },
                     wgpu::BindGroupEntry {
-                        binding: 30,
+                        binding: Res::HostSource as u32,
                         resource: wgpu::BindingResource::TextureView(&host.view),
                     },
                     wgpu::BindGroupEntry {
-                        binding: 31,
+                        binding: Res::HostParams as u32,
                         resource: host.params.as_entire_binding(),
                     },
                     wgpu::BindGroupEntry {
-                        binding: 32,
+                        binding: Res::HostOut as u32,
                         resource: wgpu::BindingResource::TextureView(&host_view),
                     },
                 ],
@@ -215,7 +216,7 @@ impl HostImport {
             label: Some("wirepass host seed"),
             layout: seed_layout,
             entries: &[wgpu::BindGroupEntry {
-                binding: 33,
+                binding: Res::HostDepth as u32,
                 resource: wgpu::BindingResource::TextureView(&host_view),
             }],
         });
@@ -278,51 +279,26 @@ pub fn depth_quantum(format: wgpu::TextureFormat, depth: DepthRange) -> f64 {
     }
 }
 
-fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
 fn build_resolve(
     device: &wgpu::Device,
     multisampled: bool,
 ) -> Result<(wgpu::ComputePipeline, wgpu::BindGroupLayout)> {
     let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
     let cs = wgpu::ShaderStages::COMPUTE;
+    let mut source = Res::HostSource.layout_entry(cs, HOST_FORMAT);
+    if let wgpu::BindingType::Texture {
+        multisampled: m, ..
+    } = &mut source.ty
+    {
+        *m = multisampled;
+    }
     let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("wirepass host depth"),
         entries: &[
-            uniform_entry(0, cs),
-            wgpu::BindGroupLayoutEntry {
-                binding: 30,
-                visibility: cs,
-                // Unfilterable float: what every backend can load a depth texture as.
-                ty: wgpu::BindingType::Texture {
-                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                    view_dimension: wgpu::TextureViewDimension::D2,
-                    multisampled,
-                },
-                count: None,
-            },
-            uniform_entry(31, cs),
-            wgpu::BindGroupLayoutEntry {
-                binding: 32,
-                visibility: cs,
-                ty: wgpu::BindingType::StorageTexture {
-                    access: wgpu::StorageTextureAccess::WriteOnly,
-                    format: HOST_FORMAT,
-                    view_dimension: wgpu::TextureViewDimension::D2,
-                },
-                count: None,
-            },
+            Res::Frame.layout_entry(cs, HOST_FORMAT),
+            source,
+            Res::HostParams.layout_entry(cs, HOST_FORMAT),
+            Res::HostOut.layout_entry(cs, HOST_FORMAT),
         ],
     });
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -352,16 +328,7 @@ fn build_seed(device: &wgpu::Device) -> Result<(wgpu::RenderPipeline, wgpu::Bind
     let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
     let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("wirepass host seed"),
-        entries: &[wgpu::BindGroupLayoutEntry {
-            binding: 33,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Uint,
-                view_dimension: wgpu::TextureViewDimension::D2,
-                multisampled: false,
-            },
-            count: None,
-        }],
+        entries: &[Res::HostDepth.layout_entry(wgpu::ShaderStages::FRAGMENT, HOST_FORMAT)],
     });
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some("wirepass host seed"),

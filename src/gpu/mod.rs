@@ -12,9 +12,12 @@ mod context;
 mod deferred;
 #[cfg(feature = "diagnostics")]
 mod diagnostics;
+mod edge_pass;
 mod frame;
 mod host_depth;
 mod mesh_store;
+mod options;
+mod outline_pass;
 mod readback;
 pub mod shaders;
 mod targets;
@@ -30,12 +33,13 @@ pub use composite::{Composite, RenderTarget};
 pub use context::GpuContext;
 #[cfg(feature = "diagnostics")]
 pub use deferred::EdgeWork;
-pub use deferred::{DeferredPass, OutputTarget, PassOptions, PreparedFrame, TriangleIds};
+pub use deferred::{DeferredPass, PreparedFrame};
 #[cfg(feature = "diagnostics")]
 pub use diagnostics::EncodeOptions;
 pub use frame::{light_world_dir, Canvas, Region, MAX_INSTANCES};
 pub use host_depth::{depth_quantum, HostDepth};
 pub use mesh_store::{MeshId, MeshStore};
+pub use options::{OutputTarget, PassOptions, TriangleIds};
 pub use readback::read_texture;
 pub use targets::{
     BACKGROUND_ID, DEPTH_FORMAT, DIAGNOSTIC_FORMAT, HOST_FORMAT, HOST_ID, ID_FORMAT,

@@ -263,3 +263,70 @@ pub(crate) fn clear_color(format: wgpu::TextureFormat, bg: [f32; 4]) -> wgpu::Co
         a: f64::from(bg[3]),
     }
 }
+
+/// Checks a storage texture the pass writes: format, size, usage, one sample, 2D.
+pub(crate) fn check_storage_output(
+    view: &wgpu::TextureView,
+    format: wgpu::TextureFormat,
+    size: (u32, u32),
+    what: &str,
+) -> Result<()> {
+    let t = view.texture();
+    if t.format() != format {
+        return Err(Error::Misuse(format!(
+            "{what} is {:?}, but the pass was built for {format:?}",
+            t.format()
+        )));
+    }
+    check_texture(t, size, wgpu::TextureUsages::STORAGE_BINDING, what)
+}
+
+/// Checks a texture the pass samples: size, usage, one sample, 2D, a float format.
+pub(crate) fn check_sampled(view: &wgpu::TextureView, size: (u32, u32), what: &str) -> Result<()> {
+    let t = view.texture();
+    let float = matches!(
+        t.format().sample_type(None, None),
+        Some(wgpu::TextureSampleType::Float { .. })
+    );
+    if !float {
+        return Err(Error::Misuse(format!(
+            "{what} is {:?}, which is not a colour format read as float",
+            t.format()
+        )));
+    }
+    check_texture(t, size, wgpu::TextureUsages::TEXTURE_BINDING, what)
+}
+
+fn check_texture(
+    t: &wgpu::Texture,
+    size: (u32, u32),
+    usage: wgpu::TextureUsages,
+    what: &str,
+) -> Result<()> {
+    if (t.width(), t.height()) != size {
+        return Err(Error::Misuse(format!(
+            "{what} is {}x{}, but the frame was prepared for {}x{}",
+            t.width(),
+            t.height(),
+            size.0,
+            size.1
+        )));
+    }
+    if !t.usage().contains(usage) {
+        return Err(Error::Misuse(format!(
+            "{what} lacks the usage {usage:?} (it has {:?})",
+            t.usage()
+        )));
+    }
+    if t.sample_count() != 1 {
+        return Err(Error::Misuse(format!(
+            "{what} has {} samples; the pass writes single-sampled textures (draw into a \
+             multisampled target with the render-pass entry instead)",
+            t.sample_count()
+        )));
+    }
+    if t.dimension() != wgpu::TextureDimension::D2 || t.depth_or_array_layers() != 1 {
+        return Err(Error::Misuse(format!("{what} is not a single 2D texture")));
+    }
+    Ok(())
+}

@@ -1,0 +1,137 @@
+//! The outline pass (compute, `shaders/outline.wgsl`): outlines (silhouettes and
+//! boundaries) and the drawn edges of large patches, drawn from the triangles into every
+//! pixel within reach of their visible runs. Three dispatches: a cull of the clusters that
+//! may hold such an edge, one invocation per listed triangle listing the edges' pieces, one
+//! per piece drawing it.
+
+use super::bindings::{self, dispatch, store_resources, Compute, Res, Size, Sources};
+use super::deferred::PreparedFrame;
+use super::frame::FrameData;
+use super::targets::LIST_HEADER;
+use super::variants::Variant;
+use super::{shaders, GpuTimer};
+use crate::error::{Error, Result};
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex};
+
+/// Workgroup size of the outline pass.
+const GROUP: u32 = 64;
+
+struct OutlinePipelines {
+    cull: Compute,
+    /// Lists the pieces of the listed clusters' outline edges.
+    draw: Compute,
+    /// Draws the listed pieces, one a lane.
+    pieces: Compute,
+}
+
+/// Where the piece dispatch's size lies in a frame's cluster list buffer: after the cluster
+/// list (header, then two words per cluster).
+pub(crate) fn piece_size_at(data: &FrameData) -> u64 {
+    LIST_HEADER + 8 * u64::from(data.uniforms_clusters().max(1))
+}
+
+/// The outline pass's pipelines, built for each variant on first use.
+pub(crate) struct OutlinePass {
+    /// The format the pipelines' layouts name for the (unused) colour output.
+    format: wgpu::TextureFormat,
+    cache: Mutex<HashMap<Variant, Arc<OutlinePipelines>>>,
+}
+
+impl OutlinePass {
+    pub(crate) fn new(format: wgpu::TextureFormat) -> Self {
+        Self {
+            format,
+            cache: Mutex::default(),
+        }
+    }
+
+    fn pipelines(&self, device: &wgpu::Device, v: Variant) -> Result<Arc<OutlinePipelines>> {
+        let mut cache = self
+            .cache
+            .lock()
+            .map_err(|_| Error::Device("pipeline cache poisoned".into()))?;
+        if let Some(p) = cache.get(&v) {
+            return Ok(p.clone());
+        }
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let source = shaders::outline_source(&v.flags());
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("wirepass outline pass"),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
+        });
+        let cull = Compute::new(
+            device,
+            &module,
+            "outline_cull",
+            vec![
+                Res::Frame,
+                bindings::instances(v.uniform_instances),
+                Res::Clusters,
+                Res::CullRw,
+            ],
+            self.format,
+        )?;
+        let mut draw_res = store_resources(v.split, true, v.uniform_instances);
+        draw_res.extend([Res::Ids, Res::AccRw]);
+        if v.host {
+            draw_res.push(Res::HostDepth);
+        }
+        let pieces = Compute::new(
+            device,
+            &module,
+            "outline_pieces_main",
+            draw_res.clone(),
+            self.format,
+        )?;
+        draw_res.push(Res::Cull);
+        let draw = Compute::new(device, &module, "outline_main", draw_res, self.format)?;
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(Error::Device(format!("building the outline pass: {e}")));
+        }
+        let p = Arc::new(OutlinePipelines { cull, draw, pieces });
+        cache.insert(v, p.clone());
+        Ok(p)
+    }
+
+    /// The outline pass: `outline_cull` lists the (instance, cluster) pairs that may hold
+    /// an outline edge, on a 2D grid of workgroups (huge scenes need more than one dimension
+    /// allows); `outline_main` then visits their triangles, dispatched indirectly with the
+    /// size the cull leaves, and lists the pieces (up to 16 px) of their outline edges;
+    /// `outline_pieces_main` draws those, one a lane.
+    pub(crate) fn encode(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        (frame, reset): (&PreparedFrame, &wgpu::Buffer),
+        sources: &Sources<'_>,
+        variant: Variant,
+        mut timer: Option<&mut GpuTimer>,
+    ) -> Result<()> {
+        let p = self.pipelines(device, variant)?;
+        let cull = p.cull.bind(device, sources)?;
+        let draw = p.draw.bind(device, sources)?;
+        let pieces = p.pieces.bind(device, sources)?;
+        let t = &frame.targets;
+        encoder.clear_buffer(&t.acc, 0, Some(t.acc_pieces));
+        encoder.copy_buffer_to_buffer(reset, 0, &t.acc, t.acc_tiles, LIST_HEADER);
+        encoder.copy_buffer_to_buffer(reset, 0, &t.acc, t.acc_pieces, LIST_HEADER);
+        encoder.copy_buffer_to_buffer(reset, 0, &frame.cull, 0, LIST_HEADER);
+        let groups = frame.data.uniforms_clusters().div_ceil(GROUP);
+        let max = device.limits().max_compute_workgroups_per_dimension.max(1);
+        let (x, y) = (groups.clamp(1, max), groups.div_ceil(max).max(1));
+        let names = ("wirepass outline cull", "outline.cull");
+        let size = Size::Grid(x, y);
+        dispatch(encoder, timer.as_deref_mut(), names, (&p.cull, &cull), size);
+        let names = ("wirepass outline pass", "outline.draw");
+        let size = Size::Indirect(&frame.cull, 0);
+        dispatch(encoder, timer.as_deref_mut(), names, (&p.draw, &draw), size);
+        // The piece dispatch's size, where no pass binding `acc` for writing reads it.
+        let size_at = piece_size_at(&frame.data);
+        encoder.copy_buffer_to_buffer(&t.acc, t.acc_pieces, &frame.cull, size_at, LIST_HEADER);
+        let names = ("wirepass outline pieces", "outline.pieces");
+        let size = Size::Indirect(&frame.cull, size_at);
+        dispatch(encoder, timer, names, (&p.pieces, &pieces), size);
+        Ok(())
+    }
+}
