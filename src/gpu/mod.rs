@@ -15,6 +15,7 @@ mod diagnostics;
 mod edge_pass;
 mod frame;
 mod host_depth;
+mod mesh_records;
 mod mesh_store;
 mod options;
 mod outline_pass;

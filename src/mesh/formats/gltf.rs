@@ -181,7 +181,7 @@ fn supported_requirement(name: &str) -> bool {
             .any(|p| name.starts_with(p))
 }
 
-type Res<T> = std::result::Result<T, String>;
+type FileResult<T> = std::result::Result<T, String>;
 
 /// Loads a glTF file's scene. Every problem of the file is an [`Error::MeshFile`] naming
 /// it (a missing external buffer too); a scene without a triangle to draw is one as well.
@@ -247,7 +247,7 @@ type Chunks<'a> = (Cow<'a, [u8]>, Option<Cow<'a, [u8]>>);
 /// The GLB container's JSON chunk and binary chunk. The header is checked here before the
 /// `gltf` crate splits the chunks: it subtracts the header size from the declared length
 /// without checking it first.
-fn split_glb(bytes: &[u8]) -> Res<Chunks<'_>> {
+fn split_glb(bytes: &[u8]) -> FileResult<Chunks<'_>> {
     let word = |at: usize| {
         bytes
             .get(at..at + 4)
@@ -294,7 +294,7 @@ struct RawNode {
 
 impl RawNode {
     /// The node's local transform: its matrix, or T · R · S.
-    fn local(&self) -> Res<DMat4> {
+    fn local(&self) -> FileResult<DMat4> {
         if let Some(m) = self.matrix {
             return Ok(DMat4::from_cols_array(&m));
         }
@@ -309,7 +309,7 @@ impl RawNode {
     }
 }
 
-fn parse(path: &Path, bytes: &[u8]) -> Res<Document> {
+fn parse(path: &Path, bytes: &[u8]) -> FileResult<Document> {
     if bytes.is_empty() {
         return Err("empty file, not a glTF file".into());
     }
@@ -463,7 +463,7 @@ fn named(name: Option<&str>) -> String {
 }
 
 /// Whether a node's world transform can place a mesh: finite, affine and not singular.
-fn check_placement(t: &DMat4) -> Res<()> {
+fn check_placement(t: &DMat4) -> FileResult<()> {
     if !t.is_finite() {
         return Err("its transform has a non-finite entry".into());
     }
@@ -477,7 +477,7 @@ fn check_placement(t: &DMat4) -> Res<()> {
 }
 
 /// Camera `index` of the file, placed by `world`, checked.
-fn camera_of(doc: &gltf::Document, index: usize, world: DMat4) -> Res<GltfCamera> {
+fn camera_of(doc: &gltf::Document, index: usize, world: DMat4) -> FileResult<GltfCamera> {
     use gltf::json::camera::Type;
     use gltf::json::validation::Checked;
     let json = &doc.as_json().cameras[index];
@@ -561,7 +561,11 @@ struct Buffers<'a> {
 }
 
 impl<'a> Buffers<'a> {
-    fn load(path: &Path, doc: &gltf::Document, blob: Option<Cow<'a, [u8]>>) -> Res<Buffers<'a>> {
+    fn load(
+        path: &Path,
+        doc: &gltf::Document,
+        blob: Option<Cow<'a, [u8]>>,
+    ) -> FileResult<Buffers<'a>> {
         let mut blob = blob;
         let mut data = Vec::new();
         for buffer in doc.buffers() {
@@ -588,7 +592,7 @@ impl<'a> Buffers<'a> {
     }
 
     /// The bytes of a buffer view, checked against its buffer.
-    fn view(&self, view: &gltf::buffer::View) -> Res<&[u8]> {
+    fn view(&self, view: &gltf::buffer::View) -> FileResult<&[u8]> {
         let buffer = &self.data[view.buffer().index()];
         let (start, length) = (view.offset(), view.length());
         start
@@ -611,7 +615,7 @@ impl<'a> Buffers<'a> {
         &self,
         accessor: &gltf::Accessor,
         convert: impl Fn(&[u8]) -> T,
-    ) -> Res<Vec<T>> {
+    ) -> FileResult<Vec<T>> {
         let a = accessor.index();
         let count = accessor.count();
         let size = accessor.size();
@@ -686,7 +690,7 @@ impl<'a> Buffers<'a> {
 
     /// A vertex attribute of three components as f32: floats, or the integer types
     /// `KHR_mesh_quantization` allows, normalized or not.
-    fn read_vec3(&self, accessor: &gltf::Accessor, what: &str) -> Res<Vec<Vec3>> {
+    fn read_vec3(&self, accessor: &gltf::Accessor, what: &str) -> FileResult<Vec<Vec3>> {
         if accessor.dimensions() != Dimensions::Vec3 {
             return Err(format!(
                 "{what} accessor {} is {:?}, not VEC3",
@@ -718,7 +722,7 @@ impl<'a> Buffers<'a> {
     }
 
     /// Unsigned integer scalars (indices), widened to u32.
-    fn read_indices(&self, accessor: &gltf::Accessor, what: &str) -> Res<Vec<u32>> {
+    fn read_indices(&self, accessor: &gltf::Accessor, what: &str) -> FileResult<Vec<u32>> {
         let ok = accessor.dimensions() == Dimensions::Scalar
             && matches!(
                 accessor.data_type(),
@@ -767,7 +771,7 @@ fn component_reader(ty: DataType, normalized: bool) -> Option<fn(&[u8]) -> f32> 
 
 /// Reads a buffer's URI: a base64 `data:` URI, or a file relative to the glTF file's
 /// folder (percent-encoded, as URIs are).
-fn read_uri(path: &Path, uri: &str) -> Res<Vec<u8>> {
+fn read_uri(path: &Path, uri: &str) -> FileResult<Vec<u8>> {
     use base64::Engine as _;
     if let Some(rest) = uri.strip_prefix("data:") {
         let (_, data) = rest
@@ -825,7 +829,7 @@ fn build_mesh(
     buffers: &Buffers,
     index: usize,
     notes: &mut Vec<String>,
-) -> Res<Option<GltfMesh>> {
+) -> FileResult<Option<GltfMesh>> {
     let Some(mesh) = doc.meshes().nth(index) else {
         return Err(format!("mesh {index} does not exist"));
     };
@@ -1003,7 +1007,11 @@ fn triangles(mode: Mode, idx: &[u32], at: &str, notes: &mut Vec<String>) -> Vec<
 }
 
 /// An accessor named by an extension's property.
-fn accessor_at<'d>(doc: &'d gltf::Document, value: &Value, name: &str) -> Res<gltf::Accessor<'d>> {
+fn accessor_at<'d>(
+    doc: &'d gltf::Document,
+    value: &Value,
+    name: &str,
+) -> FileResult<gltf::Accessor<'d>> {
     let i = value
         .get(name)
         .ok_or_else(|| format!("no {name}"))?
@@ -1023,7 +1031,7 @@ fn edge_visibility(
     ext: &Value,
     tris: &[[u32; 3]],
     count: usize,
-) -> Res<Vec<[u8; 3]>> {
+) -> FileResult<Vec<[u8; 3]>> {
     let mut levels = vec![[HIDDEN; 3]; count];
     if ext.get("visibility").is_some() {
         let acc = accessor_at(doc, ext, "visibility")?;
@@ -1076,7 +1084,11 @@ fn edge_visibility(
 }
 
 /// The vertex pairs a `CESIUM_primitive_outline` object lists.
-fn outline_pairs(doc: &gltf::Document, buffers: &Buffers, ext: &Value) -> Res<HashSet<(u32, u32)>> {
+fn outline_pairs(
+    doc: &gltf::Document,
+    buffers: &Buffers,
+    ext: &Value,
+) -> FileResult<HashSet<(u32, u32)>> {
     let acc = accessor_at(doc, ext, "indices")?;
     let idx = buffers.read_indices(&acc, "indices")?;
     if !idx.len().is_multiple_of(2) {
@@ -1139,7 +1151,7 @@ fn line_width(
 }
 
 /// Builds the mesh, then its authored edge masks from the levels.
-fn finish(b: Builder, what: &str, name: String) -> Res<GltfMesh> {
+fn finish(b: Builder, what: &str, name: String) -> FileResult<GltfMesh> {
     let Builder {
         positions,
         mut normals,

@@ -1,0 +1,430 @@
+//! How one mesh becomes the mesh store's records: positions relative to its centre and
+//! scaled, packed normals, triangles in cluster order, each edge's neighbour word, and the
+//! per-triangle info word (drawn edges, patches, quads) that the shaders decode. The store
+//! (`mesh_store.rs`) places these records in its arena; `shaders/common.wgsl` and
+//! `shaders/scene.wgsl` hold the decoding twins.
+
+// `!(a > b)` is deliberate throughout: NaN must take the rejecting branch.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+use super::mesh_store::{MeshLines, CLUSTER};
+use crate::mesh::{adjacency::NO_NEIGHBOUR, patches::Patches, EdgeSelection, Mesh, ALL_EDGES};
+use glam::{DVec3, Vec2, Vec3};
+use std::sync::Arc;
+
+/// The packed normal of a vertex without one (a zero normal, next to degenerate triangles
+/// only): both components at the snorm code that unpacking clamps, which no unit vector
+/// packs to.
+pub(crate) const NO_NORMAL: u32 = 0x8000_8000;
+
+/// One mesh as the arena stores it.
+pub(crate) struct MeshData {
+    pub vertices: Vec<[f32; 4]>,
+    pub indices: Vec<[u32; 3]>,
+    pub neighbours: Vec<[u32; 3]>,
+    pub info: Vec<u32>,
+    pub clusters: Vec<[f32; 8]>,
+    pub bounds_of_clusters: Arc<[[f32; 8]]>,
+    pub lines: MeshLines,
+    pub origin: DVec3,
+    pub scale: f64,
+    pub order: Arc<[u32]>,
+    pub bounds: (DVec3, DVec3),
+}
+
+impl MeshData {
+    pub(crate) fn new(mesh: &Mesh, edges: EdgeSelection) -> MeshData {
+        let (lo, hi) = mesh.bounds_f64();
+        let origin = (lo + hi) * 0.5;
+        let extent = (hi - lo).max_element() * 0.5;
+        // A power of two, so scaling is exact; 1 for a mesh of one point.
+        let scale = if extent > 0.0 && extent.is_finite() {
+            extent.log2().round().exp2()
+        } else {
+            1.0
+        };
+        let vertices = mesh
+            .positions()
+            .iter()
+            .zip(mesh.normals())
+            .map(|(p, n)| {
+                let q = ((p.as_dvec3() - origin) / scale).as_vec3();
+                [q.x, q.y, q.z, f32::from_bits(pack_normal(*n))]
+            })
+            .collect();
+        let clusters = mesh.outline_clusters();
+        let order: Arc<[u32]> = clusters.order.clone().into();
+        let mut stored = vec![0u32; order.len()];
+        for (s, &t) in order.iter().enumerate() {
+            stored[t as usize] = s as u32;
+        }
+        let tris = mesh.triangles();
+        let indices = order.iter().map(|&t| tris[t as usize]).collect();
+        let neighbours = order
+            .iter()
+            .map(|&t| [0, 1, 2].map(|i| neighbour_word(mesh, &stored, t as usize, i)))
+            .collect();
+        let bounds: Vec<[f32; 8]> = clusters
+            .bounds
+            .iter()
+            .map(|c| {
+                let center = (c.center - origin) / scale;
+                let radius = c.radius / scale * (1.0 + 1e-6) + center.length() * 1e-6;
+                let [x, y, z] = center.as_vec3().to_array();
+                let [ax, ay, az] = c.axis.as_vec3().to_array();
+                [x, y, z, radius as f32, ax, ay, az, c.spread as f32]
+            })
+            .collect();
+        let bounds: Arc<[[f32; 8]]> = bounds.into();
+        let edges = EdgeData::new(mesh, edges, &order);
+        MeshData {
+            vertices,
+            indices,
+            neighbours,
+            clusters: cluster_records(&bounds, &edges.info),
+            bounds_of_clusters: bounds,
+            info: edges.info,
+            lines: edges.lines,
+            origin,
+            scale,
+            order,
+            bounds: (lo, hi),
+        }
+    }
+}
+
+/// Most triangles in one mesh: a neighbour word holds the neighbour's index in 29 bits, and
+/// the all-ones word means no neighbour.
+pub(crate) const MAX_MESH_TRIANGLES: u32 = (1 << 29) - 1;
+/// The neighbour word's bits below this hold the neighbour's stored index (relative to its
+/// mesh); the next two its corner off the shared edge.
+const NEIGHBOUR_CORNER_SHIFT: u32 = 29;
+/// Bit of a neighbour word: the neighbour runs along the shared edge the same way as this
+/// triangle (the two are wound oppositely); clear, the other way.
+const NEIGHBOUR_SAME_WAY: u32 = 1 << 31;
+
+/// What the passes read of the triangle across edge `i` of triangle `t` (`scene.wgsl`,
+/// `neighbour_word`): its stored index, its corner k off the shared edge and whether its
+/// corners k + 1 and k + 2 are that edge's start and end (the same way) or its end and start.
+/// A step of a walk across the edge then reads one corner, not three; `u32::MAX` where there
+/// is no neighbour. The shared corners are found by position, as the adjacency welds them.
+fn neighbour_word(mesh: &Mesh, stored: &[u32], t: usize, i: usize) -> u32 {
+    let n = mesh.edge_neighbours()[t][i];
+    if n == NO_NEIGHBOUR {
+        return u32::MAX;
+    }
+    let tris = mesh.triangles();
+    let at = |v: u32| {
+        (mesh.positions()[v as usize] + Vec3::ZERO)
+            .to_array()
+            .map(f32::to_bits)
+    };
+    let (a, b) = (at(tris[t][i]), at(tris[t][(i + 1) % 3]));
+    let other = tris[n as usize];
+    let back = (0..3).find(|&j| {
+        let (p, q) = (at(other[j]), at(other[(j + 1) % 3]));
+        mesh.edge_neighbours()[n as usize][j] == t as u32 && ((p, q) == (a, b) || (p, q) == (b, a))
+    });
+    // The adjacency pairs the two sides of an edge with the same welded ends, so `back` is
+    // always found; without it the edge reads as a boundary.
+    let Some(j) = back else {
+        return u32::MAX;
+    };
+    let k = (j as u32 + 2) % 3;
+    let same_way = if at(other[j]) == a {
+        NEIGHBOUR_SAME_WAY
+    } else {
+        0
+    };
+    stored[n as usize] | k << NEIGHBOUR_CORNER_SHIFT | same_way
+}
+
+/// Bit of [`EdgeData::info`]: the triangle's patch is large ([`Patches::large`]).
+const INFO_LARGE_PATCH: u32 = 1 << 11;
+/// First of the three bits of [`EdgeData::info`] that mark the edges the outline pass draws
+/// for a large patch ([`Patches::splat`]).
+const INFO_SPLAT_SHIFT: u32 = 12;
+/// Bit of [`EdgeData::info`]: the triangle's patch is a quad (two triangles), which the edge
+/// pass searches without a queue.
+const INFO_QUAD: u32 = 1 << 15;
+
+/// First bit of [`EdgeData::info`] of a quad: its diagonal (edge 0–2, two bits), then the
+/// other triangle's corner off the diagonal (two bits), whether that triangle's next corner
+/// is the diagonal's start (one bit) and its drawn edges (three bits): `quad_of` in
+/// edge_pass.wgsl reads the other triangle from these, its id and one corner's position.
+const QUAD_SHIFT: u32 = 16;
+
+/// Bits of [`EdgeData::info`] of a quad: its other triangle is stored right after this one
+/// ([`QUAD_NEXT`]) or right before it ([`QUAD_PREVIOUS`]), as the cluster order keeps the
+/// halves of a source quad ([`Mesh::quad_partners`]); with neither, `quad_of` reads it from
+/// the adjacency.
+const QUAD_NEXT: u32 = 1 << 24;
+const QUAD_PREVIOUS: u32 = 1 << 25;
+
+/// [`INFO_QUAD`] and the bits after [`QUAD_SHIFT`] for triangle `t` of a two-triangle patch
+/// under edge mask `mask` (`stored` maps triangles to their stored places), or 0 (the
+/// triangle is then searched as any small patch is) where the other triangle does not meet
+/// it across the diagonal at bit-identical positions (so that the diagonal's ends read from
+/// either triangle are the same numbers) or draws the diagonal from its side.
+fn quad_bits(mesh: &Mesh, mask: &[u8], stored: &[u32], t: usize) -> u32 {
+    let neighbours = mesh.edge_neighbours();
+    let (tris, positions) = (mesh.triangles(), mesh.positions());
+    let at = |v: u32| positions[v as usize].to_array().map(f32::to_bits);
+    // The last undrawn edge with a neighbour, as the search would take it.
+    let Some(e) = (0..3)
+        .rev()
+        .find(|&e| mask[t] & (1 << e) == 0 && neighbours[t][e] != NO_NEIGHBOUR)
+    else {
+        return 0;
+    };
+    let n = neighbours[t][e] as usize;
+    let (a, b) = (at(tris[t][e]), at(tris[t][(e + 1) % 3]));
+    let shared = (0..3).find_map(|j| {
+        let (p, q) = (at(tris[n][j]), at(tris[n][(j + 1) % 3]));
+        let back = neighbours[n][j] as usize == t && mask[n] & (1 << j) == 0;
+        (back && ((p, q) == (a, b) || (p, q) == (b, a))).then_some((j, p == a))
+    });
+    let Some((j, same)) = shared else {
+        return 0;
+    };
+    let k = (j + 2) % 3;
+    let place = if stored[n] == stored[t] + 1 {
+        QUAD_NEXT
+    } else if stored[n] + 1 == stored[t] {
+        QUAD_PREVIOUS
+    } else {
+        0
+    };
+    INFO_QUAD
+        | place
+        | (e as u32) << QUAD_SHIFT
+        | (k as u32) << (QUAD_SHIFT + 2)
+        | u32::from(same) << (QUAD_SHIFT + 4)
+        | u32::from(mask[n] & ALL_EDGES) << (QUAD_SHIFT + 5)
+}
+
+/// A mesh's edge data under one edge selection, in stored order.
+pub(crate) struct EdgeData {
+    /// Per stored triangle, the 4 bytes the passes read (`triangle_info` in common.wgsl):
+    /// bits 0–2 the drawn edges, bit 3 a boundary edge, bits 4–7 the fold code of
+    /// [`Mesh::outline_hints`], bits 8–10 the edges that may be drawn as outlines, bit 11
+    /// a large patch, bits 12–14 the drawn edges the outline pass draws, bit 15 a patch of
+    /// two triangles, bits 16–25 that quad's other triangle ([`quad_bits`]).
+    pub info: Vec<u32>,
+    pub lines: MeshLines,
+}
+
+impl EdgeData {
+    pub fn new(mesh: &Mesh, edges: EdgeSelection, order: &[u32]) -> EdgeData {
+        let mask = mesh.edge_mask(edges);
+        let neighbours = mesh.edge_neighbours();
+        // Each edge splatted from the side with the lower stored id, the side the outline
+        // pass draws a silhouette from.
+        let mut stored = vec![0u32; order.len()];
+        for (s, &t) in order.iter().enumerate() {
+            stored[t as usize] = s as u32;
+        }
+        let patches = Patches::ordered(neighbours, &mask, |t, u| stored[t] < stored[u]);
+        let hints = mesh.outline_hints();
+        let outline = mesh.outline_mask();
+        let info = order
+            .iter()
+            .map(|&t| {
+                let t = t as usize;
+                let large = if patches.large[t] {
+                    INFO_LARGE_PATCH
+                } else {
+                    0
+                };
+                let quad = if patches.size[t] == 2 {
+                    quad_bits(mesh, &mask, &stored, t)
+                } else {
+                    0
+                };
+                u32::from(mask[t])
+                    | u32::from(hints[t]) << 3
+                    | u32::from(outline[t]) << 8
+                    | large
+                    | u32::from(patches.splat[t]) << INFO_SPLAT_SHIFT
+                    | quad
+            })
+            .collect();
+        let lines = MeshLines {
+            small_patches: mask
+                .iter()
+                .zip(&patches.large)
+                .any(|(&m, &large)| m != ALL_EDGES && !large),
+            splat: patches.splat.iter().any(|&b| b != 0),
+        };
+        EdgeData { info, lines }
+    }
+}
+
+/// The cluster records the outline pass reads: `bounds` with the spread of each cluster
+/// holding an edge to splat (`info`, stored order) stored as −1 − spread, so the outline
+/// pass visits it whatever the eye (`cluster_splats` in common.wgsl).
+pub(crate) fn cluster_records(bounds: &[[f32; 8]], info: &[u32]) -> Vec<[f32; 8]> {
+    bounds
+        .iter()
+        .zip(info.chunks(CLUSTER as usize))
+        .map(|(b, tris)| {
+            let mut b = *b;
+            if tris.iter().any(|i| i >> INFO_SPLAT_SHIFT & 7 != 0) {
+                b[7] = -1.0 - b[7];
+            }
+            b
+        })
+        .collect()
+}
+
+/// A unit normal packed octahedrally into two 16-bit snorms (`unpack_normal` in
+/// common.wgsl is the inverse); a zero normal packs to `NO_NORMAL`.
+pub(crate) fn pack_normal(n: Vec3) -> u32 {
+    let sum = n.x.abs() + n.y.abs() + n.z.abs();
+    if !(sum > 0.0) {
+        return NO_NORMAL;
+    }
+    let mut p = Vec2::new(n.x, n.y) / sum;
+    if n.z < 0.0 {
+        let sign = Vec2::new(p.x.signum(), p.y.signum());
+        p = (Vec2::ONE - Vec2::new(p.y.abs(), p.x.abs())) * sign;
+    }
+    let q = |v: f32| (v.clamp(-1.0, 1.0) * 32767.0).round() as i16 as u16 as u32;
+    q(p.x) | q(p.y) << 16
+}
+
+/// Twin of `unpack_normal` in common.wgsl: the unit normal of a packed one (zero for
+/// `NO_NORMAL`).
+#[cfg(test)]
+pub(crate) fn unpack_normal(packed: u32) -> Vec3 {
+    if packed == NO_NORMAL {
+        return Vec3::ZERO;
+    }
+    let s = |v: u32| (f32::from(v as u16 as i16) / 32767.0).max(-1.0);
+    let (x, y) = (s(packed & 0xffff), s(packed >> 16));
+    let mut n = Vec3::new(x, y, 1.0 - x.abs() - y.abs());
+    let t = (-n.z).max(0.0);
+    n.x += if n.x >= 0.0 { -t } else { t };
+    n.y += if n.y >= 0.0 { -t } else { t };
+    n.normalize()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The quad (0,0)-(1,0)-(1,1)-(0,1) split along 0-2, the second triangle's corners
+    /// given by `second` over positions `p`, with the diagonal undrawn on both sides.
+    fn quad_info(p: Vec<Vec3>, second: [u32; 3]) -> [u32; 2] {
+        let shared = (0..3)
+            .find(|&j| {
+                let e = [second[j], second[(j + 1) % 3]].map(|v| p[v as usize]);
+                e.contains(&p[0]) && e.contains(&p[2])
+            })
+            .unwrap();
+        let mask = vec![0b011, ALL_EDGES & !(1 << shared)];
+        let mesh = Mesh::new(p, None, vec![[0, 1, 2], second], Some(mask)).unwrap();
+        let mask = mesh.edge_mask(EdgeSelection::Polygon);
+        [0, 1].map(|t| quad_bits(&mesh, &mask, &[0, 1], t))
+    }
+
+    fn square() -> Vec<Vec3> {
+        [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
+            .map(|(x, y)| Vec3::new(x, y, 0.0))
+            .to_vec()
+    }
+
+    /// Decodes quad_bits as quad_distance does: the diagonal, the other triangle's corner
+    /// off it, whether its next corner is the diagonal's start, its drawn edges.
+    fn decode(bits: u32) -> (u32, u32, bool, u32) {
+        assert_ne!(bits & INFO_QUAD, 0);
+        let b = bits >> QUAD_SHIFT;
+        (b & 3, b >> 2 & 3, b >> 4 & 1 == 1, b >> 5 & 7)
+    }
+
+    #[test]
+    fn quad_bits_name_the_other_triangle_s_fourth_corner() {
+        // Consistently wound: the diagonal is edge 2 (2 -> 0) of the first triangle and
+        // edge 0 (0 -> 2) of the second, whose corner off it is 3 (corner 2).
+        let [first, second] = quad_info(square(), [0, 2, 3]);
+        assert_eq!(decode(first), (2, 2, false, 0b110));
+        assert_eq!(decode(second), (0, 1, false, 0b011));
+        // Stored side by side, each says where the other is.
+        assert_eq!(first & (QUAD_NEXT | QUAD_PREVIOUS), QUAD_NEXT);
+        assert_eq!(second & (QUAD_NEXT | QUAD_PREVIOUS), QUAD_PREVIOUS);
+        // The second triangle wound the other way (its next corner after 3 is the first
+        // triangle's diagonal start, 2), and with split vertices at the same positions.
+        let mut p = square();
+        p.extend([p[0], p[2]]);
+        let [first, second] = quad_info(p, [3, 5, 4]);
+        assert_eq!(decode(first), (2, 0, true, 0b101));
+        assert_eq!(decode(second), (1, 1, true, 0b011));
+    }
+
+    #[test]
+    fn neighbour_words_give_the_corner_off_the_edge_and_the_way_round() {
+        let mut split = square();
+        split.extend([split[0], split[2]]);
+        // The second triangle wound against the first, with it, and on split vertices.
+        for (p, second) in [
+            (square(), [0, 2, 3]),
+            (square(), [0, 3, 2]),
+            (split, [3, 5, 4]),
+        ] {
+            let mesh = Mesh::new(p.clone(), None, vec![[0, 1, 2], second], None).unwrap();
+            let tris = mesh.triangles();
+            for (t, i) in (0..2).flat_map(|t| (0..3).map(move |i| (t, i))) {
+                let word = neighbour_word(&mesh, &[0, 1], t, i);
+                let n = mesh.edge_neighbours()[t][i];
+                if n == NO_NEIGHBOUR {
+                    assert_eq!(word, u32::MAX);
+                    continue;
+                }
+                assert_eq!(word & MAX_MESH_TRIANGLES, n);
+                // The neighbour's corners as beyond_edge (scene.wgsl) rebuilds them: corner k
+                // read, the next two the edge's ends.
+                let k = (word >> NEIGHBOUR_CORNER_SHIFT & 3) as usize;
+                let (a, b) = (p[tris[t][i] as usize], p[tris[t][(i + 1) % 3] as usize]);
+                let same = word & NEIGHBOUR_SAME_WAY != 0;
+                let mut q = [p[tris[n as usize][k] as usize]; 3];
+                q[(k + 1) % 3] = if same { a } else { b };
+                q[(k + 2) % 3] = if same { b } else { a };
+                assert_eq!(q, tris[n as usize].map(|v| p[v as usize]), "{t} {i}");
+            }
+        }
+    }
+
+    #[test]
+    fn quads_joined_at_unequal_bits_are_searched_instead() {
+        // 0.0 and -0.0 weld into one edge, but read from the two triangles they would be
+        // different numbers: the triangles are left to the patch search.
+        let mut p = square();
+        p.extend([Vec3::new(-0.0, 0.0, 0.0), p[2]]);
+        assert_eq!(quad_info(p, [4, 5, 3]), [0, 0]);
+    }
+
+    #[test]
+    fn normals_survive_packing() {
+        let mut worst: f64 = 0.0;
+        for i in 0..2000 {
+            let a = i as f32 * 0.731;
+            let b = (i as f32 * 0.377).sin() * 1.5;
+            let n = Vec3::new(a.cos() * b.cos(), b.sin(), a.sin() * b.cos()).normalize();
+            let m = unpack_normal(pack_normal(n));
+            let cos = n.as_dvec3().dot(m.as_dvec3());
+            let sin = n.as_dvec3().cross(m.as_dvec3()).length();
+            worst = worst.max(sin.atan2(cos));
+        }
+        assert!(worst < 1e-4, "{worst}");
+        for n in [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z] {
+            assert!(unpack_normal(pack_normal(n)).distance(n) < 1e-6, "{n}");
+        }
+        assert_eq!(pack_normal(Vec3::ZERO), NO_NORMAL);
+        assert_eq!(unpack_normal(NO_NORMAL), Vec3::ZERO);
+        // No unit normal packs to the marker.
+        assert_ne!(
+            pack_normal(Vec3::new(-1.0, -1.0, 0.0).normalize()),
+            NO_NORMAL
+        );
+    }
+}
