@@ -694,20 +694,45 @@ fn shaded_composite_keeps_the_host_image_where_no_instance_shows() {
     assert!(on_instances > 5_000 && on_host > 5_000 && outlined > 100);
 }
 
-/// Every misuse of the library API is its `wirepass::Error`: no panic, no wgpu validation
-/// error on the device.
-#[test]
-fn misuse_is_an_error_never_a_panic_or_a_validation_error() {
-    let ctx = device();
-    let d = &ctx.device;
-    let f = fixture();
-    let view = f.scene.view(ASPECT, DepthRange::Standard);
-    let wp = Wirepass::new();
-    let misuse = |what: &str, r: wirepass::Result<()>| match r {
+/// Expects `r` to be an [`Error::Misuse`], and prints its message.
+fn misuse(what: &str, r: wirepass::Result<()>) {
+    match r {
         Err(Error::Misuse(m)) => println!("{what}: {m}"),
         other => panic!("{what}: expected Error::Misuse, got {other:?}"),
-    };
+    }
+}
 
+/// A single-level 2D texture for the misuse tests.
+fn texture(
+    d: &wgpu::Device,
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+    size: (u32, u32),
+    samples: u32,
+) -> wgpu::Texture {
+    d.create_texture(&wgpu::TextureDescriptor {
+        label: Some("misuse"),
+        size: wgpu::Extent3d {
+            width: size.0,
+            height: size.1,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: samples,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage,
+        view_formats: &[],
+    })
+}
+
+// Every misuse of the library API is its `wirepass::Error`: no panic, no wgpu validation
+// error on the device. One test for each kind of misuse.
+
+#[test]
+fn render_targets_the_composite_cannot_draw_into_are_misuse() {
+    let ctx = device();
+    let d = &ctx.device;
     // Render targets the composite cannot draw into.
     let target = |format, sample_count, depth_stencil| PassOptions {
         render_target: Some(RenderTarget {
@@ -731,38 +756,34 @@ fn misuse_is_an_error_never_a_panic_or_a_validation_error() {
         misuse(what, DeferredPass::new(d, options).map(drop));
     }
 
-    // Host depth textures the pass cannot read.
+    ctx.finish()
+        .unwrap_or_else(|e| panic!("misuse raised a wgpu error: {e}"));
+}
+
+#[test]
+fn host_depth_the_pass_cannot_read_is_misuse() {
+    let ctx = device();
+    let d = &ctx.device;
+    let f = fixture();
+    let view = f.scene.view(ASPECT, DepthRange::Standard);
+    let wp = Wirepass::new();
     let mut pass = DeferredPass::new(d, PassOptions::default()).unwrap();
-    let texture = |format, usage, size: (u32, u32), samples| {
-        d.create_texture(&wgpu::TextureDescriptor {
-            label: Some("misuse"),
-            size: wgpu::Extent3d {
-                width: size.0,
-                height: size.1,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: samples,
-            dimension: wgpu::TextureDimension::D2,
-            format,
-            usage,
-            view_formats: &[],
-        })
-    };
+    use wgpu::TextureFormat as F;
+    // Host depth textures the pass cannot read.
     use wgpu::TextureUsages as U;
     let depth_usage = U::RENDER_ATTACHMENT | U::TEXTURE_BINDING;
     for (what, t) in [
         (
             "colour texture as host depth",
-            texture(F::Rgba8Unorm, U::TEXTURE_BINDING, SIZE, 1),
+            texture(d, F::Rgba8Unorm, U::TEXTURE_BINDING, SIZE, 1),
         ),
         (
             "host depth without TEXTURE_BINDING",
-            texture(F::Depth32Float, U::RENDER_ATTACHMENT, SIZE, 1),
+            texture(d, F::Depth32Float, U::RENDER_ATTACHMENT, SIZE, 1),
         ),
         (
             "host depth of another size",
-            texture(F::Depth32Float, depth_usage, (SIZE.0, SIZE.1 + 1), 1),
+            texture(d, F::Depth32Float, depth_usage, (SIZE.0, SIZE.1 + 1), 1),
         ),
     ] {
         let canvas = Canvas::new(SIZE).with_host_depth(HostDepth { texture: &t, view });
@@ -770,7 +791,7 @@ fn misuse_is_an_error_never_a_panic_or_a_validation_error() {
     }
     let mut bad_view = view;
     bad_view.projection.x_axis.x = f64::NAN;
-    let t = texture(F::Depth32Float, depth_usage, SIZE, 1);
+    let t = texture(d, F::Depth32Float, depth_usage, SIZE, 1);
     let canvas = Canvas::new(SIZE).with_host_depth(HostDepth {
         texture: &t,
         view: bad_view,
@@ -780,6 +801,20 @@ fn misuse_is_an_error_never_a_panic_or_a_validation_error() {
         "a host view with a NaN projection"
     );
 
+    ctx.finish()
+        .unwrap_or_else(|e| panic!("misuse raised a wgpu error: {e}"));
+}
+
+#[test]
+fn outputs_frames_and_stores_the_pass_cannot_use_are_misuse() {
+    let ctx = device();
+    let d = &ctx.device;
+    let f = fixture();
+    let view = f.scene.view(ASPECT, DepthRange::Standard);
+    let wp = Wirepass::new();
+    let mut pass = DeferredPass::new(d, PassOptions::default()).unwrap();
+    use wgpu::TextureFormat as F;
+    use wgpu::TextureUsages as U;
     // Outputs the pass cannot write.
     let frame = wp.prepare(&mut pass, view, Canvas::new(SIZE)).unwrap();
     let storage = U::STORAGE_BINDING | U::COPY_SRC;
@@ -792,19 +827,20 @@ fn misuse_is_an_error_never_a_panic_or_a_validation_error() {
     for (what, t) in [
         (
             "output of another format",
-            texture(F::Rgba16Float, storage, SIZE, 1),
+            texture(d, F::Rgba16Float, storage, SIZE, 1),
         ),
         (
             "output without STORAGE_BINDING",
-            texture(F::Rgba8Unorm, U::TEXTURE_BINDING, SIZE, 1),
+            texture(d, F::Rgba8Unorm, U::TEXTURE_BINDING, SIZE, 1),
         ),
         (
             "output of another size",
-            texture(F::Rgba8Unorm, storage, (SIZE.0 - 1, SIZE.1), 1),
+            texture(d, F::Rgba8Unorm, storage, (SIZE.0 - 1, SIZE.1), 1),
         ),
         (
             "multisampled output",
             texture(
+                d,
                 F::Rgba8Unorm,
                 U::RENDER_ATTACHMENT | U::TEXTURE_BINDING,
                 SIZE,
@@ -815,9 +851,9 @@ fn misuse_is_an_error_never_a_panic_or_a_validation_error() {
         let v = t.create_view(&Default::default());
         misuse(what, encode(&pass, &frame, OutputTarget::Shaded(&v)));
     }
-    let output = texture(F::Rgba8Unorm, storage, SIZE, 1);
+    let output = texture(d, F::Rgba8Unorm, storage, SIZE, 1);
     let out = output.create_view(&Default::default());
-    let sampled = texture(F::R32Uint, U::TEXTURE_BINDING, SIZE, 1);
+    let sampled = texture(d, F::R32Uint, U::TEXTURE_BINDING, SIZE, 1);
     misuse(
         "integer host colour",
         encode(
@@ -877,6 +913,19 @@ fn misuse_is_an_error_never_a_panic_or_a_validation_error() {
     );
     foreign.finish().unwrap();
 
+    ctx.finish()
+        .unwrap_or_else(|e| panic!("misuse raised a wgpu error: {e}"));
+}
+
+#[test]
+fn render_out_of_order_is_misuse() {
+    let ctx = device();
+    let d = &ctx.device;
+    let f = fixture();
+    let view = f.scene.view(ASPECT, DepthRange::Standard);
+    let wp = Wirepass::new();
+    let mut pass = DeferredPass::new(d, PassOptions::default()).unwrap();
+    let frame = wp.prepare(&mut pass, view, Canvas::new(SIZE)).unwrap();
     // render() out of order.
     let formats = HostFormats {
         samples: 1,
@@ -922,6 +971,18 @@ fn misuse_is_an_error_never_a_panic_or_a_validation_error() {
     }
     ctx.queue.submit([encoder.finish()]);
 
+    ctx.finish()
+        .unwrap_or_else(|e| panic!("misuse raised a wgpu error: {e}"));
+}
+
+#[test]
+fn values_that_cannot_make_an_image_are_errors() {
+    let ctx = device();
+    let d = &ctx.device;
+    let f = fixture();
+    let view = f.scene.view(ASPECT, DepthRange::Standard);
+    let wp = Wirepass::new();
+    let mut pass = DeferredPass::new(d, PassOptions::default()).unwrap();
     // Values that cannot make an image; an infinite far plane is fine where the projection
     // supports it.
     let mut nan_instance = wp.instances.clone();
