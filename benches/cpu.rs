@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Duration;
 use wirepass::mesh::{adjacency, load, load_obj};
-use wirepass::truth::raycast::{draw_raycast, RayCaster};
+use wirepass::truth::{draw_raycast, RayCaster};
 use wirepass::world::{Shot, World};
 use wirepass::{Camera, EdgeSelection, Style};
 

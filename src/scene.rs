@@ -10,6 +10,9 @@ use crate::gpu::MeshId;
 use crate::style::{Color, MAX_LINE_WIDTH};
 use glam::DMat4;
 
+/// Most instances a frame may hold; instance slots must fit the outline keys' 20 bits.
+pub const MAX_INSTANCES: u32 = 1 << 20;
+
 /// Per-instance departures from the frame's [`Style`](crate::Style); `None` keeps the
 /// style's setting.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -146,11 +149,11 @@ impl<'a> Scene<'a> {
     /// Checks the view and every instance.
     pub fn validate(&self) -> Result<()> {
         self.view.validate()?;
-        if self.instances.len() >= crate::gpu::MAX_INSTANCES as usize {
+        if self.instances.len() >= MAX_INSTANCES as usize {
             return Err(Error::InvalidScene(format!(
                 "{} instances; at most {} are supported",
                 self.instances.len(),
-                crate::gpu::MAX_INSTANCES - 1
+                MAX_INSTANCES - 1
             )));
         }
         for (i, instance) in self.instances.iter().enumerate() {

@@ -16,7 +16,7 @@ use common::{framing, gpu, load, shoot};
 use glam::{DVec3, Vec3};
 use wirepass::tools::compare::{distance_errors, metrics, Metrics};
 use wirepass::tools::offline::Method;
-use wirepass::truth::raycast::RayCaster;
+use wirepass::truth::RayCaster;
 use wirepass::world::{Rendering, Shot, World};
 use wirepass::{Camera, EdgeSelection, Mesh, Style};
 

@@ -22,7 +22,7 @@ use wirepass::style::line_reach;
 use wirepass::tools::compare::metrics;
 use wirepass::tools::offline::{draw_deferred_on, Uploaded};
 use wirepass::tools::regression::{difference, Rgba, Threshold};
-use wirepass::truth::raycast::{draw_raycast_over, HostOccluders};
+use wirepass::truth::{draw_raycast_over, HostOccluders};
 use wirepass::world::{Object, Rendering, Shot, World, WorldMesh, BACKGROUND, HOST};
 use wirepass::{wgpu, DepthRange, EdgeSelection, Error, Instance, InstanceStyle, Scene, Style};
 

@@ -17,7 +17,7 @@ fn validate(source: &str) -> Result<(), String> {
 
 #[test]
 fn every_variant_validates() {
-    let variants = shaders::variants();
+    let variants = wirepass::gpu::shader_modules();
     assert!(variants.len() > 100, "{} variants", variants.len());
     let failures: Vec<String> = variants
         .iter()
@@ -44,7 +44,7 @@ fn shader_files() -> Vec<PathBuf> {
 
 #[test]
 fn every_shader_file_is_in_a_variant() {
-    let variants = shaders::variants();
+    let variants = wirepass::gpu::shader_modules();
     let files = shader_files();
     assert!(files.len() >= 8, "{files:?}");
     for file in files {

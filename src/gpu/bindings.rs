@@ -376,7 +376,7 @@ pub(crate) fn bind_group(
         .iter()
         .any(|r| matches!(r, Res::OutColor | Res::HostColor));
     if sources.from_host && holds_host {
-        super::bind_host_resources(device, &desc)
+        bind_host_resources(device, &desc)
     } else {
         // The pass's own resources only: nothing wgpu could reject.
         Ok(device.create_bind_group(&desc))
@@ -408,6 +408,23 @@ pub(crate) fn dispatch(
     match size {
         Size::Grid(x, y) => pass.dispatch_workgroups(x, y, 1),
         Size::Indirect(buffer, offset) => pass.dispatch_workgroups_indirect(buffer, offset),
+    }
+}
+
+/// Creates a bind group that may hold the host's resources, turning wgpu's validation of
+/// them (a view from another device, say) into an [`Error::Misuse`] before anything uses
+/// the group.
+pub(crate) fn bind_host_resources(
+    device: &wgpu::Device,
+    desc: &wgpu::BindGroupDescriptor<'_>,
+) -> Result<wgpu::BindGroup> {
+    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let group = device.create_bind_group(desc);
+    match pollster::block_on(scope.pop()) {
+        None => Ok(group),
+        Some(e) => Err(Error::Misuse(format!(
+            "a texture given to the pass cannot be bound (from another device?): {e}"
+        ))),
     }
 }
 
@@ -457,7 +474,7 @@ mod tests {
     #[test]
     fn every_wgsl_binding_is_its_resource_number() {
         let mut seen = std::collections::HashSet::new();
-        for (name, source) in super::super::shaders::variants() {
+        for (name, source) in super::super::variants::shader_modules() {
             let module = naga::front::wgsl::parse_str(&source)
                 .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&source)));
             for (_, var) in module.global_variables.iter() {

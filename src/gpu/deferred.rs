@@ -4,9 +4,10 @@
 //! file of its own; this file prepares frames and records the sub-passes in order.
 
 use super::bindings::Sources;
+use super::canvas::Canvas;
 use super::composite::{Composite, CompositePipeline};
 use super::edge_pass::{round_to_half, EdgePass};
-use super::frame::{Canvas, FrameData};
+use super::frame::FrameData;
 use super::host_depth::{HostFrame, HostImport};
 use super::mesh_store::MeshStore;
 use super::options::{OutputTarget, PassOptions, TriangleIds};
@@ -544,10 +545,10 @@ impl DeferredPass {
         };
         let variant = self.variant(frame);
         if variant.outlines {
-            let frame = (frame, &self.reset);
+            let buffers = (t, &frame.cull, &self.reset);
             let timer = timer.as_deref_mut();
             self.outline
-                .encode(device, encoder, frame, &sources, variant, timer)?;
+                .encode(device, encoder, buffers, &sources, variant, timer)?;
         }
         let edge = self.edge.pipelines(device, mode, variant)?;
         if let Mode::Result { .. } = mode {
@@ -556,15 +557,8 @@ impl DeferredPass {
         }
         let output = (mode, out_color);
         let reset = &self.reset;
-        self.edge.encode(
-            device,
-            encoder,
-            (&edge, reset),
-            frame,
-            &sources,
-            output,
-            timer,
-        )
+        self.edge
+            .encode(device, encoder, (&edge, reset), t, &sources, output, timer)
     }
 
     /// Draws `frame`'s result into the host's render pass, whose attachments match

@@ -5,8 +5,8 @@
 //! listed tiles and the refine list write the output.
 
 use super::bindings::{dispatch, store_resources, Compute, Res, Size, Sources};
-use super::deferred::PreparedFrame;
-use super::targets::{self, LIST_HEADER, RESULT_FORMAT};
+use super::frame::FrameData;
+use super::targets::{self, Targets, LIST_HEADER, RESULT_FORMAT};
 use super::variants::{Mode, Variant};
 use super::{shaders, GpuTimer};
 use crate::error::{Error, Result};
@@ -64,7 +64,7 @@ impl EdgePass {
         &self,
         mode: Mode,
         texture: &wgpu::Texture,
-        frame: &PreparedFrame,
+        data: &FrameData,
     ) -> Option<wgpu::Color> {
         let usage = texture.usage();
         if !usage.contains(wgpu::TextureUsages::RENDER_ATTACHMENT) || texture.mip_level_count() != 1
@@ -72,10 +72,7 @@ impl EdgePass {
             return None;
         }
         match mode {
-            Mode::Shade => Some(background_value(
-                self.format,
-                frame.data.uniforms.background(),
-            )),
+            Mode::Shade => Some(background_value(self.format, data.uniforms.background())),
             Mode::Result { .. } => Some(wgpu::Color::TRANSPARENT),
             Mode::Overlay { .. } => None,
             #[cfg(feature = "diagnostics")]
@@ -178,16 +175,15 @@ impl EdgePass {
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
         (edge, reset): (&EdgePipelines, &wgpu::Buffer),
-        frame: &PreparedFrame,
+        t: &Targets,
         sources: &Sources<'_>,
         (mode, out_color): (Mode, Option<&wgpu::TextureView>),
         mut timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
-        let t = &frame.targets;
         let (w, h) = t.output;
         // Where the background is one colour and the output can be cleared, a clear lays it
         // down at the speed of a fill; elsewhere a dispatch writes it.
-        let clear = out_color.and_then(|v| self.background_clear(mode, v.texture(), frame));
+        let clear = out_color.and_then(|v| self.background_clear(mode, v.texture(), sources.frame));
         let (columns, rows) = (w.div_ceil(TILE), h.div_ceil(TILE));
         // The lists first, then the background (the clear or its dispatch), then the passes
         // that write the output: a software rasterizer runs a clear when a later pass reads

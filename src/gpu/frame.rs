@@ -3,6 +3,7 @@
 //! instanced draws. One place for all passes, so deferred, forward and two-pass draw the
 //! same scene the same way.
 
+use super::canvas::Region;
 use super::mesh_store::{MeshRecord, MeshStore, StoreBuffers};
 use crate::camera::View;
 use crate::error::{Error, Result};
@@ -59,9 +60,6 @@ const INSTANCE_EDGES: u32 = 1;
 /// `Instance.flags`: the instance's outline is drawn.
 const INSTANCE_OUTLINES: u32 = 2;
 
-/// Most instances a frame may hold; instance slots must fit the outline keys' 20 bits.
-pub const MAX_INSTANCES: u32 = 1 << 20;
-
 /// Instance records a uniform buffer holds (`scene.wgsl`, `UNIFORM_INSTANCES`): frames with
 /// up to this many bind them as uniforms, which software rasterizers read many times faster
 /// than storage buffers; 256 records are 52 KiB, within `Limits::default()`'s 64 KiB.
@@ -107,91 +105,6 @@ pub fn guard_band(scene: &Scene<'_>, style: &Style) -> u32 {
         .filter_map(|i| i.style.line_width)
         .fold(style.line_width, f32::max);
     (crate::style::line_reach(f64::from(widest)).ceil() as u32).saturating_add(2)
-}
-
-/// Which part of a full image the targets cover: all of it, or a tile of it, with a guard
-/// band of `guard` pixels around the output on every side (so lines just outside the output
-/// are found). Every pixel is addressed in full-image coordinates, so a tile computes
-/// exactly what the whole image computes there.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Region {
-    /// The full image the projection maps onto, in pixels.
-    pub image: (u32, u32),
-    /// The output's first pixel in the full image.
-    pub origin: (u32, u32),
-    /// The output's size in pixels.
-    pub size: (u32, u32),
-}
-
-impl Region {
-    /// The whole image.
-    pub fn whole(size: (u32, u32)) -> Region {
-        Region {
-            image: size,
-            origin: (0, 0),
-            size,
-        }
-    }
-
-    /// Checks that the region lies inside its image.
-    pub fn validate(&self) -> Result<()> {
-        let (w, h) = self.size;
-        let (x, y) = self.origin;
-        let (iw, ih) = self.image;
-        if w == 0 || h == 0 || iw == 0 || ih == 0 {
-            return Err(Error::InvalidSetting(format!(
-                "image size {iw}x{ih} or region size {w}x{h} has a zero side"
-            )));
-        }
-        if u64::from(x) + u64::from(w) > u64::from(iw)
-            || u64::from(y) + u64::from(h) > u64::from(ih)
-        {
-            return Err(Error::InvalidSetting(format!(
-                "the region {w}x{h} at ({x}, {y}) reaches past the {iw}x{ih} image"
-            )));
-        }
-        Ok(())
-    }
-}
-
-/// What a frame draws onto: an image, or a region of a larger one, and optionally the
-/// host's depth buffer. An image size converts into one: `pass.prepare(.., (800, 600))`.
-#[derive(Clone, Copy, Debug)]
-pub struct Canvas<'a> {
-    /// The image, or the part of it the frame draws.
-    pub region: Region,
-    /// The host's depth: host geometry nearer than a wireframed surface hides its lines.
-    pub host_depth: Option<super::HostDepth<'a>>,
-}
-
-impl<'a> Canvas<'a> {
-    /// A whole image of `size` pixels.
-    pub fn new(size: (u32, u32)) -> Canvas<'a> {
-        Region::whole(size).into()
-    }
-
-    /// This canvas over the host's depth buffer.
-    pub fn with_host_depth(self, host_depth: super::HostDepth<'a>) -> Canvas<'a> {
-        Canvas {
-            host_depth: Some(host_depth),
-            ..self
-        }
-    }
-}
-
-impl From<Region> for Canvas<'_> {
-    fn from(region: Region) -> Self {
-        Canvas {
-            region,
-            host_depth: None,
-        }
-    }
-}
-
-impl From<(u32, u32)> for Canvas<'_> {
-    fn from(size: (u32, u32)) -> Self {
-        Canvas::new(size)
-    }
 }
 
 /// One instanced draw: a mesh's triangles, for a run of consecutive instance slots.
@@ -246,7 +159,7 @@ impl FrameData {
         region.validate()?;
         scene.validate()?;
         style.validate()?;
-        super::check_size(device, region.size)?;
+        super::targets::check_size(device, region.size)?;
         // Where the device's largest texture leaves no room for the whole band, a narrower one.
         let room = device.limits().max_texture_dimension_2d - region.size.0.max(region.size.1);
         let guard = if guarded {

@@ -16,6 +16,7 @@
 //! draws its own copy of a wireframed mesh keeps that mesh's outlines whole.
 
 use super::bindings::Res;
+use super::canvas::HostDepth;
 use super::frame::FrameData;
 use super::targets::{Targets, DEPTH_FORMAT, HOST_FORMAT, ID_FORMAT};
 use super::{shaders, GpuTimer};
@@ -23,19 +24,6 @@ use crate::camera::{DepthRange, View};
 use crate::error::{Error, Result};
 use glam::{DMat4, DVec4};
 use wgpu::util::DeviceExt;
-
-/// The host's depth buffer, with the view it was rendered with.
-///
-/// Any depth format works (`Depth16Unorm`, `Depth24Plus`, `Depth24PlusStencil8`,
-/// `Depth32Float`, `Depth32FloatStencil8`), single- or multisampled; the texture needs
-/// `TEXTURE_BINDING` usage, and its size is the image's.
-#[derive(Clone, Copy, Debug)]
-pub struct HostDepth<'a> {
-    /// The host's depth texture.
-    pub texture: &'a wgpu::Texture,
-    /// The matrices and depth convention the host rendered it with (usually the scene's).
-    pub view: View,
-}
 
 /// Mirror of WGSL `HostParams` (host_depth.wgsl).
 #[repr(C)]
@@ -187,7 +175,7 @@ impl HostImport {
             .as_ref()
             .ok_or_else(|| Error::Device("the targets have no host depth".into()))?;
         let host_view = host_target.create_view(&Default::default());
-        let resolve_group = super::bind_host_resources(
+        let resolve_group = super::bindings::bind_host_resources(
             device,
             &wgpu::BindGroupDescriptor {
                 label: Some("wirepass host depth"),

@@ -7,7 +7,6 @@
 // `!(a > b)` is deliberate throughout: NaN must take the rejecting branch.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-use super::mesh_store::{MeshLines, CLUSTER};
 use crate::mesh::{adjacency::NO_NEIGHBOUR, patches::Patches, EdgeSelection, Mesh, ALL_EDGES};
 use glam::{DVec3, Vec2, Vec3};
 use std::sync::Arc;
@@ -16,6 +15,16 @@ use std::sync::Arc;
 /// only): both components at the snorm code that unpacking clamps, which no unit vector
 /// packs to.
 pub(crate) const NO_NORMAL: u32 = 0x8000_8000;
+
+/// What a mesh's edge selection asks of the passes beyond each triangle's own edges.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct MeshLines {
+    /// Some triangle of a small patch has an undrawn edge: pixels near one search their
+    /// patch (`patch_distance`).
+    pub small_patches: bool,
+    /// Some drawn edge borders a large patch: the outline pass draws it.
+    pub splat: bool,
+}
 
 /// One mesh as the arena stores it.
 pub(crate) struct MeshData {
@@ -266,7 +275,7 @@ impl EdgeData {
 pub(crate) fn cluster_records(bounds: &[[f32; 8]], info: &[u32]) -> Vec<[f32; 8]> {
     bounds
         .iter()
-        .zip(info.chunks(CLUSTER as usize))
+        .zip(info.chunks(crate::mesh::clusters::CLUSTER_TRIANGLES))
         .map(|(b, tris)| {
             let mut b = *b;
             if tris.iter().any(|i| i >> INFO_SPLAT_SHIFT & 7 != 0) {

@@ -18,7 +18,7 @@
 // `!(a > b)` is deliberate throughout: NaN must take the rejecting branch.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-use super::mesh_records::{cluster_records, EdgeData, MeshData, MAX_MESH_TRIANGLES};
+use super::mesh_records::{cluster_records, EdgeData, MeshData, MeshLines, MAX_MESH_TRIANGLES};
 use crate::error::{Error, Result};
 use crate::mesh::{EdgeSelection, Mesh};
 use glam::{DMat4, DVec3};
@@ -31,8 +31,6 @@ pub(crate) const VERTEX_BYTES: u64 = 16;
 pub(crate) const TRIANGLE_BYTES: u64 = 12;
 /// Bytes per cluster bound.
 pub(crate) const CLUSTER_BYTES: u64 = 32;
-/// Triangles per cluster.
-pub(crate) const CLUSTER: u32 = crate::mesh::clusters::CLUSTER_TRIANGLES as u32;
 /// Storage buffers per shader stage that the pipelines reading a mesh split over two
 /// bindings need (`wgpu::Limits::default()` allows 8; without them, such a mesh is an error
 /// naming the binding limit).
@@ -67,16 +65,6 @@ pub(crate) struct MeshRecord {
     pub lines: MeshLines,
     /// Per cluster, its bounds without the splat flag (see [`cluster_records`]).
     pub bounds_of_clusters: Arc<[[f32; 8]]>,
-}
-
-/// What a mesh's edge selection asks of the passes beyond each triangle's own edges.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub(crate) struct MeshLines {
-    /// Some triangle of a small patch has an undrawn edge: pixels near one search their
-    /// patch (`patch_distance`).
-    pub small_patches: bool,
-    /// Some drawn edge borders a large patch: the outline pass draws it.
-    pub splat: bool,
 }
 
 impl MeshRecord {
@@ -267,7 +255,7 @@ impl MeshStore {
                  store can hold (its adjacency indexes a triangle in 29 bits)"
             )));
         }
-        let clusters = triangles.div_ceil(CLUSTER);
+        let clusters = triangles.div_ceil(crate::mesh::clusters::CLUSTER_TRIANGLES as u32);
         self.check_capacity(
             self.vertices.used() + u64::from(vertices),
             self.triangles.used() + u64::from(triangles),

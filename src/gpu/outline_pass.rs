@@ -5,9 +5,8 @@
 //! per piece drawing it.
 
 use super::bindings::{self, dispatch, store_resources, Compute, Res, Size, Sources};
-use super::deferred::PreparedFrame;
 use super::frame::FrameData;
-use super::targets::LIST_HEADER;
+use super::targets::{Targets, LIST_HEADER};
 use super::variants::Variant;
 use super::{shaders, GpuTimer};
 use crate::error::{Error, Result};
@@ -103,7 +102,7 @@ impl OutlinePass {
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
-        (frame, reset): (&PreparedFrame, &wgpu::Buffer),
+        (t, list, reset): (&Targets, &wgpu::Buffer, &wgpu::Buffer),
         sources: &Sources<'_>,
         variant: Variant,
         mut timer: Option<&mut GpuTimer>,
@@ -112,25 +111,25 @@ impl OutlinePass {
         let cull = p.cull.bind(device, sources)?;
         let draw = p.draw.bind(device, sources)?;
         let pieces = p.pieces.bind(device, sources)?;
-        let t = &frame.targets;
+        let data = sources.frame;
         encoder.clear_buffer(&t.acc, 0, Some(t.acc_pieces));
         encoder.copy_buffer_to_buffer(reset, 0, &t.acc, t.acc_tiles, LIST_HEADER);
         encoder.copy_buffer_to_buffer(reset, 0, &t.acc, t.acc_pieces, LIST_HEADER);
-        encoder.copy_buffer_to_buffer(reset, 0, &frame.cull, 0, LIST_HEADER);
-        let groups = frame.data.uniforms_clusters().div_ceil(GROUP);
+        encoder.copy_buffer_to_buffer(reset, 0, list, 0, LIST_HEADER);
+        let groups = data.uniforms_clusters().div_ceil(GROUP);
         let max = device.limits().max_compute_workgroups_per_dimension.max(1);
         let (x, y) = (groups.clamp(1, max), groups.div_ceil(max).max(1));
         let names = ("wirepass outline cull", "outline.cull");
         let size = Size::Grid(x, y);
         dispatch(encoder, timer.as_deref_mut(), names, (&p.cull, &cull), size);
         let names = ("wirepass outline pass", "outline.draw");
-        let size = Size::Indirect(&frame.cull, 0);
+        let size = Size::Indirect(list, 0);
         dispatch(encoder, timer.as_deref_mut(), names, (&p.draw, &draw), size);
         // The piece dispatch's size, where no pass binding `acc` for writing reads it.
-        let size_at = piece_size_at(&frame.data);
-        encoder.copy_buffer_to_buffer(&t.acc, t.acc_pieces, &frame.cull, size_at, LIST_HEADER);
+        let size_at = piece_size_at(data);
+        encoder.copy_buffer_to_buffer(&t.acc, t.acc_pieces, list, size_at, LIST_HEADER);
         let names = ("wirepass outline pieces", "outline.pieces");
-        let size = Size::Indirect(&frame.cull, size_at);
+        let size = Size::Indirect(list, size_at);
         dispatch(encoder, timer, names, (&p.pieces, &pieces), size);
         Ok(())
     }

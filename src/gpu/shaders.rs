@@ -7,8 +7,6 @@
 //! rasterizer would still pay for, and no binding a device with default limits cannot
 //! afford).
 
-use super::variants::{Mode, Variant};
-
 /// Definitions shared by every pass; the Rust twins live in `edge_math`, `style` and
 /// `gpu::mesh_store`.
 pub const COMMON: &str = include_str!("../../shaders/common.wgsl");
@@ -151,65 +149,6 @@ pub fn outline_source(flags: &[&str]) -> String {
 pub fn host_depth_source(multisampled: bool) -> String {
     let flags: &[&str] = if multisampled { &["MULTISAMPLED"] } else { &[] };
     assemble(&[HOST_DEPTH], flags)
-}
-
-/// Every module the crate builds, named by its settings: each pass in each of its
-/// specialisations (the edge and outline passes in every [`Mode`] and [`Variant`] a frame
-/// can select), for validation without a GPU.
-pub fn variants() -> Vec<(String, String)> {
-    use wgpu::TextureFormat as F;
-    let mut out = vec![("composite".to_string(), COMPOSITE.to_string())];
-    for multisampled in [false, true] {
-        out.push((
-            format!("host depth multisampled={multisampled}"),
-            host_depth_source(multisampled),
-        ));
-    }
-    for pulled in [false, true] {
-        for split in [false, true] {
-            out.push((
-                format!("visibility pulled={pulled} split={split}"),
-                visibility_source(pulled, split),
-            ));
-        }
-    }
-    let variants = Variant::all();
-    for format in [F::Rgba8Unorm, F::Rgba16Float, F::Rgba32Float] {
-        out.push((
-            format!("floor {format:?}"),
-            edge_source(format, super::variants::FLOOR_FLAGS),
-        ));
-        for mode in Mode::all() {
-            for v in &variants {
-                let mut flags = v.flags();
-                flags.extend_from_slice(mode.flags());
-                out.push((
-                    format!("edge {format:?} {flags:?}"),
-                    edge_source(format, &flags),
-                ));
-            }
-        }
-    }
-    for v in variants.iter().filter(|v| v.outlines) {
-        let flags = v.flags();
-        out.push((format!("outline {flags:?}"), outline_source(&flags)));
-    }
-    for split in [false, true] {
-        for format in [
-            F::Rgba8Unorm,
-            F::Rgba8UnormSrgb,
-            F::Rgba16Float,
-            F::Rgba32Float,
-        ] {
-            if let Some(s) = super::baselines::forward_source(format, split) {
-                out.push((format!("forward {format:?} split={split}"), s));
-            }
-            if let Some(s) = super::baselines::two_pass_source(format, split) {
-                out.push((format!("two-pass {format:?} split={split}"), s));
-            }
-        }
-    }
-    out
 }
 
 #[cfg(test)]

@@ -6,6 +6,50 @@
 use crate::error::{Error, Result};
 use crate::style::linear_to_srgb;
 
+/// A single-level 2D texture of `width × height`: the shape of every target and output here.
+pub fn texture_2d(
+    device: &wgpu::Device,
+    label: &str,
+    (width, height): (u32, u32),
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage,
+        view_formats: &[],
+    })
+}
+
+/// Checks an image size against the device: non-zero and within `max_texture_dimension_2d`.
+pub fn check_size(device: &wgpu::Device, (width, height): (u32, u32)) -> Result<()> {
+    if width == 0 || height == 0 {
+        return Err(Error::InvalidSetting(format!(
+            "image size {width}x{height} has a zero side"
+        )));
+    }
+    let limit = device.limits().max_texture_dimension_2d;
+    let side = width.max(height);
+    if side > limit {
+        return Err(Error::OverLimit {
+            what: format!("image side of {width}x{height}"),
+            value: u64::from(side),
+            limit_name: "max_texture_dimension_2d",
+            limit: u64::from(limit),
+        });
+    }
+    Ok(())
+}
+
 /// The id target's first channel where no triangle is: background.
 pub const BACKGROUND_ID: u32 = u32::MAX;
 /// The id target's first channel where the host's own geometry is in front (with host
@@ -135,8 +179,7 @@ impl Targets {
         // The list: header, then one packed tile per entry.
         let tiles_bytes = LIST_HEADER + 4 * tiles;
         use wgpu::TextureUsages as U;
-        let texture =
-            |label, size, format, usage| super::texture_2d(device, label, size, format, usage);
+        let texture = |label, size, format, usage| texture_2d(device, label, size, format, usage);
         let buffer = |label, size, usage| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),

@@ -1,7 +1,7 @@
 //! The settings constant over a frame that specialise the compute pipelines, and the WGSL
 //! `#if` flags each one sets. The deferred pass picks its pipelines by them, and
-//! [`shaders::variants`](super::shaders::variants) validates every module they can select,
-//! so the two cannot drift apart.
+//! [`shader_modules`] lists every module they can select (with every other pass's) for
+//! validation, so the two cannot drift apart.
 
 /// What the edge pass writes, which selects its pipeline.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -109,4 +109,64 @@ impl Variant {
         .filter_map(|(on, flag)| on.then_some(flag))
         .collect()
     }
+}
+
+/// Every module the crate builds, named by its settings: each pass in each of its
+/// specialisations (the edge and outline passes in every [`Mode`] and [`Variant`] a frame
+/// can select), for validation without a GPU.
+pub fn shader_modules() -> Vec<(String, String)> {
+    use super::shaders::*;
+    use wgpu::TextureFormat as F;
+    let mut out = vec![("composite".to_string(), COMPOSITE.to_string())];
+    for multisampled in [false, true] {
+        out.push((
+            format!("host depth multisampled={multisampled}"),
+            host_depth_source(multisampled),
+        ));
+    }
+    for pulled in [false, true] {
+        for split in [false, true] {
+            out.push((
+                format!("visibility pulled={pulled} split={split}"),
+                visibility_source(pulled, split),
+            ));
+        }
+    }
+    let variants = Variant::all();
+    for format in [F::Rgba8Unorm, F::Rgba16Float, F::Rgba32Float] {
+        out.push((
+            format!("floor {format:?}"),
+            edge_source(format, FLOOR_FLAGS),
+        ));
+        for mode in Mode::all() {
+            for v in &variants {
+                let mut flags = v.flags();
+                flags.extend_from_slice(mode.flags());
+                out.push((
+                    format!("edge {format:?} {flags:?}"),
+                    edge_source(format, &flags),
+                ));
+            }
+        }
+    }
+    for v in variants.iter().filter(|v| v.outlines) {
+        let flags = v.flags();
+        out.push((format!("outline {flags:?}"), outline_source(&flags)));
+    }
+    for split in [false, true] {
+        for format in [
+            F::Rgba8Unorm,
+            F::Rgba8UnormSrgb,
+            F::Rgba16Float,
+            F::Rgba32Float,
+        ] {
+            if let Some(s) = super::baselines::forward_source(format, split) {
+                out.push((format!("forward {format:?} split={split}"), s));
+            }
+            if let Some(s) = super::baselines::two_pass_source(format, split) {
+                out.push((format!("two-pass {format:?} split={split}"), s));
+            }
+        }
+    }
+    out
 }

@@ -8,7 +8,7 @@ use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
 use crate::tools::offline::{draw, Method};
 use crate::tools::regression;
-use crate::truth::raycast::draw_raycast;
+use crate::truth::draw_raycast;
 use crate::world::{Rendering, Shot, BACKGROUND};
 use serde::Serialize;
 use std::collections::BTreeMap;

@@ -125,7 +125,7 @@ impl std::str::FromStr for Method {
 /// Renders `shot` with `method` and reads back the image and all maps.
 pub fn draw(ctx: &GpuContext, shot: &Shot<'_>, method: Method) -> Result<Rendering> {
     match method {
-        Method::Raycast => crate::truth::raycast::draw_raycast(shot),
+        Method::Raycast => crate::truth::draw_raycast(shot),
         Method::Deferred => draw_deferred(ctx, shot),
         Method::Forward => draw_forward(ctx, shot),
         Method::TwoPass => draw_two_pass(ctx, shot),

@@ -9,5 +9,7 @@
 
 pub mod outline;
 pub mod raycast;
+pub mod rays;
 
-pub use raycast::{draw_raycast, draw_raycast_over, HostOccluders, RayCaster};
+pub use raycast::{draw_raycast, draw_raycast_over};
+pub use rays::{HostOccluders, RayCaster};

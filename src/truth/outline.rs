@@ -26,7 +26,7 @@ use crate::edge_math;
 use crate::mesh::adjacency::NO_NEIGHBOUR;
 use crate::mesh::patches::Patches;
 use crate::style::{depth_fade, line_intensity, line_key, line_reach};
-use crate::truth::raycast::{HostMap, Line, ObjectStyle, RayCaster, Rays};
+use crate::truth::rays::{HostMap, Line, ObjectStyle, RayCaster, Rays};
 use crate::world::Shot;
 use glam::{DVec2, DVec4};
 use rayon::prelude::*;

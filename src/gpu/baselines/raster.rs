@@ -5,10 +5,11 @@
 
 use crate::error::{Error, Result};
 use crate::gpu::bindings::{self, store_resources, Res, Sources};
-use crate::gpu::frame::{FrameData, Region};
+use crate::gpu::canvas::Region;
+use crate::gpu::frame::FrameData;
 use crate::gpu::mesh_store::MeshStore;
+use crate::gpu::targets::texture_2d;
 use crate::gpu::targets::{clear_color, cleared, BACKGROUND_ID, DEPTH_FORMAT, ID_FORMAT};
-use crate::gpu::texture_2d;
 use crate::scene::Scene;
 use crate::style::Style;
 
