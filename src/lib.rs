@@ -66,16 +66,16 @@
 //! through its own wgpu dependency, glam, bytemuck, thiserror, pollster). `formats` adds the
 //! mesh loaders (OBJ, STL, PLY, glTF), `parallel` preprocessing on all cores, `regression`
 //! FLIP image comparison, `diagnostics` what tools measure the pass with (the benchmark
-//! floor, diagnostic maps, timestamps: [`gpu::EncodeOptions`]), `truth` the ray-cast ground
+//! floor, diagnostic maps, timestamps: `gpu::EncodeOptions`), `truth` the ray-cast ground
 //! truth, and `tools` all of them with offline frames, compare and bench. The `wirepass`
 //! command is the workspace's `wirepass-cli` package.
 //!
 //! ## Layers
 //!
-//! Each depends only on those before it: the frame's terms ([`camera`], [`scene`],
-//! [`style`], [`edge_math`], [`error`]); [`mesh`] and its loaders (`mesh::formats`); the
-//! pass ([`gpu`]); the world of meshes tools draw and the ground truth (`world`, `truth`);
-//! the tools (`tools`).
+//! Each depends only on those before it (a test checks every file): [`error`]; the frame's
+//! terms ([`camera`], [`style`]) and [`mesh`]; [`edge_math`]; the loaders
+//! (`mesh::formats`); the pass ([`scene`], [`gpu`]); the world of meshes tools draw
+//! (`world`); the ground truth (`truth`); the tools (`tools`).
 
 #![warn(missing_docs)]
 

@@ -12,7 +12,7 @@ pub struct PassOptions {
     /// background (one fill) instead of writing it pixel by pixel, with the same result. An
     /// `Rgba16Float` output takes the background as its nearest half.
     pub output_format: wgpu::TextureFormat,
-    /// The host's render pass that [`DeferredPass::render`] draws into, if it is used.
+    /// The host's render pass that [`DeferredPass::render`](super::DeferredPass::render) draws into, if it is used.
     pub render_target: Option<RenderTarget>,
     /// How the visibility pass learns which triangle a pixel shows.
     pub triangle_ids: TriangleIds,
@@ -64,7 +64,7 @@ pub enum OutputTarget<'a> {
         output: &'a wgpu::TextureView,
     },
     /// Diagnostics for tools and tests into the pass's own textures (needs
-    /// [`DeferredPass::with_diagnostics`]): the distance in pixels to the line and the
+    /// [`DeferredPass::with_diagnostics`](super::DeferredPass::with_diagnostics)): the distance in pixels to the line and the
     /// reverse depth of the visible point, and the (instance slot, triangle) after the exact
     /// coverage test.
     #[cfg(feature = "diagnostics")]
@@ -73,7 +73,7 @@ pub enum OutputTarget<'a> {
     /// into the output, doing none of the edge work. What a deferred pass cannot go below.
     #[cfg(feature = "diagnostics")]
     Floor(&'a wgpu::TextureView),
-    /// The frame's own result, which [`DeferredPass::render`] then draws into the host's
+    /// The frame's own result, which [`DeferredPass::render`](super::DeferredPass::render) then draws into the host's
     /// render pass (needs [`PassOptions::render_target`]).
     RenderPass,
 }

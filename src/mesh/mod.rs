@@ -1,7 +1,7 @@
 //! Triangle meshes as every method sees them: positions, smooth normals, triangles, and the
 //! per-triangle mask that says which triangle edges were edges of the source polygons; and
 //! what is computed from them once (adjacency, patches, outline clusters). The loaders are
-//! in [`formats`] (feature `formats`). It uses only the crate's error type.
+//! in `formats` (feature `formats`). It uses only the crate's error type.
 
 pub mod adjacency;
 pub mod clusters;

@@ -1,7 +1,7 @@
 //! What the `wirepass` command, the tests and the benchmarks are built from, over the
 //! library: scenes loaded from files and specs ([`load`], [`scene_file`]), offscreen frames
 //! of every method and their dumps ([`offline`]), the comparison against the ground truth
-//! ([`compare`]), the benchmark ([`bench`]) and image regression ([`regression`]).
+//! ([`compare`]), the benchmark ([`bench`](mod@bench)) and image regression ([`regression`]).
 //!
 //! Everything here may use the whole library below it (the pass, the loaders, the ground
 //! truth); nothing in the library uses it.

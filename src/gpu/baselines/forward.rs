@@ -53,8 +53,8 @@ struct Pipelines {
 /// many on two hard cameras). It draws no outline pass: outlines get half their width.
 ///
 /// Use: [`new`](Self::new) once, [`prepare`](Self::prepare) each frame, then
-/// [`encode`](Self::encode) (colour only) or [`encode_with_maps`](Self::encode_with_maps)
-/// (also ids and the diagnostic map, for tools and tests) into the host's encoder.
+/// [`encode`](Self::encode) (colour only) into the host's encoder; with the `diagnostics`
+/// feature, `encode_with` also writes ids and the diagnostic map, for tools and tests.
 pub struct ForwardPass {
     id: u32,
     format: wgpu::TextureFormat,

@@ -163,7 +163,7 @@ struct Pipelines {
 }
 
 /// The two-pass wireframe baseline: a shaded fill (the deferred pass's shading) with a depth
-/// bias ([`FILL_DEPTH_BIAS`]), then the drawn edges ([`EdgeLines`]) as 1-pixel hardware lines
+/// bias, then the drawn edges ([`EdgeLines`]) as 1-pixel hardware lines
 /// in each instance's wire colour, alpha-blended, depth-tested against the fill.
 ///
 /// Hardware lines are one pixel wide whatever the style's line width (wgpu has no wide
@@ -171,7 +171,7 @@ struct Pipelines {
 /// output the shader encodes sRGB itself, so a translucent wire colour blends in encoded
 /// space; `Rgba8UnormSrgb` and `Rgba16Float` blend in linear space.
 ///
-/// Maps ([`encode_with_maps`](Self::encode_with_maps)): ids and depth come from the fill. No
+/// Maps (`encode_with` and `EncodeOptions::maps`, feature `diagnostics`): ids and depth come from the fill. No
 /// distance is measured, so the diagnostic map's distance (red) is honest rather than
 /// estimated: 0 where a line fragment was drawn (background included, where a silhouette
 /// line spills over), 3e38 (no edge) everywhere else.

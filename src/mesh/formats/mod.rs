@@ -68,8 +68,8 @@ pub fn format_of(path: &Path) -> Option<&'static Format> {
 
 /// Loads a mesh file with the loader its extension names (`.obj`, `.stl`, `.ply`, `.gltf`,
 /// `.glb`, in any case; a glTF scene comes as one mesh: see
-/// [`load_gltf_mesh`](gltf::load_gltf_mesh)). A missing file is an [`Error::Io`]; an unknown extension is an
-/// [`Error::MeshFile`] that names the supported ones.
+/// [`load_gltf_mesh`]). A missing file is an [`Error::Io`](crate::Error::Io); an unknown
+/// extension is an [`Error::MeshFile`](crate::Error::MeshFile) that names the supported ones.
 pub fn load(path: &Path) -> Result<Mesh> {
     if let Some(format) = format_of(path) {
         return (format.load)(path);
