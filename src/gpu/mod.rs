@@ -21,7 +21,11 @@ mod mesh_store;
 mod options;
 mod outline_pass;
 mod readback;
+// The WGSL sources and their assembly: public for the tests that validate them.
+#[cfg(feature = "diagnostics")]
 pub mod shaders;
+#[cfg(not(feature = "diagnostics"))]
+mod shaders;
 mod targets;
 #[cfg_attr(not(feature = "diagnostics"), allow(dead_code))]
 mod timing;
@@ -29,9 +33,9 @@ mod variants;
 mod visibility;
 
 pub use crate::scene::MAX_INSTANCES;
-pub use baselines::{
-    drawn_edges, EdgeLines, ForwardPass, RasterFrame, TwoPass, MAPS_DIAGNOSTIC_FORMAT,
-};
+#[cfg(feature = "diagnostics")]
+pub use baselines::MAPS_DIAGNOSTIC_FORMAT;
+pub use baselines::{drawn_edges, EdgeLines, ForwardPass, RasterFrame, TwoPass};
 pub use canvas::{Canvas, HostDepth, Region};
 pub use composite::{Composite, RenderTarget};
 pub use context::GpuContext;
@@ -40,17 +44,20 @@ pub use deferred::EdgeWork;
 pub use deferred::{DeferredPass, PreparedFrame};
 #[cfg(feature = "diagnostics")]
 pub use diagnostics::EncodeOptions;
-pub use frame::light_world_dir;
-pub use host_depth::depth_quantum;
+// For the ground truth, which shades and reads host depth as the pass does.
+#[cfg(feature = "truth")]
+pub(crate) use frame::light_world_dir;
+#[cfg(feature = "truth")]
+pub(crate) use host_depth::depth_quantum;
 pub use mesh_store::{MeshId, MeshStore};
 pub use options::{OutputTarget, PassOptions, TriangleIds};
 pub use readback::read_texture;
-pub use targets::{
-    check_size, texture_2d, BACKGROUND_ID, DEPTH_FORMAT, DIAGNOSTIC_FORMAT, HOST_FORMAT, HOST_ID,
-    ID_FORMAT, RESOLVED_ID_FORMAT, RESULT_FORMAT,
-};
+pub use targets::{check_size, texture_2d, BACKGROUND_ID, DEPTH_FORMAT, HOST_ID, ID_FORMAT};
+#[cfg(feature = "diagnostics")]
+pub use targets::{DIAGNOSTIC_FORMAT, RESOLVED_ID_FORMAT};
 #[cfg(feature = "diagnostics")]
 pub use timing::GpuTimer;
 #[cfg(not(feature = "diagnostics"))]
 use timing::GpuTimer;
+#[cfg(feature = "diagnostics")]
 pub use variants::shader_modules;

@@ -114,6 +114,7 @@ impl Variant {
 /// Every module the crate builds, named by its settings: each pass in each of its
 /// specialisations (the edge and outline passes in every output mode and frame variant a
 /// frame can select), for validation without a GPU.
+#[cfg_attr(not(feature = "diagnostics"), allow(dead_code))]
 pub fn shader_modules() -> Vec<(String, String)> {
     use super::shaders::*;
     use wgpu::TextureFormat as F;
