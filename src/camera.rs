@@ -100,6 +100,22 @@ impl View {
         )
     }
 
+    /// [`View::orthographic`] with reversed depth (1 at `near`, 0 at `far`), as reverse-Z
+    /// hosts draw orthographic views.
+    pub fn orthographic_reversed(
+        (eye, target, up): (DVec3, DVec3, DVec3),
+        height: f64,
+        aspect: f64,
+        (near, far): (f64, f64),
+    ) -> View {
+        let (h, w) = (0.5 * height, 0.5 * height * aspect);
+        View::new(
+            look_at_mat4(eye, target, up.normalize_or_zero()),
+            proj::orthographic(-w, w, -h, h, far, near),
+            DepthRange::Reversed,
+        )
+    }
+
     /// World → clip.
     pub fn view_projection(&self) -> DMat4 {
         self.projection * self.view
@@ -178,8 +194,28 @@ impl View {
                 return bad("the orthographic projection gives w <= 0 everywhere".into());
             }
             let rows = self.clip_rows(DMat4::IDENTITY);
-            if rows.clip.row(2).truncate() == DVec3::ZERO {
+            let near = rows.clip.row(2).truncate();
+            if near == DVec3::ZERO {
                 return bad("the orthographic projection has no depth axis".into());
+            }
+            // An affine projection does not say which side the viewer is on: the depth
+            // convention does (depth grows away from the viewer). Read against the image's
+            // axes, a mislabelled one shows the scene from behind, mirrored. So the image's
+            // x and y axes and the direction towards the viewer must make a right-handed
+            // frame, as they do for every camera that is not a mirror.
+            let unit = |v: DVec3| v / v.abs().max_element();
+            let (x, y) = (rows.clip.row(0).truncate(), rows.clip.row(1).truncate());
+            let facing = unit(x).cross(unit(y)).dot(-unit(near));
+            if !(facing > 0.0) {
+                let fix = match self.depth {
+                    DepthRange::Standard => "declare DepthRange::Reversed",
+                    DepthRange::Reversed => "declare DepthRange::Standard",
+                };
+                return bad(format!(
+                    "the orthographic projection's depth grows towards the viewer that its x \
+                     and y axes imply (x right, y up, depth away from the viewer): {fix} (a \
+                     mirror image is drawn by mirroring the instances, not the view)"
+                ));
             }
             return Ok(());
         }
@@ -518,6 +554,47 @@ mod tests {
         );
         rev.validate().unwrap();
         assert!((rev.eye().truncate() - eye.normalize()).length() < 1e-12);
+        let made = View::orthographic_reversed((eye, DVec3::ZERO, DVec3::Y), 4.0, 1.5, (0.1, 20.0));
+        made.validate().unwrap();
+        assert!(made.projection.abs_diff_eq(rev.projection, 1e-12));
+        assert!((made.eye().truncate() - eye.normalize()).length() < 1e-12);
+    }
+
+    /// An orthographic projection labelled with the other depth convention shows the scene
+    /// from behind, mirrored: an error, for either label, as it is for a perspective one.
+    /// So is a mirrored orthographic view.
+    #[test]
+    fn a_mislabelled_orthographic_depth_is_an_error() {
+        let eye = DVec3::new(1.0, 2.0, 5.0);
+        let at = (eye, DVec3::ZERO, DVec3::Y);
+        let standard = View::orthographic(at, 4.0, 1.5, (0.1, 20.0));
+        let reversed = View::orthographic_reversed(at, 4.0, 1.5, (0.1, 20.0));
+        for (view, label) in [
+            (standard, DepthRange::Reversed),
+            (reversed, DepthRange::Standard),
+        ] {
+            let wrong = View::new(view.view, view.projection, label);
+            let e = wrong.validate().unwrap_err().to_string();
+            assert!(e.contains("towards the viewer"), "{e}");
+        }
+        let mut mirrored = standard;
+        mirrored.projection.x_axis.x = -mirrored.projection.x_axis.x;
+        assert!(mirrored.validate().is_err());
+        // Cameras 1e-30 and 1e30 across decide the same way.
+        for scale in [1e-30, 1e30] {
+            let small = View::orthographic(
+                (eye * scale, DVec3::ZERO, DVec3::Y),
+                4.0 * scale,
+                1.5,
+                (0.1 * scale, 20.0 * scale),
+            );
+            small.validate().unwrap();
+            assert!(
+                View::new(small.view, small.projection, DepthRange::Reversed)
+                    .validate()
+                    .is_err()
+            );
+        }
     }
 
     #[test]
