@@ -153,26 +153,54 @@ impl PreparedFrame {
 /// Into the host's own render pass, with the host's depth hiding the lines (the crate-level
 /// docs show the storage-texture path):
 ///
-/// ```no_run
-/// use wirepass::gpu::{Canvas, Composite, HostDepth, OutputTarget, PassOptions, RenderTarget};
-/// use wirepass::{wgpu, DeferredPass, MeshStore, Scene, Style};
+/// ```
+/// use wirepass::glam::DMat4;
+/// use wirepass::gpu::{texture_2d, Canvas, Composite, HostDepth, OutputTarget, RenderTarget};
+/// use wirepass::{wgpu, Camera, DeferredPass, EdgeSelection, Instance, MeshStore};
+/// use wirepass::{PassOptions, Scene, Style};
 ///
-/// # fn frame(
-/// #     device: &wgpu::Device,
-/// #     queue: &wgpu::Queue,
-/// #     meshes: &MeshStore,
-/// #     scene: &Scene,
-/// #     color: &wgpu::TextureView,
-/// #     depth: &wgpu::Texture,
-/// # ) -> wirepass::Result<()> {
-/// // Once: a pass for the host's attachments (4x MSAA sRGB colour, its depth-stencil).
+/// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// # let instance =
+/// #     wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+/// # let adapter = pollster::block_on(instance.request_adapter(&Default::default()))?;
+/// # let (device, queue) = pollster::block_on(adapter.request_device(&Default::default()))?;
+/// # let mut meshes = MeshStore::new(&device);
+/// # let torus = wirepass::mesh::torus(2000)?;
+/// # let id = meshes.insert(&device, &queue, &torus, EdgeSelection::Polygon)?;
+/// # let (lo, hi) = torus.bounds_f64();
+/// # let view = Camera::framing(lo, hi, 4.0 / 3.0).to_view(4.0 / 3.0);
+/// # let scene = Scene::new(view, vec![Instance::new(id, DMat4::IDENTITY)]);
+/// // The host's attachments: 4x MSAA sRGB colour and a depth-stencil buffer it can sample.
+/// let size = (320, 240);
+/// let msaa = |label, format, usage| {
+///     device.create_texture(&wgpu::TextureDescriptor {
+///         label: Some(label),
+///         size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
+///         mip_level_count: 1,
+///         sample_count: 4,
+///         dimension: wgpu::TextureDimension::D2,
+///         format,
+///         usage,
+///         view_formats: &[],
+///     })
+/// };
+/// use wgpu::TextureUsages as U;
+/// let color = msaa("colour", wgpu::TextureFormat::Rgba8UnormSrgb, U::RENDER_ATTACHMENT);
+/// let depth_format = wgpu::TextureFormat::Depth24PlusStencil8;
+/// let depth = msaa("depth", depth_format, U::RENDER_ATTACHMENT | U::TEXTURE_BINDING);
+/// let resolved = texture_2d(&device, "resolved", size, color.format(), U::RENDER_ATTACHMENT);
+/// let color_view = color.create_view(&Default::default());
+/// let depth_view = depth.create_view(&Default::default());
+/// let resolved_view = resolved.create_view(&Default::default());
+///
+/// // Once: a pass for those attachments.
 /// let mut pass = DeferredPass::new(
-///     device,
+///     &device,
 ///     PassOptions {
 ///         render_target: Some(RenderTarget {
-///             format: wgpu::TextureFormat::Rgba8UnormSrgb,
+///             format: color.format(),
 ///             sample_count: 4,
-///             depth_stencil: Some(wgpu::TextureFormat::Depth24PlusStencil8),
+///             depth_stencil: Some(depth_format),
 ///             content: Composite::Lines,
 ///         }),
 ///         ..Default::default()
@@ -181,19 +209,27 @@ impl PreparedFrame {
 ///
 /// // Each frame, after the host has drawn its scene into `color` and `depth` with the
 /// // scene's view: the lines, hidden where the host's surfaces are in front.
-/// let size = (depth.width(), depth.height());
-/// let canvas = Canvas::new(size).with_host_depth(HostDepth { texture: depth, view: scene.view });
-/// let frame = pass.prepare(device, meshes, scene, &Style::default(), canvas)?;
+/// let canvas = Canvas::new(size).with_host_depth(HostDepth { texture: &depth, view: scene.view });
+/// let frame = pass.prepare(&device, &meshes, &scene, &Style::default(), canvas)?;
 /// let mut encoder = device.create_command_encoder(&Default::default());
-/// pass.encode(device, &mut encoder, meshes, &frame, OutputTarget::RenderPass)?;
+/// pass.encode(&device, &mut encoder, &meshes, &frame, OutputTarget::RenderPass)?;
 /// {
+///     // The host's render pass, with the attachments the render target names: the
+///     // depth-stencil attachment too, as `depth_stencil` says (kept, neither tested nor
+///     // written by wirepass).
+///     let store = wgpu::StoreOp::Store;
 ///     let mut overlay = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
 ///         color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-///             view: color,
+///             view: &color_view,
 ///             depth_slice: None,
-///             resolve_target: None,
-///             ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store },
+///             resolve_target: Some(&resolved_view),
+///             ops: wgpu::Operations { load: wgpu::LoadOp::Load, store },
 ///         })],
+///         depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+///             view: &depth_view,
+///             depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Load, store }),
+///             stencil_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Load, store }),
+///         }),
 ///         ..Default::default()
 ///     });
 ///     // The host may draw its own overlays here too.

@@ -150,8 +150,14 @@ enum Kind {
 /// All meshes' GPU buffers. Insert meshes once; instances of them are then drawn by any
 /// pass of the same device.
 ///
-/// ```no_run
-/// # fn demo(device: &wgpu::Device, queue: &wgpu::Queue) -> wirepass::Result<()> {
+/// ```
+/// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// # use wirepass::wgpu;
+/// # let instance =
+/// #     wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+/// # let adapter = pollster::block_on(instance.request_adapter(&Default::default()))?;
+/// # let (device, queue) = pollster::block_on(adapter.request_device(&Default::default()))?;
+/// # let (device, queue) = (&device, &queue);
 /// use wirepass::gpu::MeshStore;
 /// use wirepass::EdgeSelection;
 ///
