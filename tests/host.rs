@@ -135,7 +135,7 @@ fn assert_msaa_refused(formats: HostFormats) {
     let mut pass = DeferredPass::new(&ctx.device, PassOptions::default()).unwrap();
     let canvas = Canvas::new(SIZE).with_host_depth(HostDepth {
         texture: &targets.depth,
-        view,
+        matrices: view,
     });
     match wp.prepare(&mut pass, view, canvas) {
         Err(e @ Error::MissingFeature { .. }) => println!("{}x host depth: {e}", formats.samples),
@@ -180,7 +180,7 @@ fn host_case(
         .with_diagnostics();
     let canvas = Canvas::new(SIZE).with_host_depth(HostDepth {
         texture: &targets.depth,
-        view: host_view,
+        matrices: host_view,
     });
     let frame = draw_deferred_on(ctx, &shot, &up, pass, canvas).unwrap();
     ctx.finish().unwrap();
@@ -441,7 +441,7 @@ fn composited(formats: HostFormats, content: Composite) -> Vec<u8> {
     .unwrap();
     let canvas = Canvas::new(SIZE).with_host_depth(HostDepth {
         texture: &targets.depth,
-        view,
+        matrices: view,
     });
     let frame = wp.prepare(&mut pass, view, canvas).unwrap();
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
@@ -472,7 +472,7 @@ fn stored(formats: HostFormats, content: Composite) -> (Vec<u8>, Vec<u8>) {
     let mut pass = DeferredPass::new(&ctx.device, PassOptions::default()).unwrap();
     let canvas = Canvas::new(SIZE).with_host_depth(HostDepth {
         texture: &targets.depth,
-        view,
+        matrices: view,
     });
     let frame = wp.prepare(&mut pass, view, canvas).unwrap();
     let usage = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC;
@@ -527,7 +527,7 @@ fn a_cleared_background_is_the_background_the_pass_writes() {
         let mut pass = DeferredPass::new(&ctx.device, options).unwrap();
         let canvas = Canvas::new(SIZE).with_host_depth(HostDepth {
             texture: &targets.depth,
-            view,
+            matrices: view,
         });
         let frame = pass
             .prepare(&ctx.device, &wp.store, &scene, &style, canvas)
@@ -660,7 +660,7 @@ fn shaded_composite_keeps_the_host_image_where_no_instance_shows() {
         .with_diagnostics();
     let canvas = Canvas::new(SIZE).with_host_depth(HostDepth {
         texture: &targets.depth,
-        view,
+        matrices: view,
     });
     let ids = draw_deferred_on(device(), &shot, &up, pass, canvas)
         .unwrap()
@@ -786,7 +786,10 @@ fn host_depth_the_pass_cannot_read_is_misuse() {
             texture(d, F::Depth32Float, depth_usage, (SIZE.0, SIZE.1 + 1), 1),
         ),
     ] {
-        let canvas = Canvas::new(SIZE).with_host_depth(HostDepth { texture: &t, view });
+        let canvas = Canvas::new(SIZE).with_host_depth(HostDepth {
+            texture: &t,
+            matrices: view,
+        });
         misuse(what, wp.prepare(&mut pass, view, canvas).map(drop));
     }
     let mut bad_view = view;
@@ -794,7 +797,7 @@ fn host_depth_the_pass_cannot_read_is_misuse() {
     let t = texture(d, F::Depth32Float, depth_usage, SIZE, 1);
     let canvas = Canvas::new(SIZE).with_host_depth(HostDepth {
         texture: &t,
-        view: bad_view,
+        matrices: bad_view,
     });
     assert!(
         wp.prepare(&mut pass, view, canvas).is_err(),
@@ -1135,7 +1138,7 @@ fn soak_memory_stays_flat_over_changing_frames() {
         );
         let canvas = Canvas::new(size).with_host_depth(HostDepth {
             texture: &targets.depth,
-            view,
+            matrices: view,
         });
         let frame = pass
             .prepare(d, &base.store, &scene, &style(), canvas)

@@ -92,7 +92,7 @@ fn render(
     );
     let canvas = wirepass::gpu::Canvas::new(size).with_host_depth(HostDepth {
         texture: &targets.depth,
-        view,
+        matrices: view,
     });
     let frame = pass.prepare(device, &store, &wire_scene, &style, canvas)?;
     pass.encode(

@@ -98,6 +98,7 @@ impl From<(u32, u32)> for Canvas<'_> {
 pub struct HostDepth<'a> {
     /// The host's depth texture.
     pub texture: &'a wgpu::Texture,
-    /// The matrices and depth convention the host rendered it with (usually the scene's).
-    pub view: View,
+    /// The matrices and depth convention the host rendered it with (usually the scene's
+    /// view).
+    pub matrices: View,
 }

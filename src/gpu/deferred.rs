@@ -209,7 +209,7 @@ impl PreparedFrame {
 ///
 /// // Each frame, after the host has drawn its scene into `color` and `depth` with the
 /// // scene's view: the lines, hidden where the host's surfaces are in front.
-/// let canvas = Canvas::new(size).with_host_depth(HostDepth { texture: &depth, view: scene.view });
+/// let canvas = Canvas::new(size).with_host_depth(HostDepth { texture: &depth, matrices: scene.view });
 /// let frame = pass.prepare(&device, &meshes, &scene, &Style::default(), canvas)?;
 /// let mut encoder = device.create_command_encoder(&Default::default());
 /// pass.encode(&device, &mut encoder, &meshes, &frame, OutputTarget::RenderPass)?;

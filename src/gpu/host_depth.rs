@@ -94,7 +94,7 @@ impl HostImport {
                 "the host depth texture is not a single 2D texture".into(),
             ));
         }
-        host.view.validate()?;
+        host.matrices.validate()?;
         let multisampled = t.sample_count() > 1;
         if multisampled && device.adapter_info().backend == wgpu::Backend::Gl {
             // wgpu's GL backend cannot render into a multisampled texture that can also be
@@ -114,14 +114,14 @@ impl HostImport {
         if self.seed.is_none() {
             self.seed = Some(build_seed(device)?);
         }
-        let same =
-            host.view.view == scene_view.view && host.view.projection == scene_view.projection;
-        let reversed = host.view.depth == DepthRange::Reversed;
+        let same = host.matrices.view == scene_view.view
+            && host.matrices.projection == scene_view.projection;
+        let reversed = host.matrices.depth == DepthRange::Reversed;
         let (mode, a, b) = if same {
             (u32::from(reversed), DVec4::ZERO, DVec4::ZERO)
         } else {
             // Host NDC (u, v, d, 1) → world → the scene's reverse depth and w.
-            let inverse = (host.view.projection * host.view.view).inverse();
+            let inverse = (host.matrices.projection * host.matrices.view).inverse();
             let rows = scene_view.clip_rows(DMat4::IDENTITY);
             (
                 2,
@@ -135,7 +135,7 @@ impl HostImport {
             mode,
             reversed: u32::from(reversed),
             _pad: 0,
-            quantum: depth_quantum(t.format(), host.view.depth) as f32,
+            quantum: depth_quantum(t.format(), host.matrices.depth) as f32,
         };
         let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("wirepass host depth"),
