@@ -920,6 +920,91 @@ fn outputs_frames_and_stores_the_pass_cannot_use_are_misuse() {
         .unwrap_or_else(|e| panic!("misuse raised a wgpu error: {e}"));
 }
 
+/// The host's render-pass attachments are checked against the render target before the
+/// draw: every mismatch wgpu would reject is an `Error::Misuse`, and the matching
+/// attachments (an sRGB view of a texture without sRGB included) pass.
+#[test]
+fn attachments_that_differ_from_the_render_target_are_misuse() {
+    let ctx = device();
+    let d = &ctx.device;
+    use wgpu::TextureFormat as F;
+    use wgpu::TextureUsages as U;
+    let target = RenderTarget {
+        format: F::Rgba8UnormSrgb,
+        sample_count: 4,
+        depth_stencil: Some(F::Depth24PlusStencil8),
+        content: Composite::Lines,
+    };
+    let u = U::RENDER_ATTACHMENT;
+    let view = |t: &wgpu::Texture| t.create_view(&Default::default());
+    let color = texture(d, F::Rgba8UnormSrgb, u, SIZE, 4);
+    let depth = texture(d, F::Depth24PlusStencil8, u, SIZE, 4);
+    target
+        .check_attachments(&view(&color), Some(&view(&depth)))
+        .unwrap();
+    // Views in another format need DownlevelFlags::VIEW_FORMATS, which GL lacks.
+    let flags = ctx.adapter.get_downlevel_capabilities().flags;
+    if flags.contains(wgpu::DownlevelFlags::VIEW_FORMATS) {
+        let linear = d.create_texture(&wgpu::TextureDescriptor {
+            label: Some("linear colour, sRGB view"),
+            size: wgpu::Extent3d {
+                width: SIZE.0,
+                height: SIZE.1,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 4,
+            dimension: wgpu::TextureDimension::D2,
+            format: F::Rgba8Unorm,
+            usage: u,
+            view_formats: &[F::Rgba8UnormSrgb],
+        });
+        let srgb_view = linear.create_view(&wgpu::TextureViewDescriptor {
+            format: Some(F::Rgba8UnormSrgb),
+            ..Default::default()
+        });
+        target
+            .check_attachments(&srgb_view, Some(&view(&depth)))
+            .unwrap();
+    }
+    let other_format = texture(d, F::Bgra8UnormSrgb, u, SIZE, 4);
+    let single = texture(d, F::Rgba8UnormSrgb, u, SIZE, 1);
+    let depth_other = texture(d, F::Depth32Float, u, SIZE, 4);
+    let depth_single = texture(d, F::Depth24PlusStencil8, u, SIZE, 1);
+    let cases = [
+        (
+            "another colour format",
+            view(&other_format),
+            Some(view(&depth)),
+        ),
+        ("another sample count", view(&single), Some(view(&depth))),
+        ("no depth-stencil attachment", view(&color), None),
+        (
+            "another depth format",
+            view(&color),
+            Some(view(&depth_other)),
+        ),
+        (
+            "a single-sampled depth",
+            view(&color),
+            Some(view(&depth_single)),
+        ),
+    ];
+    for (what, c, ds) in &cases {
+        misuse(what, target.check_attachments(c, ds.as_ref()));
+    }
+    let without = RenderTarget {
+        depth_stencil: None,
+        ..target
+    };
+    misuse(
+        "a depth-stencil attachment the target does not name",
+        without.check_attachments(&view(&color), Some(&view(&depth))),
+    );
+    ctx.finish()
+        .unwrap_or_else(|e| panic!("checking raised a wgpu error: {e}"));
+}
+
 #[test]
 fn render_out_of_order_is_misuse() {
     let ctx = device();

@@ -38,6 +38,64 @@ pub struct RenderTarget {
     pub content: Composite,
 }
 
+impl RenderTarget {
+    /// Checks the attachments the host's render pass will have against this target, before
+    /// [`DeferredPass::render`](super::DeferredPass::render) draws into it: wirepass cannot
+    /// see a render pass's attachments, and wgpu reports a mismatch as a validation error
+    /// (a panic with its default handler). `color` is the colour attachment (an sRGB view of
+    /// a texture without sRGB, or the other way round, counts as its format), and
+    /// `depth_stencil` the depth-stencil attachment, if the pass has one.
+    pub fn check_attachments(
+        &self,
+        color: &wgpu::TextureView,
+        depth_stencil: Option<&wgpu::TextureView>,
+    ) -> Result<()> {
+        let c = color.texture();
+        if c.format().remove_srgb_suffix() != self.format.remove_srgb_suffix() {
+            return Err(Error::Misuse(format!(
+                "the colour attachment is {:?}, but the render target says {:?}",
+                c.format(),
+                self.format
+            )));
+        }
+        if c.sample_count() != self.sample_count {
+            return Err(Error::Misuse(format!(
+                "the colour attachment has {} samples per pixel, but the render target says {}",
+                c.sample_count(),
+                self.sample_count
+            )));
+        }
+        match (
+            depth_stencil.map(wgpu::TextureView::texture),
+            self.depth_stencil,
+        ) {
+            (None, None) => Ok(()),
+            (Some(d), None) => Err(Error::Misuse(format!(
+                "the render pass has a {:?} depth-stencil attachment, but the render target \
+                 says none (RenderTarget::depth_stencil)",
+                d.format()
+            ))),
+            (None, Some(f)) => Err(Error::Misuse(format!(
+                "the render target says a {f:?} depth-stencil attachment, but the render pass \
+                 has none"
+            ))),
+            (Some(d), Some(f)) if d.format() != f => Err(Error::Misuse(format!(
+                "the depth-stencil attachment is {:?}, but the render target says {f:?}",
+                d.format()
+            ))),
+            (Some(d), Some(_)) if d.sample_count() != self.sample_count => {
+                Err(Error::Misuse(format!(
+                    "the depth-stencil attachment has {} samples per pixel, but the render \
+                     target says {}",
+                    d.sample_count(),
+                    self.sample_count
+                )))
+            }
+            _ => Ok(()),
+        }
+    }
+}
+
 /// The composite pipeline for one render target.
 pub(crate) struct CompositePipeline {
     pub pipeline: wgpu::RenderPipeline,

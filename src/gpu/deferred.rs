@@ -194,18 +194,14 @@ impl PreparedFrame {
 /// let resolved_view = resolved.create_view(&Default::default());
 ///
 /// // Once: a pass for those attachments.
-/// let mut pass = DeferredPass::new(
-///     &device,
-///     PassOptions {
-///         render_target: Some(RenderTarget {
-///             format: color.format(),
-///             sample_count: 4,
-///             depth_stencil: Some(depth_format),
-///             content: Composite::Lines,
-///         }),
-///         ..Default::default()
-///     },
-/// )?;
+/// let target = RenderTarget {
+///     format: color.format(),
+///     sample_count: 4,
+///     depth_stencil: Some(depth_format),
+///     content: Composite::Lines,
+/// };
+/// let options = PassOptions { render_target: Some(target), ..Default::default() };
+/// let mut pass = DeferredPass::new(&device, options)?;
 ///
 /// // Each frame, after the host has drawn its scene into `color` and `depth` with the
 /// // scene's view: the lines, hidden where the host's surfaces are in front.
@@ -216,7 +212,8 @@ impl PreparedFrame {
 /// {
 ///     // The host's render pass, with the attachments the render target names: the
 ///     // depth-stencil attachment too, as `depth_stencil` says (kept, neither tested nor
-///     // written by wirepass).
+///     // written by wirepass). A mismatch would be wgpu's validation error: check first.
+///     target.check_attachments(&color_view, Some(&depth_view))?;
 ///     let store = wgpu::StoreOp::Store;
 ///     let mut overlay = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
 ///         color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -602,6 +599,13 @@ impl DeferredPass {
     /// and its lines. The frame must have been encoded with [`OutputTarget::RenderPass`],
     /// and no other frame of this pass encoded since (each frame's result lives in the
     /// pass's one result texture until the next encode).
+    ///
+    /// wirepass cannot see the render pass's attachments: if they differ from the render
+    /// target (format, sample count, a depth-stencil attachment), wgpu rejects the draw with a
+    /// validation error, not a `wirepass::Error`. [`RenderTarget::check_attachments`] checks
+    /// them beforehand.
+    ///
+    /// [`RenderTarget::check_attachments`]: super::RenderTarget::check_attachments
     pub fn render(&self, pass: &mut wgpu::RenderPass<'_>, frame: &PreparedFrame) -> Result<()> {
         if frame.pass != self.id {
             return Err(Error::Misuse(
