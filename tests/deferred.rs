@@ -5,7 +5,9 @@ mod common;
 
 use common::{camera, cpu_distance, framing, gpu, load, shoot};
 use glam::{DMat4, Vec3};
-use wirepass::gpu::{DeferredPass, EncodeOptions, MeshStore, OutputTarget, PassOptions};
+use wirepass::gpu::{
+    DeferredPass, EncodeOptions, MeshStore, OutputTarget, PassOptions, PreparedFrame,
+};
 use wirepass::tools::offline::Method;
 use wirepass::world::{Rendering, BACKGROUND};
 use wirepass::{Camera, EdgeSelection, Instance, Mesh, Scene, Style};
@@ -553,4 +555,56 @@ fn edge_work_lists_the_tiles_with_foreground_and_the_background_beside_it() {
         (0, 0, 0),
         "{work:?}"
     );
+}
+
+/// `warm_up` builds every pipeline the frame's encode uses: after it, encoding builds
+/// none, for a frame with outlines, one without, and a second output kind. Without it, the
+/// first encode of each kind builds its own.
+#[test]
+fn warm_up_builds_what_the_first_encode_would() {
+    let ctx = gpu();
+    let d = &ctx.device;
+    let mesh = wirepass::mesh::torus(500).unwrap();
+    let size = (64, 48);
+    let view = framing(&mesh, size).to_view(64.0 / 48.0);
+    let (store, scene) = single(&mesh, EdgeSelection::Polygon, view);
+    use wirepass::wgpu::TextureUsages as U;
+    let encode = |pass: &DeferredPass, frame: &PreparedFrame, target: OutputTarget<'_>| {
+        let mut encoder = d.create_command_encoder(&Default::default());
+        pass.encode(d, &mut encoder, &store, frame, target).unwrap();
+        ctx.queue.submit([encoder.finish()]);
+    };
+    for silhouettes in [true, false] {
+        let style = Style {
+            silhouettes,
+            ..Style::default()
+        };
+        let mut pass = DeferredPass::new(d, PassOptions::default()).unwrap();
+        let usage = U::STORAGE_BINDING | U::TEXTURE_BINDING;
+        let output = wirepass::gpu::texture_2d(d, "out", size, pass.output_format(), usage);
+        let host = wirepass::gpu::texture_2d(d, "host", size, pass.output_format(), usage);
+        let out = output.create_view(&Default::default());
+        let host = host.create_view(&Default::default());
+        let frame = pass.prepare(d, &store, &scene, &style, size).unwrap();
+        let shaded = OutputTarget::Shaded(&out);
+        let overlay = || OutputTarget::Overlay {
+            host: &host,
+            output: &out,
+        };
+
+        pass.warm_up(d, &frame, &shaded).unwrap();
+        let built = pass.built_pipelines();
+        assert!(built >= 1, "silhouettes {silhouettes}");
+        encode(&pass, &frame, shaded);
+        assert_eq!(pass.built_pipelines(), built, "silhouettes {silhouettes}");
+
+        // Another output kind, not warmed up: its first encode builds its pipelines.
+        encode(&pass, &frame, overlay());
+        let after = pass.built_pipelines();
+        assert!(after > built, "silhouettes {silhouettes}");
+        pass.warm_up(d, &frame, &overlay()).unwrap();
+        encode(&pass, &frame, overlay());
+        assert_eq!(pass.built_pipelines(), after, "silhouettes {silhouettes}");
+    }
+    ctx.finish().unwrap();
 }

@@ -416,6 +416,68 @@ impl DeferredPass {
         })
     }
 
+    /// What the edge pass writes for `target` (`None`: the floor, which has no edge mode).
+    fn mode(&self, target: &OutputTarget<'_>) -> Result<Option<Mode>> {
+        Ok(match target {
+            OutputTarget::Shaded(_) => Some(Mode::Shade),
+            OutputTarget::Overlay { host, .. } => {
+                // An 8-bit host format without sRGB holds sRGB-encoded values.
+                let f = host.texture().format();
+                let encoded = !f.is_srgb() && f.target_component_alignment() == Some(1);
+                Some(Mode::Overlay { encoded })
+            }
+            OutputTarget::RenderPass => {
+                let Some((_, content)) = &self.composite else {
+                    return Err(Error::Misuse(
+                        "OutputTarget::RenderPass needs PassOptions::render_target".into(),
+                    ));
+                };
+                let shaded = *content == Composite::Shaded;
+                Some(Mode::Result { shaded })
+            }
+            #[cfg(feature = "diagnostics")]
+            OutputTarget::Floor(_) => None,
+            #[cfg(feature = "diagnostics")]
+            OutputTarget::Diagnostic => Some(Mode::Diagnostic),
+        })
+    }
+
+    /// Builds now every pipeline that encoding `frame` into outputs like `target` uses, so
+    /// that the first encode does not build them. The pass builds each pipeline on first use
+    /// (its modules are specialised for what a frame holds: outlines, host depth, one or many
+    /// instances, the output), so the first frame of each kind costs more than the next (the
+    /// README's library section has lavapipe's figures). A host calls this while loading, with a
+    /// frame prepared like the ones it will draw; `prepare` has already built the visibility
+    /// and host-depth pipelines, and `new` the composite.
+    pub fn warm_up(
+        &self,
+        device: &wgpu::Device,
+        frame: &PreparedFrame,
+        target: &OutputTarget<'_>,
+    ) -> Result<()> {
+        if frame.pass != self.id {
+            return Err(Error::Misuse(
+                "the frame was prepared by another DeferredPass".into(),
+            ));
+        }
+        let Some(mode) = self.mode(target)? else {
+            // The floor's pipeline is built with the pass.
+            return Ok(());
+        };
+        let variant = self.variant(frame);
+        if variant.outlines {
+            self.outline.warm_up(device, variant)?;
+        }
+        self.edge.pipelines(device, mode, variant)?;
+        Ok(())
+    }
+
+    /// How many outline and edge pipeline sets the pass has built so far.
+    #[cfg(feature = "diagnostics")]
+    pub fn built_pipelines(&self) -> usize {
+        self.outline.built() + self.edge.built()
+    }
+
     fn variant(&self, frame: &PreparedFrame) -> Variant {
         Variant {
             split: frame.data.split(),
@@ -485,33 +547,31 @@ impl DeferredPass {
         }
         frame.data.check_store(store)?;
         let t = &frame.targets;
+        let mode = self.mode(&target)?;
         let result_view;
-        let (mode, out_color, host_color) = match &target {
+        let (out_color, host_color) = match &target {
             OutputTarget::Shaded(v) => {
                 check_storage_output(v, self.format, t.output, "the output texture")?;
-                (Some(Mode::Shade), Some(*v), None)
+                (Some(*v), None)
             }
             OutputTarget::Overlay { host, output } => {
                 check_storage_output(output, self.format, t.output, "the output texture")?;
                 check_sampled(host, t.output, "the host colour texture")?;
-                let f = host.texture().format();
-                let encoded = !f.is_srgb() && f.target_component_alignment() == Some(1);
-                (Some(Mode::Overlay { encoded }), Some(*output), Some(*host))
+                (Some(*output), Some(*host))
             }
             OutputTarget::RenderPass => {
-                let (Some((_, content)), Some(result)) = (&self.composite, &t.result) else {
-                    return Err(Error::Misuse(
+                let result = t.result.as_ref().ok_or_else(|| {
+                    Error::Misuse(
                         "OutputTarget::RenderPass needs PassOptions::render_target".into(),
-                    ));
-                };
+                    )
+                })?;
                 result_view = result.create_view(&Default::default());
-                let shaded = *content == Composite::Shaded;
-                (Some(Mode::Result { shaded }), Some(&result_view), None)
+                (Some(&result_view), None)
             }
             #[cfg(feature = "diagnostics")]
             OutputTarget::Floor(v) => {
                 check_storage_output(v, self.format, t.output, "the output texture")?;
-                (None, Some(*v), None)
+                (Some(*v), None)
             }
             #[cfg(feature = "diagnostics")]
             OutputTarget::Diagnostic => {
@@ -520,7 +580,7 @@ impl DeferredPass {
                         "diagnostics were not enabled (DeferredPass::with_diagnostics)".into(),
                     ));
                 }
-                (Some(Mode::Diagnostic), None, None)
+                (None, None)
             }
         };
         if visibility {

@@ -38,6 +38,12 @@ pub(crate) struct EdgePass {
 }
 
 impl EdgePass {
+    /// How many pipeline sets the cache holds.
+    #[cfg(feature = "diagnostics")]
+    pub(crate) fn built(&self) -> usize {
+        self.cache.lock().map_or(0, |c| c.len())
+    }
+
     /// The pass for storage outputs of `format`; its pipelines come on first use (the
     /// floor's, a diagnostics build's, now).
     #[cfg_attr(not(feature = "diagnostics"), allow(unused_variables))]

@@ -38,6 +38,17 @@ pub(crate) struct OutlinePass {
 }
 
 impl OutlinePass {
+    /// Builds the pipelines of variant `v` now, if they are not built yet.
+    pub(crate) fn warm_up(&self, device: &wgpu::Device, v: Variant) -> Result<()> {
+        self.pipelines(device, v).map(drop)
+    }
+
+    /// How many pipeline sets the cache holds.
+    #[cfg(feature = "diagnostics")]
+    pub(crate) fn built(&self) -> usize {
+        self.cache.lock().map_or(0, |c| c.len())
+    }
+
     pub(crate) fn new(format: wgpu::TextureFormat) -> Self {
         Self {
             format,
