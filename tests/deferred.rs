@@ -608,3 +608,38 @@ fn warm_up_builds_what_the_first_encode_would() {
     }
     ctx.finish().unwrap();
 }
+
+/// The async readback gives the bytes the blocking one gives, for the output and the id
+/// target (padded rows: 37 texels of 4 or 8 bytes), driven by the simplest executor, which
+/// nothing else polls the device for. (GL cannot copy depth textures out.)
+#[test]
+fn async_readback_reads_what_the_blocking_one_reads() {
+    let ctx = gpu();
+    let d = &ctx.device;
+    let mesh = wirepass::mesh::torus(300).unwrap();
+    let size = (37, 29);
+    let view = framing(&mesh, size).to_view(37.0 / 29.0);
+    let (store, scene) = single(&mesh, EdgeSelection::Polygon, view);
+    let mut pass = DeferredPass::new(d, PassOptions::default()).unwrap();
+    let frame = pass
+        .prepare(d, &store, &scene, &Style::default(), size)
+        .unwrap();
+    use wirepass::wgpu::TextureUsages as U;
+    let usage = U::STORAGE_BINDING | U::COPY_SRC;
+    let output = wirepass::gpu::texture_2d(d, "out", size, pass.output_format(), usage);
+    let out = output.create_view(&Default::default());
+    let mut encoder = d.create_command_encoder(&Default::default());
+    pass.encode(d, &mut encoder, &store, &frame, OutputTarget::Shaded(&out))
+        .unwrap();
+    ctx.queue.submit([encoder.finish()]);
+    use wirepass::gpu::{read_texture, read_texture_async};
+    use wirepass::wgpu::TextureAspect as A;
+    for (texture, aspect) in [(&output, A::All), (frame.id_texture(), A::All)] {
+        let blocking = read_texture(d, &ctx.queue, texture, aspect).unwrap();
+        let future = read_texture_async(d, &ctx.queue, texture, aspect);
+        let awaited = pollster::block_on(future).unwrap();
+        assert_eq!(blocking, awaited, "{:?}", texture.format());
+        assert!(blocking.iter().any(|&b| b != 0), "{:?}", texture.format());
+    }
+    ctx.finish().unwrap();
+}

@@ -51,7 +51,7 @@ pub(crate) use frame::light_world_dir;
 pub(crate) use host_depth::depth_quantum;
 pub use mesh_store::{MeshId, MeshStore};
 pub use options::{OutputTarget, PassOptions, TriangleIds};
-pub use readback::read_texture;
+pub use readback::{read_texture, read_texture_async};
 pub use targets::{check_size, texture_2d, BACKGROUND_ID, DEPTH_FORMAT, HOST_ID, ID_FORMAT};
 #[cfg(feature = "diagnostics")]
 pub use targets::{DIAGNOSTIC_FORMAT, RESOLVED_ID_FORMAT};
