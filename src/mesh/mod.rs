@@ -15,7 +15,8 @@ mod procedural;
 
 #[cfg(feature = "formats")]
 pub use formats::{
-    format_of, load, load_gltf, load_gltf_mesh, load_obj, load_ply, load_stl, Format, FORMATS,
+    format_of, load, load_bytes, load_gltf, load_gltf_mesh, load_obj, load_ply, load_stl, Format,
+    FORMATS,
 };
 pub use procedural::{
     cube, default_parts, default_scene, grid, layers, sphere, torus, Procedural, LAYER_TRIANGLES,

@@ -21,6 +21,12 @@ pub fn load_obj(path: &Path) -> Result<Mesh> {
     parse_obj(path, &bytes)
 }
 
+/// [`load_obj`] from the bytes of a file (a browser's files come as bytes); `name` names
+/// the file in errors, which are the same as from a file.
+pub fn load_obj_bytes(name: &Path, bytes: &[u8]) -> Result<Mesh> {
+    parse_obj(name, bytes)
+}
+
 /// Parses the bytes of an OBJ file; `path` only names the file in errors.
 fn parse_obj(path: &Path, bytes: &[u8]) -> Result<Mesh> {
     let fail = |line, message| file_error(path, line, message);

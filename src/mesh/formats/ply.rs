@@ -35,11 +35,22 @@ const VERTEX_NAMES: [&str; 6] = ["x", "y", "z", "nx", "ny", "nz"];
 /// coordinates, edges, materials) are read past and ignored.
 pub fn load_ply(path: &Path) -> Result<Mesh> {
     let (file, len) = open(path, "a PLY")?;
+    read_ply(path, BufReader::with_capacity(1 << 16, file), len)
+}
+
+/// [`load_ply`] from the bytes of a file (a browser's files come as bytes); `name` names the
+/// file in errors, which are the same as from a file.
+pub fn load_ply_bytes(name: &Path, bytes: &[u8]) -> Result<Mesh> {
+    read_ply(name, bytes, bytes.len() as u64)
+}
+
+/// Reads a PLY of `len` bytes from `input`; `path` names it in errors.
+fn read_ply(path: &Path, input: impl BufRead, len: u64) -> Result<Mesh> {
     if len == 0 {
         return Err(file_error(path, None, "empty file: not a PLY file".into()));
     }
     let mut reader = Reader::new(Counted {
-        inner: BufReader::with_capacity(1 << 16, file),
+        inner: input,
         pos: 0,
     });
     let header = Parser::<Skip>::new()

@@ -33,11 +33,39 @@ const SNIFF: u64 = 512;
 /// An ASCII file is read up to its first `endsolid` (or its end, if that is missing).
 pub fn load_stl(path: &Path) -> Result<Mesh> {
     let (file, len) = open(path, "an STL")?;
+    let reopen = || -> Option<Box<dyn BufRead>> {
+        let file = std::fs::File::open(path).ok()?;
+        Some(Box::new(BufReader::new(file)))
+    };
+    read_stl(path, BufReader::new(file), len, &reopen)
+}
+
+/// [`load_stl`] from the bytes of a file (a browser's files come as bytes); `name` names
+/// the file in errors, which are the same as from a file.
+pub fn load_stl_bytes(name: &Path, bytes: &[u8]) -> Result<Mesh> {
+    let reopen = || -> Option<Box<dyn BufRead + '_>> { Some(Box::new(bytes)) };
+    read_stl(
+        name,
+        std::io::Cursor::new(bytes),
+        bytes.len() as u64,
+        &reopen,
+    )
+}
+
+/// Reads the text of the file again from its start, to say where an ASCII error is.
+type Reopen<'r, 'b> = &'r dyn Fn() -> Option<Box<dyn BufRead + 'b>>;
+
+/// Reads an STL of `len` bytes from `reader`; `path` names it in errors.
+fn read_stl<R: BufRead + Seek>(
+    path: &Path,
+    mut reader: R,
+    len: u64,
+    reopen: Reopen<'_, '_>,
+) -> Result<Mesh> {
     let fail = |line, message| file_error(path, line, message);
     if len == 0 {
         return Err(fail(None, "empty file: not an STL file".into()));
     }
-    let mut reader = BufReader::new(file);
     // The header, the count and what follows, to tell text from binary.
     let mut head = Vec::with_capacity(SNIFF as usize);
     (&mut reader)
@@ -80,7 +108,7 @@ pub fn load_stl(path: &Path) -> Result<Mesh> {
         }
     }
     if text {
-        return read_ascii(path, reader);
+        return read_ascii(path, reader, reopen);
     }
     Err(fail(
         None,
@@ -207,7 +235,7 @@ fn read_binary<R: Read + Seek>(path: &Path, reader: R, count: u32) -> Result<Mes
     build(path, welder.positions, None, triangles, None)
 }
 
-fn read_ascii<R: Read + Seek>(path: &Path, reader: R) -> Result<Mesh> {
+fn read_ascii<R: Read + Seek>(path: &Path, reader: R, reopen: Reopen<'_, '_>) -> Result<Mesh> {
     // "solid" becomes "solid ": stl_io needs the space, which a file without a solid name
     // may lack.
     let mut spliced = Spliced::new(b"solid ", reader, 5).map_err(|e| io_error(path, e))?;
@@ -229,7 +257,7 @@ fn read_ascii<R: Read + Seek>(path: &Path, reader: R) -> Result<Mesh> {
                 if e.kind() == std::io::ErrorKind::InvalidData
                     || e.kind() == std::io::ErrorKind::UnexpectedEof =>
             {
-                let (line, message) = locate_ascii_error(path, t, &e.to_string());
+                let (line, message) = locate_ascii_error(reopen, t, &e.to_string());
                 return Err(file_error(path, line, message));
             }
             Err(e) => return Err(io_error(path, e)),
@@ -252,13 +280,13 @@ fn read_ascii<R: Read + Seek>(path: &Path, reader: R) -> Result<Mesh> {
 /// finds the first of facet `t`'s lines that breaks the layout and says what it expected.
 /// Where that finds nothing (an I/O error while reading), the facet's first line and
 /// stl_io's message are used.
-fn locate_ascii_error(path: &Path, t: usize, message: &str) -> (Option<usize>, String) {
+fn locate_ascii_error(reopen: Reopen<'_, '_>, t: usize, message: &str) -> (Option<usize>, String) {
     let fallback = (None, format!("facet {}: {message}", t + 1));
-    let Ok(file) = std::fs::File::open(path) else {
+    let Some(text) = reopen() else {
         return fallback;
     };
     // (line number, words) of the non-blank lines, the `solid` line first.
-    let mut lines = BufReader::new(file)
+    let mut lines = text
         .split(b'\n')
         .enumerate()
         .map_while(|(i, l)| l.ok().map(|l| (i + 1, l)))

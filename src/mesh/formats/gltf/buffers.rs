@@ -5,11 +5,10 @@
 // `!(a > b)` is deliberate throughout: NaN must take the rejecting branch.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-use super::FileResult;
+use super::{FileResult, Resolver};
 use glam::Vec3;
 use gltf::accessor::{DataType, Dimensions};
 use std::borrow::Cow;
-use std::path::Path;
 
 /// The bytes of every buffer of the file.
 pub(super) struct Buffers<'a> {
@@ -20,9 +19,9 @@ pub(super) struct Buffers<'a> {
 
 impl<'a> Buffers<'a> {
     pub(super) fn load(
-        path: &Path,
         doc: &gltf::Document,
         blob: Option<Cow<'a, [u8]>>,
+        resolve: Resolver<'_>,
     ) -> FileResult<Buffers<'a>> {
         let mut blob = blob;
         let mut data = Vec::new();
@@ -33,7 +32,7 @@ impl<'a> Buffers<'a> {
                     format!("buffer {i} is the GLB binary chunk, which the file lacks")
                 })?,
                 gltf::buffer::Source::Uri(uri) => {
-                    Cow::Owned(read_uri(path, uri).map_err(|m| format!("buffer {i}: {m}"))?)
+                    Cow::Owned(read_uri(uri, resolve).map_err(|m| format!("buffer {i}: {m}"))?)
                 }
             };
             if bytes.len() < buffer.length() {
@@ -231,9 +230,9 @@ fn component_reader(ty: DataType, normalized: bool) -> Option<fn(&[u8]) -> f32> 
     })
 }
 
-/// Reads a buffer's URI: a base64 `data:` URI, or a file relative to the glTF file's
-/// folder (percent-encoded, as URIs are).
-fn read_uri(path: &Path, uri: &str) -> FileResult<Vec<u8>> {
+/// Reads a buffer's URI: a base64 `data:` URI, or a relative reference (percent-encoded,
+/// as URIs are) that `resolve` turns into bytes.
+fn read_uri(uri: &str, resolve: Resolver<'_>) -> FileResult<Vec<u8>> {
     use base64::Engine as _;
     if let Some(rest) = uri.strip_prefix("data:") {
         let (_, data) = rest
@@ -263,6 +262,5 @@ fn read_uri(path: &Path, uri: &str) -> FileResult<Vec<u8>> {
     }
     let decoded = urlencoding::decode(uri)
         .map_err(|_| format!("'{uri}' is not UTF-8 once percent-decoded"))?;
-    let file = path.parent().unwrap_or(Path::new(".")).join(&*decoded);
-    std::fs::read(&file).map_err(|e| format!("cannot read '{}': {e}", file.display()))
+    resolve(&decoded)
 }

@@ -186,6 +186,10 @@ fn supported_requirement(name: &str) -> bool {
 /// A problem of the file, in words; the loader adds the file's name.
 type FileResult<T> = std::result::Result<T, String>;
 
+/// Gives the bytes of an external buffer a glTF file names by a relative reference (its
+/// URI, percent-decoded: `"scene.bin"`, `"buffers/a b.bin"`), or says why it cannot.
+pub type Resolver<'r> = &'r mut dyn FnMut(&str) -> std::result::Result<Vec<u8>, String>;
+
 /// Loads a glTF file's scene. Every problem of the file is an [`Error::MeshFile`] naming
 /// it (a missing external buffer too); a scene without a triangle to draw is one as well.
 pub fn load_gltf(path: &Path) -> Result<Document> {
@@ -194,7 +198,20 @@ pub fn load_gltf(path: &Path) -> Result<Document> {
     let mut bytes = Vec::with_capacity(usize::try_from(len).unwrap_or(0));
     file.read_to_end(&mut bytes)
         .map_err(|e| io_error(path, e))?;
-    parse(path, &bytes).map_err(|message| file_error(path, None, message))
+    let folder = path.parent().unwrap_or(Path::new("."));
+    let mut beside = |name: &str| {
+        let file = folder.join(name);
+        std::fs::read(&file).map_err(|e| format!("cannot read '{}': {e}", file.display()))
+    };
+    load_gltf_bytes(path, &bytes, &mut beside)
+}
+
+/// [`load_gltf`] from the bytes of a `.gltf` or `.glb` file (a browser has no file system:
+/// its files come by drag and drop or `fetch`); `name` names the file in errors. `resolve`
+/// gives the external buffers a `.gltf` names (a `.glb`, or a `.gltf` with its buffers in
+/// `data:` URIs, asks for none); its error message becomes the file's error.
+pub fn load_gltf_bytes(name: &Path, bytes: &[u8], resolve: Resolver<'_>) -> Result<Document> {
+    parse(bytes, resolve).map_err(|message| file_error(name, None, message))
 }
 
 /// Loads a glTF file as one mesh, for where one mesh is wanted (`mesh::load`, scene
@@ -203,7 +220,16 @@ pub fn load_gltf(path: &Path) -> Result<Document> {
 /// outline masks and all). Cameras, notes and line widths are left out: load the file with
 /// [`load_gltf`] for them.
 pub fn load_gltf_mesh(path: &Path) -> Result<Mesh> {
-    let mut doc = load_gltf(path)?;
+    one_mesh(path, load_gltf(path)?)
+}
+
+/// [`load_gltf_mesh`] from the bytes of a file, as [`load_gltf_bytes`] reads them.
+pub fn load_gltf_mesh_bytes(name: &Path, bytes: &[u8], resolve: Resolver<'_>) -> Result<Mesh> {
+    one_mesh(name, load_gltf_bytes(name, bytes, resolve)?)
+}
+
+/// A document's scene as one mesh: see [`load_gltf_mesh`].
+fn one_mesh(path: &Path, mut doc: Document) -> Result<Mesh> {
     if let [(m, t)] = doc.instances[..] {
         if t == DMat4::IDENTITY {
             return Ok(doc.meshes.swap_remove(m).mesh);
@@ -312,7 +338,7 @@ impl RawNode {
     }
 }
 
-fn parse(path: &Path, bytes: &[u8]) -> FileResult<Document> {
+fn parse(bytes: &[u8], resolve: Resolver<'_>) -> FileResult<Document> {
     if bytes.is_empty() {
         return Err("empty file, not a glTF file".into());
     }
@@ -356,7 +382,7 @@ fn parse(path: &Path, bytes: &[u8]) -> FileResult<Document> {
     }
     let doc = gltf::Document::from_json(root).map_err(|e| e.to_string())?;
     let raw: RawRoot = serde_json::from_slice(&json).map_err(|e| format!("not glTF JSON: {e}"))?;
-    let buffers = Buffers::load(path, &doc, blob)?;
+    let buffers = Buffers::load(&doc, blob, resolve)?;
     let mut notes = Vec::new();
 
     let (roots, scene_name) = match doc.default_scene().or_else(|| doc.scenes().next()) {
