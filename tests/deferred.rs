@@ -372,7 +372,8 @@ fn timer_reports_every_pass() {
         .unwrap();
     let mut timer = wirepass::gpu::GpuTimer::new(device, &ctx.queue, 16)
         .expect("software adapters expose TIMESTAMP_QUERY");
-    for _ in 0..2 {
+    // The second round reads the timer without blocking.
+    for round in 0..2 {
         let mut encoder = device.create_command_encoder(&Default::default());
         pass.encode_with(
             device,
@@ -388,7 +389,10 @@ fn timer_reports_every_pass() {
         .unwrap();
         timer.resolve(&mut encoder);
         ctx.queue.submit([encoder.finish()]);
-        let spans = timer.read(device).unwrap();
+        let spans = match round {
+            0 => timer.read(device).unwrap(),
+            _ => pollster::block_on(timer.read_async(device)).unwrap(),
+        };
         let names: Vec<_> = spans.iter().map(|s| s.0).collect();
         assert_eq!(
             names,
@@ -610,7 +614,7 @@ fn warm_up_builds_what_the_first_encode_would() {
 }
 
 /// The async readback gives the bytes the blocking one gives, for the output and the id
-/// target (padded rows: 37 texels of 4 or 8 bytes), driven by the simplest executor, which
+/// target, and the same edge work counters (padded rows: 37 texels of 4 or 8 bytes), driven by the simplest executor, which
 /// nothing else polls the device for. (GL cannot copy depth textures out.)
 #[test]
 fn async_readback_reads_what_the_blocking_one_reads() {
@@ -641,5 +645,9 @@ fn async_readback_reads_what_the_blocking_one_reads() {
         assert_eq!(blocking, awaited, "{:?}", texture.format());
         assert!(blocking.iter().any(|&b| b != 0), "{:?}", texture.format());
     }
+    let work = frame.edge_work(d, &ctx.queue).unwrap();
+    let awaited = pollster::block_on(frame.edge_work_async(d, &ctx.queue)).unwrap();
+    assert_eq!(work, awaited);
+    assert!(work.tiles > 0 && work.outline_clusters > 0, "{work:?}");
     ctx.finish().unwrap();
 }

@@ -418,9 +418,9 @@ pub(crate) fn bind_host_resources(
     device: &wgpu::Device,
     desc: &wgpu::BindGroupDescriptor<'_>,
 ) -> Result<wgpu::BindGroup> {
-    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let scope = crate::gpu::validation::Validation::begin(device);
     let group = device.create_bind_group(desc);
-    match pollster::block_on(scope.pop()) {
+    match scope.end() {
         None => Ok(group),
         Some(e) => Err(Error::Misuse(format!(
             "a texture given to the pass cannot be bound (from another device?): {e}"

@@ -138,7 +138,7 @@ impl CompositePipeline {
                 )));
             }
         }
-        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let scope = crate::gpu::validation::Validation::begin(device);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("wirepass composite"),
             entries: &[Res::Result.layout_entry(wgpu::ShaderStages::FRAGMENT, RESULT_FORMAT)],
@@ -194,7 +194,7 @@ impl CompositePipeline {
             multiview_mask: None,
             cache: None,
         });
-        if let Some(e) = pollster::block_on(scope.pop()) {
+        if let Some(e) = scope.end() {
             return Err(Error::Device(format!(
                 "building the composite pipeline: {e}"
             )));

@@ -71,36 +71,68 @@ pub struct EdgeWork {
 impl PreparedFrame {
     /// What the outline pass and the edge pass's tile and refine dispatches took on in the
     /// last encode of this frame, read back from the GPU (it waits for the work submitted so
-    /// far): for tools, tests and benchmarks.
+    /// far): for tools, tests and benchmarks. [`edge_work_async`](Self::edge_work_async)
+    /// reads it without blocking.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn edge_work(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<EdgeWork> {
-        let count = |buffer: &wgpu::Buffer, at: u64| -> Result<u32> {
-            let bytes = super::readback::read_buffer(device, queue, buffer, at + 12, 4)?;
-            Ok(u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]))
-        };
-        let (w, h) = self.targets.output;
+        let mut counts = [0u32; 5];
+        for (count, (buffer, at)) in counts.iter_mut().zip(self.counters()) {
+            if let Some(buffer) = buffer {
+                let bytes = super::readback::read_buffer(device, queue, buffer, at + 12, 4)?;
+                *count = u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]);
+            }
+        }
+        Ok(self.edge_work_of(counts))
+    }
+
+    /// [`edge_work`](Self::edge_work) without blocking, as a browser needs.
+    pub async fn edge_work_async(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+    ) -> Result<EdgeWork> {
+        let mut counts = [0u32; 5];
+        for (count, (buffer, at)) in counts.iter_mut().zip(self.counters()) {
+            if let Some(buffer) = buffer {
+                let read = super::readback::read_buffer_async(device, queue, buffer, at + 12, 4);
+                let bytes = read.await?;
+                *count = u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]);
+            }
+        }
+        Ok(self.edge_work_of(counts))
+    }
+
+    /// Where the lists' counts lie: the tile list, the outlined tiles, the refine list, the
+    /// cluster list and the pieces (the last three's only where the outline pass ran).
+    fn counters(&self) -> [(Option<&wgpu::Buffer>, u64); 5] {
         let t = &self.targets;
-        Ok(EdgeWork {
-            tiles: count(&t.tiles, 0)?,
-            outlined_tiles: if self.data.outlines {
-                count(&t.acc, t.acc_tiles)?
-            } else {
-                0
-            },
-            all_tiles: w.div_ceil(super::edge_pass::TILE) * h.div_ceil(super::edge_pass::TILE),
-            refined: count(&t.work, 0)?,
+        let outlines = |b| self.data.outlines.then_some(b);
+        [
+            (Some(&t.tiles), 0),
+            (outlines(&t.acc), t.acc_tiles),
+            (Some(&t.work), 0),
+            (outlines(&self.cull), 0),
+            (outlines(&t.acc), t.acc_pieces),
+        ]
+    }
+
+    /// The work from the counts at [`counters`](Self::counters).
+    fn edge_work_of(
+        &self,
+        [tiles, outlined_tiles, refined, clusters, pieces]: [u32; 5],
+    ) -> EdgeWork {
+        let (w, h) = self.targets.output;
+        let tile = super::edge_pass::TILE;
+        EdgeWork {
+            tiles,
+            outlined_tiles,
+            all_tiles: w.div_ceil(tile) * h.div_ceil(tile),
+            refined,
             pixels: w * h,
-            outline_clusters: if self.data.outlines {
-                count(&self.cull, 0)?
-            } else {
-                0
-            },
-            outline_pieces: if self.data.outlines {
-                count(&t.acc, t.acc_pieces)?
-            } else {
-                0
-            },
-            piece_room: t.piece_room(),
-        })
+            outline_clusters: clusters,
+            outline_pieces: pieces,
+            piece_room: self.targets.piece_room(),
+        }
     }
 }
 
@@ -278,7 +310,7 @@ impl DeferredPass {
                  (Rgba8Unorm, Rgba16Float, Rgba32Float)"
             )));
         }
-        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let scope = crate::gpu::validation::Validation::begin(device);
         let visibility = Visibility::new(device, pulled)?;
         let composite = match &options.render_target {
             Some(t) => Some((CompositePipeline::new(device, t)?, t.content)),
@@ -289,7 +321,7 @@ impl DeferredPass {
             contents: bytemuck::cast_slice(&[0u32, 1, 1, 0]),
             usage: wgpu::BufferUsages::COPY_SRC,
         });
-        if let Some(e) = pollster::block_on(scope.pop()) {
+        if let Some(e) = scope.end() {
             return Err(Error::Device(format!("creating the deferred pass: {e}")));
         }
         Ok(Self {

@@ -108,7 +108,7 @@ impl EdgePass {
             #[cfg(feature = "diagnostics")]
             Mode::Diagnostic => (vec![Res::OutDiagnostic, Res::OutIds], self.format),
         };
-        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let scope = crate::gpu::validation::Validation::begin(device);
         let module = edge_module(device, self.format, &flags);
         let mut common = store_resources(v.split, false, v.uniform_instances);
         common.push(Res::Ids);
@@ -157,7 +157,7 @@ impl EdgePass {
         let mut refine_res = with(&[Res::Work]);
         refine_res.extend_from_slice(&neighbours);
         let refine = Compute::new(device, &module, "refine_main", refine_res, color)?;
-        if let Some(e) = pollster::block_on(scope.pop()) {
+        if let Some(e) = scope.end() {
             return Err(Error::Device(format!("building the edge pass: {e}")));
         }
         let p = Arc::new(EdgePipelines {

@@ -271,7 +271,7 @@ fn build_resolve(
     device: &wgpu::Device,
     multisampled: bool,
 ) -> Result<(wgpu::ComputePipeline, wgpu::BindGroupLayout)> {
-    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let scope = crate::gpu::validation::Validation::begin(device);
     let cs = wgpu::ShaderStages::COMPUTE;
     let mut source = Res::HostSource.layout_entry(cs, HOST_FORMAT);
     if let wgpu::BindingType::Texture {
@@ -306,14 +306,14 @@ fn build_resolve(
         compilation_options: Default::default(),
         cache: None,
     });
-    if let Some(e) = pollster::block_on(scope.pop()) {
+    if let Some(e) = scope.end() {
         return Err(Error::Device(format!("building the host depth pass: {e}")));
     }
     Ok((pipeline, layout))
 }
 
 fn build_seed(device: &wgpu::Device) -> Result<(wgpu::RenderPipeline, wgpu::BindGroupLayout)> {
-    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let scope = crate::gpu::validation::Validation::begin(device);
     let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("wirepass host seed"),
         entries: &[Res::HostDepth.layout_entry(wgpu::ShaderStages::FRAGMENT, HOST_FORMAT)],
@@ -354,7 +354,7 @@ fn build_seed(device: &wgpu::Device) -> Result<(wgpu::RenderPipeline, wgpu::Bind
         multiview_mask: None,
         cache: None,
     });
-    if let Some(e) = pollster::block_on(scope.pop()) {
+    if let Some(e) = scope.end() {
         return Err(Error::Device(format!("building the host seed pass: {e}")));
     }
     Ok((pipeline, layout))

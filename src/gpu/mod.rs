@@ -9,6 +9,7 @@ pub mod baselines;
 mod bindings;
 mod canvas;
 mod composite;
+#[cfg(not(target_arch = "wasm32"))]
 mod context;
 mod deferred;
 #[cfg(feature = "diagnostics")]
@@ -29,6 +30,7 @@ mod shaders;
 mod targets;
 #[cfg_attr(not(feature = "diagnostics"), allow(dead_code))]
 mod timing;
+mod validation;
 mod variants;
 mod visibility;
 
@@ -38,6 +40,7 @@ pub use baselines::MAPS_DIAGNOSTIC_FORMAT;
 pub use baselines::{drawn_edges, EdgeLines, ForwardPass, RasterFrame, TwoPass};
 pub use canvas::{Canvas, HostDepth, Region};
 pub use composite::{Composite, RenderTarget};
+#[cfg(not(target_arch = "wasm32"))]
 pub use context::GpuContext;
 #[cfg(feature = "diagnostics")]
 pub use deferred::EdgeWork;
@@ -51,7 +54,9 @@ pub(crate) use frame::light_world_dir;
 pub(crate) use host_depth::depth_quantum;
 pub use mesh_store::{MeshId, MeshStore};
 pub use options::{OutputTarget, PassOptions, TriangleIds};
-pub use readback::{read_texture, read_texture_async};
+#[cfg(not(target_arch = "wasm32"))]
+pub use readback::read_texture;
+pub use readback::read_texture_async;
 pub use targets::{check_size, texture_2d, BACKGROUND_ID, DEPTH_FORMAT, HOST_ID, ID_FORMAT};
 #[cfg(feature = "diagnostics")]
 pub use targets::{DIAGNOSTIC_FORMAT, RESOLVED_ID_FORMAT};

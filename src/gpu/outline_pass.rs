@@ -64,7 +64,7 @@ impl OutlinePass {
         if let Some(p) = cache.get(&v) {
             return Ok(p.clone());
         }
-        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let scope = crate::gpu::validation::Validation::begin(device);
         let source = shaders::outline_source(&v.flags());
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("wirepass outline pass"),
@@ -96,7 +96,7 @@ impl OutlinePass {
         )?;
         draw_res.push(Res::Cull);
         let draw = Compute::new(device, &module, "outline_main", draw_res, self.format)?;
-        if let Some(e) = pollster::block_on(scope.pop()) {
+        if let Some(e) = scope.end() {
             return Err(Error::Device(format!("building the outline pass: {e}")));
         }
         let p = Arc::new(OutlinePipelines { cull, draw, pieces });

@@ -10,6 +10,7 @@ use std::task::{Context, Poll, Waker};
 /// Reads a whole 2D texture (mip 0, layer 0) into tightly packed rows of
 /// `bytes_per_texel × width` bytes, top row first. It blocks until the GPU is done: for
 /// native tools and tests; [`read_texture_async`] is the one for a browser or an async host.
+#[cfg(not(target_arch = "wasm32"))]
 pub fn read_texture(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
@@ -104,16 +105,16 @@ impl TextureCopy {
     }
 }
 
-/// Reads `size` bytes of `buffer` from `offset` (both multiples of 4), once the work
-/// submitted before has finished.
+/// Copies `size` bytes of `buffer` from `offset` (both multiples of 4) into a mappable
+/// buffer, after the work submitted before.
 #[cfg(feature = "diagnostics")]
-pub(crate) fn read_buffer(
+fn copy_buffer(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     buffer: &wgpu::Buffer,
     offset: u64,
     size: u64,
-) -> Result<Vec<u8>> {
+) -> wgpu::Buffer {
     let staging = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("wirepass readback"),
         size,
@@ -123,11 +124,37 @@ pub(crate) fn read_buffer(
     let mut encoder = device.create_command_encoder(&Default::default());
     encoder.copy_buffer_to_buffer(buffer, offset, &staging, 0, size);
     queue.submit([encoder.finish()]);
-    map_read(device, &staging)
+    staging
+}
+
+/// Reads `size` bytes of `buffer` from `offset` (both multiples of 4), once the work
+/// submitted before has finished.
+#[cfg(all(feature = "diagnostics", not(target_arch = "wasm32")))]
+pub(crate) fn read_buffer(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    buffer: &wgpu::Buffer,
+    offset: u64,
+    size: u64,
+) -> Result<Vec<u8>> {
+    map_read(device, &copy_buffer(device, queue, buffer, offset, size))
+}
+
+/// [`read_buffer`] without blocking.
+#[cfg(feature = "diagnostics")]
+pub(crate) async fn read_buffer_async(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    buffer: &wgpu::Buffer,
+    offset: u64,
+    size: u64,
+) -> Result<Vec<u8>> {
+    map_read_async(device, &copy_buffer(device, queue, buffer, offset, size)).await
 }
 
 /// Maps a MAP_READ buffer, waits for it, and copies it out.
-fn map_read(device: &wgpu::Device, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
+#[cfg(not(target_arch = "wasm32"))]
+pub(crate) fn map_read(device: &wgpu::Device, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
     let (tx, rx) = std::sync::mpsc::channel();
     buffer.map_async(wgpu::MapMode::Read, .., move |r| {
         let _ = tx.send(r);
@@ -148,7 +175,10 @@ fn map_read(device: &wgpu::Device, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
 }
 
 /// The mapped contents of a MAP_READ buffer, once the map completes, without blocking.
-async fn map_read_async(device: &wgpu::Device, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
+pub(crate) async fn map_read_async(
+    device: &wgpu::Device,
+    buffer: &wgpu::Buffer,
+) -> Result<Vec<u8>> {
     let state = Arc::new(Mutex::new(MapState::default()));
     let done = state.clone();
     buffer.map_async(wgpu::MapMode::Read, .., move |r| {

@@ -96,38 +96,34 @@ impl GpuTimer {
 
     /// Waits for the submission and returns each span's name and duration in milliseconds,
     /// in the order the spans were made; the timer is then empty again.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn read(&mut self, device: &wgpu::Device) -> Result<Vec<(&'static str, f64)>> {
-        let n = 2 * self.names.len() as u64;
-        if n == 0 {
+        if self.names.is_empty() {
             return Ok(Vec::new());
         }
-        let slice = self.readback.slice(..n * 8);
-        let (tx, rx) = std::sync::mpsc::channel();
-        slice.map_async(wgpu::MapMode::Read, move |r| {
-            let _ = tx.send(r);
-        });
-        device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| Error::Device(format!("waiting for timestamps: {e}")))?;
-        rx.recv()
-            .map_err(|_| Error::Device("timestamp readback was dropped".into()))?
-            .map_err(|e| Error::Device(format!("mapping timestamps: {e}")))?;
-        let ticks: Vec<u64> = {
-            let view = slice
-                .get_mapped_range()
-                .map_err(|e| Error::Device(format!("reading timestamps: {e}")))?;
-            bytemuck::pod_collect_to_vec(&view)
-        };
-        self.readback.unmap();
-        let spans = self
-            .names
+        let bytes = super::readback::map_read(device, &self.readback)?;
+        Ok(self.spans(&bytes))
+    }
+
+    /// [`read`](Self::read) without blocking, as a browser needs.
+    pub async fn read_async(&mut self, device: &wgpu::Device) -> Result<Vec<(&'static str, f64)>> {
+        if self.names.is_empty() {
+            return Ok(Vec::new());
+        }
+        let bytes = super::readback::map_read_async(device, &self.readback).await?;
+        Ok(self.spans(&bytes))
+    }
+
+    /// The spans from the resolved timestamps' bytes; empties the timer.
+    fn spans(&mut self, bytes: &[u8]) -> Vec<(&'static str, f64)> {
+        let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&bytes[..16 * self.names.len()]);
+        self.names
             .drain(..)
             .enumerate()
             .map(|(i, name)| {
                 let ticks = ticks[2 * i + 1].saturating_sub(ticks[2 * i]);
                 (name, ticks as f64 * self.period_ns * 1e-6)
             })
-            .collect();
-        Ok(spans)
+            .collect()
     }
 }

@@ -88,7 +88,7 @@ impl ForwardPass {
         let format = self.format;
         let source = forward_source(format, split)
             .ok_or_else(|| Error::InvalidSetting(format!("{format:?}")))?;
-        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let scope = crate::gpu::validation::Validation::begin(device);
         let (layout, pipeline_layout) = pipeline_layout(device, "wirepass forward", split)?;
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("wirepass forward"),
@@ -129,7 +129,7 @@ impl ForwardPass {
         };
         let color_only = pipeline("fs_main", false);
         let with_maps = pipeline("fs_maps", true);
-        if let Some(e) = pollster::block_on(scope.pop()) {
+        if let Some(e) = scope.end() {
             return Err(Error::Device(format!("creating the forward pass: {e}")));
         }
         Ok(Pipelines {

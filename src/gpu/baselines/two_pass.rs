@@ -207,7 +207,7 @@ impl TwoPass {
         let format = self.format;
         let source = two_pass_source(format, split)
             .ok_or_else(|| Error::InvalidSetting(format!("{format:?}")))?;
-        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let scope = crate::gpu::validation::Validation::begin(device);
         let (layout, pipeline_layout) = pipeline_layout(device, "wirepass two-pass", split)?;
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("wirepass two-pass"),
@@ -293,7 +293,7 @@ impl TwoPass {
             lines: pipeline(true, false),
             lines_maps: pipeline(true, true),
         };
-        if let Some(e) = pollster::block_on(scope.pop()) {
+        if let Some(e) = scope.end() {
             return Err(Error::Device(format!("creating the two-pass method: {e}")));
         }
         Ok(p)
