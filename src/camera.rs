@@ -103,17 +103,15 @@ impl View {
     /// [`View::orthographic`] with reversed depth (1 at `near`, 0 at `far`), as reverse-Z
     /// hosts draw orthographic views.
     pub fn orthographic_reversed(
-        (eye, target, up): (DVec3, DVec3, DVec3),
+        at: (DVec3, DVec3, DVec3),
         height: f64,
         aspect: f64,
         (near, far): (f64, f64),
     ) -> View {
-        let (h, w) = (0.5 * height, 0.5 * height * aspect);
-        View::new(
-            look_at_mat4(eye, target, up.normalize_or_zero()),
-            proj::orthographic(-w, w, -h, h, far, near),
-            DepthRange::Reversed,
-        )
+        View {
+            depth: DepthRange::Reversed,
+            ..View::orthographic(at, height, aspect, (far, near))
+        }
     }
 
     /// World → clip.

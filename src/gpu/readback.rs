@@ -165,13 +165,7 @@ pub(crate) fn map_read(device: &wgpu::Device, buffer: &wgpu::Buffer) -> Result<V
     rx.recv()
         .map_err(|_| Error::Device("readback was dropped".into()))?
         .map_err(|e| Error::Device(format!("mapping a readback buffer: {e}")))?;
-    let view = buffer
-        .get_mapped_range(..)
-        .map_err(|e| Error::Device(format!("reading a readback buffer: {e}")))?;
-    let out = view.to_vec();
-    drop(view);
-    buffer.unmap();
-    Ok(out)
+    copy_out(buffer)
 }
 
 /// The mapped contents of a MAP_READ buffer, once the map completes, without blocking.
@@ -195,13 +189,7 @@ pub(crate) async fn map_read_async(
     }
     .await
     .map_err(|e| Error::Device(format!("mapping a readback buffer: {e}")))?;
-    let view = buffer
-        .get_mapped_range(..)
-        .map_err(|e| Error::Device(format!("reading a readback buffer: {e}")))?;
-    let out = view.to_vec();
-    drop(view);
-    buffer.unmap();
-    Ok(out)
+    copy_out(buffer)
 }
 
 /// What a buffer's map callback has said, and who waits for it.
@@ -237,4 +225,15 @@ impl Future for MapFuture {
         }
         Poll::Pending
     }
+}
+
+/// The contents of a mapped buffer, which is then unmapped.
+fn copy_out(buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
+    let view = buffer
+        .get_mapped_range(..)
+        .map_err(|e| Error::Device(format!("reading a readback buffer: {e}")))?;
+    let out = view.to_vec();
+    drop(view);
+    buffer.unmap();
+    Ok(out)
 }
