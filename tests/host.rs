@@ -710,6 +710,17 @@ fn texture(
     size: (u32, u32),
     samples: u32,
 ) -> wgpu::Texture {
+    texture_viewed_as(d, (format, &[]), usage, size, samples)
+}
+
+/// [`texture`], whose views may also take the formats `view_formats`.
+fn texture_viewed_as(
+    d: &wgpu::Device,
+    (format, view_formats): (wgpu::TextureFormat, &[wgpu::TextureFormat]),
+    usage: wgpu::TextureUsages,
+    size: (u32, u32),
+    samples: u32,
+) -> wgpu::Texture {
     d.create_texture(&wgpu::TextureDescriptor {
         label: Some("misuse"),
         size: wgpu::Extent3d {
@@ -722,7 +733,7 @@ fn texture(
         dimension: wgpu::TextureDimension::D2,
         format,
         usage,
-        view_formats: &[],
+        view_formats,
     })
 }
 
@@ -945,20 +956,8 @@ fn attachments_that_differ_from_the_render_target_are_misuse() {
     // Views in another format need DownlevelFlags::VIEW_FORMATS, which GL lacks.
     let flags = ctx.adapter.get_downlevel_capabilities().flags;
     if flags.contains(wgpu::DownlevelFlags::VIEW_FORMATS) {
-        let linear = d.create_texture(&wgpu::TextureDescriptor {
-            label: Some("linear colour, sRGB view"),
-            size: wgpu::Extent3d {
-                width: SIZE.0,
-                height: SIZE.1,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 4,
-            dimension: wgpu::TextureDimension::D2,
-            format: F::Rgba8Unorm,
-            usage: u,
-            view_formats: &[F::Rgba8UnormSrgb],
-        });
+        let formats = (F::Rgba8Unorm, &[F::Rgba8UnormSrgb][..]);
+        let linear = texture_viewed_as(d, formats, u, SIZE, 4);
         let srgb_view = linear.create_view(&wgpu::TextureViewDescriptor {
             format: Some(F::Rgba8UnormSrgb),
             ..Default::default()
