@@ -21,12 +21,13 @@ use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, EventLoop, OwnedDisplayHandle};
 use winit::keyboard::{Key, NamedKey};
 use winit::window::{Window, WindowId};
-use wirepass::glam::{DMat4, DVec3, Vec3};
+use wirepass::camera::Orbit;
+use wirepass::glam::DMat4;
 use wirepass::gpu::{
     Composite, DeferredPass, ForwardPass, MeshId, MeshStore, OutputTarget, PassOptions,
     RenderTarget,
 };
-use wirepass::{wgpu, Camera, EdgeSelection, Instance, Mesh, Scene, Style};
+use wirepass::{wgpu, EdgeSelection, Instance, Mesh, Scene, Style};
 
 type AnyError = Box<dyn std::error::Error>;
 
@@ -87,71 +88,6 @@ fn options() -> Result<Options, AnyError> {
         }
     }
     Ok(o)
-}
-
-/// An orbit camera around the mesh's bounding sphere.
-struct Orbit {
-    target: DVec3,
-    radius: f64,
-    distance: f64,
-    yaw: f64,
-    pitch: f64,
-}
-
-impl Orbit {
-    fn new(mesh: &Mesh) -> Orbit {
-        let (lo, hi) = mesh.bounds_f64();
-        let radius = ((hi - lo).length() * 0.5).max(f64::MIN_POSITIVE);
-        Orbit {
-            target: (lo + hi) * 0.5,
-            radius,
-            distance: 2.8 * radius,
-            yaw: 0.5,
-            pitch: 0.35,
-        }
-    }
-
-    fn forward(&self) -> DVec3 {
-        -DVec3::new(
-            self.pitch.cos() * self.yaw.sin(),
-            self.pitch.sin(),
-            self.pitch.cos() * self.yaw.cos(),
-        )
-    }
-
-    /// A perspective camera with an infinite far plane and a near plane just before the
-    /// mesh (or close to the eye once inside it).
-    fn camera(&self) -> Camera {
-        let eye = self.target - self.forward() * self.distance;
-        let near = ((self.distance - self.radius) * 0.5).max(self.distance * 1e-3);
-        Camera {
-            eye: eye.as_vec3(),
-            target: self.target.as_vec3(),
-            up: Vec3::Y,
-            fov_y_deg: 40.0,
-            near: near as f32,
-            far: f32::INFINITY,
-        }
-    }
-
-    fn rotate(&mut self, dx: f64, dy: f64) {
-        self.yaw -= dx * 0.01;
-        self.pitch = (self.pitch + dy * 0.01).clamp(-1.5, 1.5);
-    }
-
-    /// Moves the target in the view plane by a drag of `(dx, dy)` pixels of a window
-    /// `height` pixels tall, so the point under the cursor follows it.
-    fn pan(&mut self, dx: f64, dy: f64, height: f64) {
-        let forward = self.forward();
-        let right = forward.cross(DVec3::Y).normalize();
-        let up = right.cross(forward);
-        let per_pixel = 2.0 * self.distance * (20f64.to_radians()).tan() / height;
-        self.target += (-right * dx + up * dy) * per_pixel;
-    }
-
-    fn zoom(&mut self, steps: f64) {
-        self.distance = (self.distance * 0.9f64.powf(steps)).max(self.radius * 1e-3);
-    }
 }
 
 /// The window's GPU side: the surface, the passes and the mesh in each edge selection.
@@ -260,7 +196,10 @@ impl Viewer {
             meshes: meshes.try_into().expect("one mesh per edge selection"),
             deferred,
             forward,
-            orbit: Orbit::new(mesh),
+            orbit: {
+                let (lo, hi) = mesh.bounds_f64();
+                Orbit::framing(lo, hi)
+            },
             style: Style::default(),
             method: o.method,
             edges: o.edges,

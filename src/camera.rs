@@ -396,6 +396,99 @@ impl Camera {
     }
 }
 
+/// An orbit camera for viewers: it circles a target at a distance, pans in the view plane
+/// and zooms towards the target, with a near plane just before what it frames (or close to
+/// the eye once inside it) and an infinite far plane.
+///
+/// ```
+/// use wirepass::camera::Orbit;
+/// use wirepass::glam::DVec3;
+///
+/// let mut orbit = Orbit::framing(DVec3::splat(-1.0), DVec3::splat(1.0));
+/// orbit.rotate(40.0, 0.0); // a drag of 40 pixels to the right
+/// orbit.zoom(2.0); // two wheel steps closer
+/// let view = orbit.camera().to_view(16.0 / 9.0);
+/// assert!(view.validate().is_ok());
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Orbit {
+    /// The point circled.
+    pub target: DVec3,
+    /// The radius of what is framed: it scales the near plane and the closest zoom.
+    pub radius: f64,
+    /// From the eye to the target.
+    pub distance: f64,
+    /// Turn about the vertical axis, in radians.
+    pub yaw: f64,
+    /// Elevation above the horizontal plane, in radians, within ±1.5.
+    pub pitch: f64,
+}
+
+impl Orbit {
+    /// The vertical field of view of [`camera`](Self::camera), in degrees.
+    pub const FOV_Y_DEG: f64 = 40.0;
+
+    /// Frames the box `lo..hi` (its bounding sphere fills the view), seen a little from
+    /// above and to the side.
+    pub fn framing(lo: DVec3, hi: DVec3) -> Orbit {
+        let radius = ((hi - lo).length() * 0.5).max(f64::MIN_POSITIVE);
+        Orbit {
+            target: (lo + hi) * 0.5,
+            radius,
+            distance: 2.8 * radius,
+            yaw: 0.5,
+            pitch: 0.35,
+        }
+    }
+
+    fn forward(&self) -> DVec3 {
+        -DVec3::new(
+            self.pitch.cos() * self.yaw.sin(),
+            self.pitch.sin(),
+            self.pitch.cos() * self.yaw.cos(),
+        )
+    }
+
+    /// A perspective camera with an infinite far plane and a near plane just before the
+    /// framed sphere (or close to the eye once inside it).
+    pub fn camera(&self) -> Camera {
+        let eye = self.target - self.forward() * self.distance;
+        let near = ((self.distance - self.radius) * 0.5).max(self.distance * 1e-3);
+        Camera {
+            eye: eye.as_vec3(),
+            target: self.target.as_vec3(),
+            up: Vec3::Y,
+            fov_y_deg: Self::FOV_Y_DEG as f32,
+            near: near as f32,
+            far: f32::INFINITY,
+        }
+    }
+
+    /// Turns by a drag of `(dx, dy)` pixels: right turns the view to the left of the
+    /// object, down raises the eye.
+    pub fn rotate(&mut self, dx: f64, dy: f64) {
+        self.yaw -= dx * 0.01;
+        self.pitch = (self.pitch + dy * 0.01).clamp(-1.5, 1.5);
+    }
+
+    /// Moves the target in the view plane by a drag of `(dx, dy)` pixels of a view
+    /// `height` pixels tall, so the point under the cursor follows it.
+    pub fn pan(&mut self, dx: f64, dy: f64, height: f64) {
+        let forward = self.forward();
+        let right = forward.cross(DVec3::Y).normalize();
+        let up = right.cross(forward);
+        let per_pixel =
+            2.0 * self.distance * (0.5 * Self::FOV_Y_DEG).to_radians().tan() / height.max(1.0);
+        self.target += (-right * dx + up * dy) * per_pixel;
+    }
+
+    /// Moves `steps` wheel steps towards the target (away for negative steps), each 10 %
+    /// of the distance; never past a thousandth of the radius.
+    pub fn zoom(&mut self, steps: f64) {
+        self.distance = (self.distance * 0.9f64.powf(steps)).max(self.radius * 1e-3);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -14,6 +14,9 @@ use crate::style::Style;
 use glam::{DMat4, DVec3};
 use std::sync::Arc;
 
+#[cfg(feature = "diagnostics")]
+pub mod offscreen;
+
 /// Id of pixels that show no triangle (the id target's [`crate::gpu::BACKGROUND_ID`]).
 pub const BACKGROUND: u32 = crate::gpu::BACKGROUND_ID;
 /// Id of pixels where the host's own geometry is in front ([`crate::gpu::HOST_ID`]).

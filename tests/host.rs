@@ -174,7 +174,7 @@ fn host_case(
         style: &style,
         size: SIZE,
     };
-    let up = Uploaded::new(ctx, &f.wire).unwrap();
+    let up = Uploaded::new(&ctx.device, &ctx.queue, &f.wire).unwrap();
     let pass = DeferredPass::new(&ctx.device, PassOptions::default())
         .unwrap()
         .with_diagnostics();
@@ -654,7 +654,7 @@ fn shaded_composite_keeps_the_host_image_where_no_instance_shows() {
         style: &style,
         size: SIZE,
     };
-    let up = Uploaded::new(device(), &f.wire).unwrap();
+    let up = Uploaded::new(&device().device, &device().queue, &f.wire).unwrap();
     let pass = DeferredPass::new(&device().device, PassOptions::default())
         .unwrap()
         .with_diagnostics();

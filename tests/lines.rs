@@ -417,7 +417,8 @@ fn tiles_stitch_into_the_whole_image() {
             style: &style,
             size,
         };
-        let up = Uploaded::new(common::gpu(), &world).unwrap_or_else(|e| panic!("{e}"));
+        let up = Uploaded::new(&common::gpu().device, &common::gpu().queue, &world)
+            .unwrap_or_else(|e| panic!("{e}"));
         let whole = render_window(&shot, &up, Region::whole(size));
         let (cx, cy) = (137, 101);
         for (x0, w) in [(0, cx), (cx, size.0 - cx)] {
@@ -509,7 +510,8 @@ fn set_edges_redraws_a_stored_mesh_as_a_fresh_upload_would() {
     let view = camera.to_view(f64::from(size.0) / f64::from(size.1));
     let ctx = common::gpu();
     let all = World::single(mesh.clone(), EdgeSelection::All);
-    let mut switched = Uploaded::new(ctx, &all).unwrap_or_else(|e| panic!("{e}"));
+    let mut switched =
+        Uploaded::new(&ctx.device, &ctx.queue, &all).unwrap_or_else(|e| panic!("{e}"));
     for edges in [EdgeSelection::Polygon, EdgeSelection::Feature(30.0)] {
         let world = World::single(mesh.clone(), edges);
         let shot = Shot {
@@ -523,7 +525,8 @@ fn set_edges_redraws_a_stored_mesh_as_a_fresh_upload_would() {
             .store
             .set_edges(&ctx.queue, id, &mesh, edges)
             .unwrap_or_else(|e| panic!("{e}"));
-        let fresh = Uploaded::new(ctx, &world).unwrap_or_else(|e| panic!("{e}"));
+        let fresh =
+            Uploaded::new(&ctx.device, &ctx.queue, &world).unwrap_or_else(|e| panic!("{e}"));
         let a = render_window(&shot, &switched, Region::whole(size));
         let b = render_window(&shot, &fresh, Region::whole(size));
         assert_eq!(a.ids, b.ids, "{edges:?}");

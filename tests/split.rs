@@ -224,7 +224,7 @@ fn outline_pieces_past_the_list_s_room_are_drawn_where_they_are_found() {
         size,
     };
     // What the outline pass listed on the small device, and its room.
-    let up = Uploaded::new(&small, &world).unwrap();
+    let up = Uploaded::new(&small.device, &small.queue, &world).unwrap();
     let mut pass = DeferredPass::new(&small.device, PassOptions::default()).unwrap();
     let frame = pass
         .prepare(

@@ -314,8 +314,8 @@ pub fn bench_scene(
     let device = &ctx.device;
     let queue = &ctx.queue;
     let size = shot.size;
-    let up = Uploaded::new(ctx, shot.world)?;
-    let lines = up.edge_lines(ctx, shot.world)?;
+    let up = Uploaded::new(&ctx.device, &ctx.queue, shot.world)?;
+    let lines = up.edge_lines(&ctx.device, shot.world)?;
     let scene = up.scene(shot.world, shot.view);
     let storage = || {
         // RENDER_ATTACHMENT: the edge pass clears the background instead of writing it.
@@ -353,7 +353,7 @@ pub fn bench_scene(
             m.mesh = Arc::new(mesh);
             m.edges = e;
         }
-        let up = Box::new(Uploaded::new(ctx, &world)?);
+        let up = Box::new(Uploaded::new(&ctx.device, &ctx.queue, &world)?);
         let scene = up.scene(&world, shot.view);
         let mut pass = DeferredPass::new(device, PassOptions::default())?;
         let frame = pass.prepare(device, &up.store, &scene, shot.style, size)?;

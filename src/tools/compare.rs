@@ -8,33 +8,18 @@ use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
 use crate::tools::offline::{draw, Method};
 use crate::tools::regression;
+use crate::truth::accuracy::{distance_error, id_agreement, percentile};
 use crate::truth::draw_raycast;
-use crate::world::{Rendering, Shot, BACKGROUND};
+use crate::world::{Rendering, Shot};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::time::Instant;
 
-/// Background id.
-/// Edge distances are compared only where the true distance is below this many pixels:
-/// that is where a line can be drawn, and where the distance matters.
-pub const DISTANCE_RANGE_PX: f64 = 4.0;
+pub use crate::truth::accuracy::{distance_errors, DistanceError, DISTANCE_RANGE_PX};
+
 /// The distance-error heat map spans 10^MIN .. 10^MAX pixels, on a log scale.
 const HEAT_LOG10: (f64, f64) = (-6.0, 0.0);
-
-/// Edge-distance error in pixels: over pixels whose ids agree with the ground truth and whose
-/// true distance is finite and under [`DISTANCE_RANGE_PX`]. `None` when no pixel qualifies.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
-pub struct DistanceError {
-    /// Mean absolute error.
-    pub mean: Option<f64>,
-    /// 99th percentile (nearest rank) of the absolute error.
-    pub p99: Option<f64>,
-    /// Largest absolute error (`inf` where a method reports no edge where there is one).
-    pub max: Option<f64>,
-    /// Number of pixels measured.
-    pub pixels: usize,
-}
 
 /// Perceptual image difference (NVIDIA FLIP, LDR, default viewing distance), 0..1.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
@@ -59,45 +44,10 @@ pub struct Metrics {
     pub image_difference: ImageDifference,
 }
 
-/// Checks that two frames can be compared pixel for pixel.
-fn check_same_shape(reference: &Rendering, frame: &Rendering) -> Result<()> {
-    let n = reference.size.0 as usize * reference.size.1 as usize;
-    let whole = |f: &Rendering| {
-        f.ids.len() == n
-            && f.edge_distance.len() == n
-            && f.depth.len() == n
-            && f.rgba.len() == 4 * n
-    };
-    if reference.size != frame.size || !whole(reference) || !whole(frame) {
-        return Err(Error::InvalidSetting(format!(
-            "cannot compare a {}x{} frame with a {}x{} one (or a frame's maps are incomplete)",
-            reference.size.0, reference.size.1, frame.size.0, frame.size.1
-        )));
-    }
-    Ok(())
-}
-
 /// Compares `frame` against `reference` (the ground truth); an error if their sizes differ.
 pub fn metrics(reference: &Rendering, frame: &Rendering) -> Result<Metrics> {
-    let errors = distance_errors(reference, frame)?;
-    let mut measured: Vec<f64> = errors.iter().flatten().copied().collect();
-    measured.sort_by(f64::total_cmp);
-    let distance_error_px = DistanceError {
-        mean: (!measured.is_empty()).then(|| measured.iter().sum::<f64>() / measured.len() as f64),
-        p99: percentile(&measured, 0.99),
-        max: measured.last().copied(),
-        pixels: measured.len(),
-    };
-    let n = reference.ids.len();
-    let (mut either, mut same_id, mut same_cover) = (0usize, 0usize, 0usize);
-    for (&a, &b) in reference.ids.iter().zip(&frame.ids) {
-        let (fa, fb) = (a != BACKGROUND, b != BACKGROUND);
-        same_cover += usize::from(fa == fb);
-        if fa || fb {
-            either += 1;
-            same_id += usize::from(a == b);
-        }
-    }
+    let distance_error_px = distance_error(reference, frame)?;
+    let (id_agreement, coverage_agreement) = id_agreement(reference, frame)?;
     let mut flip: Vec<f64> = flip_map(reference, frame)?
         .into_iter()
         .map(f64::from)
@@ -105,48 +55,14 @@ pub fn metrics(reference: &Rendering, frame: &Rendering) -> Result<Metrics> {
     let flip_mean = flip.iter().sum::<f64>() / flip.len().max(1) as f64;
     flip.sort_by(f64::total_cmp);
     Ok(Metrics {
-        id_agreement: if either == 0 {
-            1.0
-        } else {
-            same_id as f64 / either as f64
-        },
-        coverage_agreement: same_cover as f64 / n.max(1) as f64,
+        id_agreement,
+        coverage_agreement,
         distance_error_px,
         image_difference: ImageDifference {
             flip_mean,
             flip_p99: percentile(&flip, 0.99).unwrap_or(0.0),
         },
     })
-}
-
-/// Nearest-rank percentile of sorted values.
-fn percentile(sorted: &[f64], q: f64) -> Option<f64> {
-    if sorted.is_empty() {
-        return None;
-    }
-    let rank = (q * sorted.len() as f64).ceil() as usize;
-    Some(sorted[rank.clamp(1, sorted.len()) - 1])
-}
-
-/// Per pixel, `|d − d_true|` where it is measured (ids agree, background included, which
-/// outlines reach; true distance finite and under [`DISTANCE_RANGE_PX`]), `None` elsewhere.
-pub fn distance_errors(reference: &Rendering, frame: &Rendering) -> Result<Vec<Option<f64>>> {
-    check_same_shape(reference, frame)?;
-    Ok((0..reference.ids.len())
-        .map(|i| {
-            let id = reference.ids[i];
-            let truth = f64::from(reference.edge_distance[i]);
-            let measured = frame.ids[i] == id && truth.is_finite() && truth < DISTANCE_RANGE_PX;
-            measured.then(|| {
-                let d = f64::from(frame.edge_distance[i]);
-                if d.is_finite() {
-                    (d - truth).abs()
-                } else {
-                    f64::INFINITY
-                }
-            })
-        })
-        .collect())
 }
 
 fn rgba(frame: &Rendering) -> regression::Rgba<'_> {
@@ -554,7 +470,7 @@ mod tests {
     #[test]
     fn metrics_count_the_right_pixels() {
         let inf = f32::INFINITY;
-        let bg = BACKGROUND;
+        let bg = crate::world::BACKGROUND;
         let reference = frame(
             vec![1, 1, 2, 2, bg, bg, 3, 3],
             vec![0.5, 3.0, 5.0, 1.0, inf, inf, inf, 2.0],

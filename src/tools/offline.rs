@@ -4,75 +4,13 @@
 use crate::camera::View;
 use crate::error::{Error, Result};
 use crate::gpu::{
-    read_texture, texture_2d, Canvas, DeferredPass, EdgeLines, EncodeOptions, ForwardPass,
-    GpuContext, MeshId, MeshStore, OutputTarget, PassOptions, TwoPass,
+    texture_2d, Canvas, DeferredPass, EncodeOptions, ForwardPass, GpuContext, PassOptions, TwoPass,
 };
-use crate::scene::{Instance, Scene};
-use crate::world::{Rendering, Shot, World, BACKGROUND, HOST};
+use crate::world::offscreen;
+use crate::world::{Rendering, Shot};
 use std::path::Path;
 
-/// A world uploaded to the GPU: its meshes in one store.
-pub struct Uploaded {
-    /// The store.
-    pub store: MeshStore,
-    /// The store's id of each world mesh.
-    pub ids: Vec<MeshId>,
-}
-
-impl Uploaded {
-    /// Uploads every mesh of `world` once.
-    pub fn new(ctx: &GpuContext, world: &World) -> Result<Uploaded> {
-        world.validate()?;
-        let mut store = MeshStore::new(&ctx.device);
-        let ids = world
-            .meshes
-            .iter()
-            .map(|m| store.insert(&ctx.device, &ctx.queue, &m.mesh, m.edges))
-            .collect::<Result<_>>()?;
-        Ok(Uploaded { store, ids })
-    }
-
-    /// The world's objects as a scene of instances seen through `view`.
-    pub fn scene(&self, world: &World, view: View) -> Scene<'static> {
-        let instances = world
-            .objects
-            .iter()
-            .map(|o| Instance {
-                mesh: self.ids[o.mesh],
-                transform: o.transform,
-                style: o.style,
-            })
-            .collect();
-        Scene::new(view, instances)
-    }
-
-    /// The two-pass method's edge lists of every mesh.
-    pub fn edge_lines(&self, ctx: &GpuContext, world: &World) -> Result<EdgeLines> {
-        let mut lines = EdgeLines::new();
-        for (m, &id) in world.meshes.iter().zip(&self.ids) {
-            lines.insert(&ctx.device, &self.store, id, &m.mesh, m.edges)?;
-        }
-        Ok(lines)
-    }
-
-    /// Global ids of a map of (instance slot, stored triangle) pairs, with `order` mapping
-    /// slots to objects.
-    pub fn global_ids(&self, world: &World, order: &[u32], raw: &[[u32; 2]]) -> Result<Vec<u32>> {
-        let first = world.first_ids();
-        raw.iter()
-            .map(|&[slot, tri]| {
-                if slot == BACKGROUND || slot == HOST {
-                    return Ok(slot);
-                }
-                let object = *order.get(slot as usize).ok_or_else(|| {
-                    Error::Device(format!("the id map holds instance slot {slot}"))
-                })? as usize;
-                let mesh = self.ids[world.objects[object].mesh];
-                Ok(first[object] + self.store.file_triangle(mesh, tri)?)
-            })
-            .collect()
-    }
-}
+pub use crate::world::offscreen::Uploaded;
 
 /// A way of drawing the wireframe.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -134,7 +72,7 @@ pub fn draw(ctx: &GpuContext, shot: &Shot<'_>, method: Method) -> Result<Renderi
 
 /// Renders `shot` with the deferred pass and reads back the image and all maps.
 pub fn draw_deferred(ctx: &GpuContext, shot: &Shot<'_>) -> Result<Rendering> {
-    let up = Uploaded::new(ctx, shot.world)?;
+    let up = Uploaded::new(&ctx.device, &ctx.queue, shot.world)?;
     let pass = DeferredPass::new(&ctx.device, PassOptions::default())?.with_diagnostics();
     draw_deferred_with(ctx, shot, &up, pass)
 }
@@ -160,99 +98,30 @@ pub fn draw_deferred_on(
     mut pass: DeferredPass,
     canvas: Canvas<'_>,
 ) -> Result<Rendering> {
-    let device = &ctx.device;
-    let region = canvas.region;
-    if region.image != shot.size {
-        return Err(Error::Misuse(format!(
-            "the canvas is {region:?}, a region of another image than the shot's {}x{}",
-            shot.size.0, shot.size.1
-        )));
-    }
-    let scene = up.scene(shot.world, shot.view);
-    let frame = pass.prepare(device, &up.store, &scene, shot.style, canvas)?;
-    // RENDER_ATTACHMENT: the edge pass clears the background instead of writing it.
-    let usage = wgpu::TextureUsages::STORAGE_BINDING
-        | wgpu::TextureUsages::COPY_SRC
-        | wgpu::TextureUsages::RENDER_ATTACHMENT;
-    let output = texture_2d(
-        device,
-        "wirepass output",
-        region.size,
-        pass.output_format(),
-        usage,
-    );
-    let view = output.create_view(&Default::default());
-    let mut encoder = device.create_command_encoder(&Default::default());
-    pass.encode(
-        device,
-        &mut encoder,
-        &up.store,
-        &frame,
-        OutputTarget::Shaded(&view),
-    )?;
-    pass.encode_with(
-        device,
-        &mut encoder,
-        &up.store,
-        &frame,
-        OutputTarget::Diagnostic,
-        EncodeOptions {
-            reuse_ids: true,
-            ..Default::default()
-        },
-    )?;
-    ctx.queue.submit([encoder.finish()]);
+    let (device, queue) = (&ctx.device, &ctx.queue);
+    let drawn = pollster::block_on(offscreen::draw_deferred(
+        device, queue, shot, up, &mut pass, canvas,
+    ));
+    // A device error makes whatever was read back meaningless: it comes first.
     ctx.finish()?;
-    let missing = || Error::Device("the frame has no diagnostic maps".into());
-    let maps = (
-        frame.resolved_id_texture().ok_or_else(missing)?,
-        frame.diagnostic_texture().ok_or_else(missing)?,
-    );
-    let out = (region.size, up);
-    read_frame(ctx, shot, out, frame.instance_order(), &output, maps)
+    drawn
 }
 
-/// Reads a rendered frame back: the 8-bit output, the `Rg32Uint` (slot, triangle) ids and
-/// the diagnostic map, four f32 per pixel (`Rgba32Float`, or their bits in `Rgba32Uint` for
-/// the forward passes; r = distance in pixels, ≥ 1e38 meaning none; g = reverse depth),
-/// converted to [`Rendering`]'s conventions.
+/// Reads back a baseline's frame ([`offscreen::read_rendering`]), then checks the device.
 fn read_frame(
     ctx: &GpuContext,
     shot: &Shot<'_>,
-    (size, up): ((u32, u32), &Uploaded),
+    out: ((u32, u32), &Uploaded),
     order: &[u32],
     output: &wgpu::Texture,
-    (ids, diagnostic): (&wgpu::Texture, &wgpu::Texture),
+    maps: (&wgpu::Texture, &wgpu::Texture),
 ) -> Result<Rendering> {
-    let device = &ctx.device;
-    let all = wgpu::TextureAspect::All;
-    let rgba = read_texture(device, &ctx.queue, output, all)?;
-    let ids = read_texture(device, &ctx.queue, ids, all)?;
-    let diagnostic = read_texture(device, &ctx.queue, diagnostic, all)?;
+    let (device, queue) = (&ctx.device, &ctx.queue);
+    let read = pollster::block_on(offscreen::read_rendering(
+        device, queue, shot, out, order, output, maps,
+    ));
     ctx.finish()?;
-    let diagnostic: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&diagnostic);
-    // (slot, triangle) pairs, from an Rg32Uint map or the first two channels of an
-    // Rgba32Uint one.
-    let per_pixel = ids.len() / diagnostic.len().max(1);
-    let words: Vec<u32> = bytemuck::pod_collect_to_vec(&ids);
-    let raw: Vec<[u32; 2]> = words
-        .chunks_exact(per_pixel / 4)
-        .map(|w| [w[0], w[1]])
-        .collect();
-    Ok(Rendering {
-        size,
-        rgba,
-        ids: up.global_ids(shot.world, order, &raw)?,
-        // Reverse depth back to the standard convention.
-        depth: diagnostic
-            .iter()
-            .map(|t| (1.0 - f64::from(t[1])) as f32)
-            .collect(),
-        edge_distance: diagnostic
-            .iter()
-            .map(|t| if t[0] >= 1e38 { f32::INFINITY } else { t[0] })
-            .collect(),
-    })
+    read
 }
 
 /// The forward baselines render to an sRGB render attachment: the hardware blends in linear
@@ -268,7 +137,7 @@ fn forward_output(device: &wgpu::Device, size: (u32, u32)) -> wgpu::Texture {
 /// Its distance map is the interpolated altitudes' minimum (NaN where the method gives NaN).
 pub fn draw_forward(ctx: &GpuContext, shot: &Shot<'_>) -> Result<Rendering> {
     let device = &ctx.device;
-    let up = Uploaded::new(ctx, shot.world)?;
+    let up = Uploaded::new(&ctx.device, &ctx.queue, shot.world)?;
     let mut pass = ForwardPass::new(device, FORWARD_OUTPUT)?;
     let scene = up.scene(shot.world, shot.view);
     let frame = pass.prepare(device, &up.store, &scene, shot.style, shot.size)?;
@@ -303,8 +172,8 @@ pub fn draw_forward(ctx: &GpuContext, shot: &Shot<'_>) -> Result<Rendering> {
 /// no distance: its `edge_distance` is 0 where a line was drawn and `inf` elsewhere.
 pub fn draw_two_pass(ctx: &GpuContext, shot: &Shot<'_>) -> Result<Rendering> {
     let device = &ctx.device;
-    let up = Uploaded::new(ctx, shot.world)?;
-    let lines = up.edge_lines(ctx, shot.world)?;
+    let up = Uploaded::new(&ctx.device, &ctx.queue, shot.world)?;
+    let lines = up.edge_lines(&ctx.device, shot.world)?;
     let mut pass = TwoPass::new(device, FORWARD_OUTPUT)?;
     let scene = up.scene(shot.world, shot.view);
     let frame = pass.prepare(device, &up.store, &scene, shot.style, shot.size)?;

@@ -7,6 +7,7 @@
 //! It uses the core (meshes, camera, style, edge math) and [`crate::world`]; nothing below
 //! it uses it.
 
+pub mod accuracy;
 pub mod outline;
 pub mod raycast;
 pub mod rays;

@@ -144,6 +144,7 @@ pub fn draw_raycast_over(shot: &Shot<'_>, host: Option<&HostOccluders<'_>>) -> R
 }
 
 /// A progress bar on stderr when it is a terminal and the job is more than a moment.
+#[cfg(not(target_arch = "wasm32"))]
 fn progress_bar(rows: u64, pixels: u64) -> indicatif::ProgressBar {
     use std::io::IsTerminal;
     if pixels < 250_000 || !std::io::stderr().is_terminal() {
@@ -156,6 +157,21 @@ fn progress_bar(rows: u64, pixels: u64) -> indicatif::ProgressBar {
         bar.set_style(style);
     }
     bar
+}
+
+/// A browser has no terminal (and no clock `indicatif` could read): no progress bar.
+#[cfg(target_arch = "wasm32")]
+fn progress_bar(_rows: u64, _pixels: u64) -> NoProgress {
+    NoProgress
+}
+
+#[cfg(target_arch = "wasm32")]
+struct NoProgress;
+
+#[cfg(target_arch = "wasm32")]
+impl NoProgress {
+    fn inc(&self, _: u64) {}
+    fn finish_and_clear(&self) {}
 }
 
 /// The frame's shading inputs in f64, as the GPU's `Frame` uniforms carry them.

@@ -86,11 +86,7 @@ impl<'a> RayCaster<'a> {
                 Aabb::new(to_vec3a(lo), to_vec3a(hi))
             })
             .collect();
-        let bvh = obvhs::bvh2::builder::build_bvh2(
-            &boxes,
-            obvhs::BvhBuildParams::medium_build(),
-            &mut std::time::Duration::default(),
-        );
+        let bvh = build_bvh(&boxes);
         Self {
             world,
             first_ids,
@@ -317,6 +313,33 @@ impl ObjectStyle {
             })
             .collect()
     }
+}
+
+/// `obvhs::bvh2::builder::build_bvh2` with its medium preset, step for step, without the
+/// build timer it reads from the system clock, which a browser's wasm32 has not.
+fn build_bvh(boxes: &[Aabb]) -> Bvh2 {
+    use obvhs::bvh2::{leaf_collapser::collapse, reinsertion::ReinsertionOptimizer};
+    let config = obvhs::BvhBuildParams::medium_build();
+    let mut bvh = obvhs::ploc::PlocBuilder::with_capacity(boxes.len()).build(
+        config.ploc_search_distance,
+        boxes,
+        (0..boxes.len() as u32).collect::<Vec<_>>(),
+        config.sort_precision,
+        config.search_depth_threshold,
+    );
+    let mut reinsertion = ReinsertionOptimizer::default();
+    reinsertion.run(&mut bvh, config.reinsertion_batch_ratio, None);
+    collapse(
+        &mut bvh,
+        config.max_prims_per_leaf.clamp(1, 255),
+        config.collapse_traversal_cost,
+    );
+    reinsertion.run(
+        &mut bvh,
+        config.reinsertion_batch_ratio * config.post_collapse_reinsertion_batch_ratio_multiplier,
+        None,
+    );
+    bvh
 }
 
 /// Geometry the host draws itself, not wireframed, as its depth buffer shows it to the pass:

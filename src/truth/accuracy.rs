@@ -1,0 +1,112 @@
+//! How closely a frame matches the ground truth, pixel by pixel: triangle-id agreement and
+//! edge-distance error. The `compare` tool, the tests and the browser tests all measure
+//! with these.
+
+use crate::error::{Error, Result};
+use crate::world::{Rendering, BACKGROUND};
+
+/// Edge distances are compared only where the true distance is below this many pixels:
+/// that is where a line can be drawn, and where the distance matters.
+pub const DISTANCE_RANGE_PX: f64 = 4.0;
+
+/// Edge-distance error in pixels: over pixels whose ids agree with the ground truth and whose
+/// true distance is finite and under [`DISTANCE_RANGE_PX`]. `None` when no pixel qualifies.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "tools", derive(serde::Serialize))]
+pub struct DistanceError {
+    /// Mean absolute error.
+    pub mean: Option<f64>,
+    /// 99th percentile (nearest rank) of the absolute error.
+    pub p99: Option<f64>,
+    /// Largest absolute error (`inf` where a method reports no edge where there is one).
+    pub max: Option<f64>,
+    /// Number of pixels measured.
+    pub pixels: usize,
+}
+
+/// Checks that two frames can be compared pixel for pixel.
+fn check_same_shape(reference: &Rendering, frame: &Rendering) -> Result<()> {
+    let n = reference.size.0 as usize * reference.size.1 as usize;
+    let whole = |f: &Rendering| {
+        f.ids.len() == n
+            && f.edge_distance.len() == n
+            && f.depth.len() == n
+            && f.rgba.len() == 4 * n
+    };
+    if reference.size != frame.size || !whole(reference) || !whole(frame) {
+        return Err(Error::InvalidSetting(format!(
+            "cannot compare a {}x{} frame with a {}x{} one (or a frame's maps are incomplete)",
+            reference.size.0, reference.size.1, frame.size.0, frame.size.1
+        )));
+    }
+    Ok(())
+}
+
+/// `(id agreement, coverage agreement)` of `frame` against `reference`: among pixels where
+/// either side is foreground, the fraction whose id equals the reference's (1 when neither
+/// has any foreground); and the fraction of all pixels where both agree on foreground versus
+/// background. An error if their sizes differ.
+pub fn id_agreement(reference: &Rendering, frame: &Rendering) -> Result<(f64, f64)> {
+    check_same_shape(reference, frame)?;
+    let n = reference.ids.len();
+    let (mut either, mut same_id, mut same_cover) = (0usize, 0usize, 0usize);
+    for (&a, &b) in reference.ids.iter().zip(&frame.ids) {
+        let (fa, fb) = (a != BACKGROUND, b != BACKGROUND);
+        same_cover += usize::from(fa == fb);
+        if fa || fb {
+            either += 1;
+            same_id += usize::from(a == b);
+        }
+    }
+    let ids = if either == 0 {
+        1.0
+    } else {
+        same_id as f64 / either as f64
+    };
+    Ok((ids, same_cover as f64 / n.max(1) as f64))
+}
+
+/// The [`DistanceError`] of `frame` against `reference`; an error if their sizes differ.
+pub fn distance_error(reference: &Rendering, frame: &Rendering) -> Result<DistanceError> {
+    let mut measured: Vec<f64> = distance_errors(reference, frame)?
+        .into_iter()
+        .flatten()
+        .collect();
+    measured.sort_by(f64::total_cmp);
+    Ok(DistanceError {
+        mean: (!measured.is_empty()).then(|| measured.iter().sum::<f64>() / measured.len() as f64),
+        p99: percentile(&measured, 0.99),
+        max: measured.last().copied(),
+        pixels: measured.len(),
+    })
+}
+
+/// Nearest-rank percentile of sorted values.
+pub fn percentile(sorted: &[f64], q: f64) -> Option<f64> {
+    if sorted.is_empty() {
+        return None;
+    }
+    let rank = (q * sorted.len() as f64).ceil() as usize;
+    Some(sorted[rank.clamp(1, sorted.len()) - 1])
+}
+
+/// Per pixel, `|d − d_true|` where it is measured (ids agree, background included, which
+/// outlines reach; true distance finite and under [`DISTANCE_RANGE_PX`]), `None` elsewhere.
+pub fn distance_errors(reference: &Rendering, frame: &Rendering) -> Result<Vec<Option<f64>>> {
+    check_same_shape(reference, frame)?;
+    Ok((0..reference.ids.len())
+        .map(|i| {
+            let id = reference.ids[i];
+            let truth = f64::from(reference.edge_distance[i]);
+            let measured = frame.ids[i] == id && truth.is_finite() && truth < DISTANCE_RANGE_PX;
+            measured.then(|| {
+                let d = f64::from(frame.edge_distance[i]);
+                if d.is_finite() {
+                    (d - truth).abs()
+                } else {
+                    f64::INFINITY
+                }
+            })
+        })
+        .collect())
+}
