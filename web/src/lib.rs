@@ -1,0 +1,621 @@
+//! The wirepass viewer page: the built-in scene, or a mesh file dropped on the page or
+//! opened with its picker (`.glb`, `.gltf` with embedded buffers, `.obj`, `.stl`, `.ply`),
+//! drawn by the deferred pass straight into a WebGPU canvas. Mouse and touch: drag orbits,
+//! right or middle drag (or shift-drag, or two fingers) pans, the wheel (or a pinch) zooms.
+//! Keys: `E` cycles the edges, `O` toggles outlines, `+`/`-` change the line width.
+//!
+//! `?adapter=high-performance|low-power|fallback` asks the browser for another adapter.
+//! [`Viewer`] is what the page's script gets from [`start`]; its `snapshot` and `model_name`
+//! are the hooks the browser tests read the page through.
+#![cfg(target_arch = "wasm32")]
+
+mod gpu;
+mod model;
+
+use gpu::{Gpu, EDGES};
+use model::Model;
+use std::cell::RefCell;
+use std::rc::Rc;
+use wasm_bindgen::prelude::*;
+use wasm_bindgen::JsCast;
+use web_sys::{HtmlCanvasElement, HtmlElement, HtmlInputElement, HtmlSelectElement};
+use wirepass::camera::Orbit;
+use wirepass::{wgpu, Style};
+
+/// The page's state: what is shown, how, and the pointers on the canvas.
+struct App {
+    gpu: Gpu,
+    canvas: HtmlCanvasElement,
+    status: HtmlElement,
+    model: Model,
+    orbit: Orbit,
+    style: Style,
+    edges: usize,
+    /// Pointers down on the canvas: id, position, button.
+    pointers: Vec<(i32, f64, f64, i16)>,
+    /// A frame is requested and not drawn yet.
+    pending: bool,
+    frames: u32,
+    /// The last error shown on the page.
+    error: Option<String>,
+}
+
+type Shared = Rc<RefCell<App>>;
+
+/// The viewer a page started: the hooks its script (and the browser tests) use.
+#[wasm_bindgen]
+pub struct Viewer {
+    app: Shared,
+}
+
+/// Builds the viewer inside `root`: controls, a canvas filling the rest, the built-in
+/// scene. Where the browser has no WebGPU, or gives no adapter, it says so in `root` and
+/// the promise rejects with the same message.
+#[wasm_bindgen]
+pub async fn start(root: HtmlElement) -> Result<Viewer, JsValue> {
+    console_error_panic_hook::set_once();
+    match App::new(&root).await {
+        Ok(app) => {
+            let app = Rc::new(RefCell::new(app));
+            wire_events(&app, &root)?;
+            schedule(&app);
+            Ok(Viewer { app })
+        }
+        Err(message) => {
+            let p = document()?.create_element("p")?;
+            p.set_class_name("wirepass-error");
+            p.set_text_content(Some(&message));
+            root.replace_children_with_node_1(&p);
+            Err(JsValue::from_str(&message))
+        }
+    }
+}
+
+#[wasm_bindgen]
+impl Viewer {
+    /// The current view drawn again into a texture of the canvas's size and format and read
+    /// back: RGBA8, sRGB, row 0 at the top (`width × height × 4` bytes).
+    pub async fn snapshot(&self) -> Result<Vec<u8>, JsValue> {
+        let read = {
+            let mut app = self.app.borrow_mut();
+            let app = &mut *app;
+            let texture = app.gpu.offscreen(app.gpu.size());
+            app.gpu
+                .record(&texture, &app.model, &app.orbit, &app.style)
+                .map_err(JsValue::from)?;
+            app.gpu.read(&texture)
+        };
+        read.await.map_err(|e| {
+            // What the device reported says why a readback failed.
+            let mut all = self.app.borrow().gpu.take_errors();
+            all.insert(0, e);
+            JsValue::from(all.join("; "))
+        })
+    }
+
+    /// The canvas's width in pixels.
+    pub fn width(&self) -> u32 {
+        self.app.borrow().gpu.size().0
+    }
+
+    /// The canvas's height in pixels.
+    pub fn height(&self) -> u32 {
+        self.app.borrow().gpu.size().1
+    }
+
+    /// The name of what is shown: a file's name or "the built-in scene".
+    pub fn model_name(&self) -> String {
+        self.app.borrow().model.name.clone()
+    }
+
+    /// Frames drawn into the canvas so far.
+    pub fn frames(&self) -> u32 {
+        self.app.borrow().frames
+    }
+
+    /// The last error the page showed (a file that could not be read, a device error).
+    pub fn error(&self) -> Option<String> {
+        self.app.borrow().error.clone()
+    }
+
+    /// The adapter the page runs on, as the browser names it.
+    pub fn adapter(&self) -> String {
+        self.app.borrow().gpu.adapter.clone()
+    }
+
+    /// Shows a mesh file from its bytes, as a dropped file is shown.
+    pub async fn load(&self, name: String, bytes: Vec<u8>) -> Result<(), JsValue> {
+        show_file(&self.app, &name, &bytes).map_err(JsValue::from)
+    }
+
+    /// Shows the built-in scene again.
+    pub fn load_builtin(&self) -> Result<(), JsValue> {
+        let model = Model::builtin().map_err(|e| JsValue::from_str(&e.to_string()))?;
+        show(&self.app, Ok(model)).map_err(JsValue::from)
+    }
+}
+
+impl App {
+    async fn new(root: &HtmlElement) -> Result<App, String> {
+        let js = |e: JsValue| format!("{e:?}");
+        let window = web_sys::window().ok_or("no window")?;
+        let gpu_object = js_sys::Reflect::get(&window.navigator(), &"gpu".into()).map_err(js)?;
+        if gpu_object.is_undefined() {
+            return Err(
+                "This browser has no WebGPU (navigator.gpu is missing), which the \
+                        viewer needs for its compute shaders; WebGL2 has none. Try a recent \
+                        Chrome, Edge or Firefox, or Safari 26."
+                    .into(),
+            );
+        }
+        let search = window.location().search().map_err(js)?;
+        let params = web_sys::UrlSearchParams::new_with_str(&search).map_err(js)?;
+        let options = gpu::adapter_options(params.get("adapter").as_deref())?;
+
+        let doc = document().map_err(js)?;
+        let (controls, status) = controls(&doc).map_err(js)?;
+        let canvas: HtmlCanvasElement = doc.create_element("canvas").map_err(js)?.unchecked_into();
+        let style = canvas.style();
+        for (k, v) in [
+            ("display", "block"),
+            ("width", "100%"),
+            ("flex", "1 1 auto"),
+            ("min-height", "0"),
+            ("touch-action", "none"),
+        ] {
+            style.set_property(k, v).map_err(js)?;
+        }
+        let rs = root.style();
+        for (k, v) in [("display", "flex"), ("flex-direction", "column")] {
+            rs.set_property(k, v).map_err(js)?;
+        }
+        root.replace_children_with_node_2(&controls, &canvas);
+        let size = canvas_size(&canvas);
+        canvas.set_width(size.0);
+        canvas.set_height(size.1);
+
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor {
+            backends: wgpu::Backends::BROWSER_WEBGPU,
+            ..wgpu::InstanceDescriptor::new_without_display_handle()
+        });
+        let surface = instance
+            .create_surface(wgpu::SurfaceTarget::Canvas(canvas.clone()))
+            .map_err(|e| format!("the canvas cannot show WebGPU: {e}"))?;
+        let adapter = instance
+            .request_adapter(&wgpu::RequestAdapterOptions {
+                compatible_surface: Some(&surface),
+                ..options
+            })
+            .await
+            .map_err(|e| {
+                format!("This browser has WebGPU but gave no adapter ({e}): it may be switched off for this GPU or driver.")
+            })?;
+        let mut gpu = Gpu::new(&adapter, surface, size).await?;
+        if let Some(name) =
+            browser_adapter_name(&gpu_object, params.get("adapter").as_deref()).await
+        {
+            gpu.adapter = name;
+        }
+        let model = Model::builtin().map_err(|e| e.to_string())?;
+        gpu.upload(&model, EDGES[0].1)?;
+        let (lo, hi) = model.bounds();
+        Ok(App {
+            gpu,
+            canvas,
+            status,
+            orbit: Orbit::framing(lo, hi),
+            model,
+            style: Style::default(),
+            edges: 0,
+            pointers: Vec::new(),
+            pending: false,
+            frames: 0,
+            error: None,
+        })
+    }
+
+    /// Draws a frame into the canvas, sized to its box on the page.
+    fn draw(&mut self) {
+        let size = canvas_size(&self.canvas);
+        if (self.canvas.width(), self.canvas.height()) != size {
+            self.canvas.set_width(size.0);
+            self.canvas.set_height(size.1);
+        }
+        self.gpu.resize(size);
+        let drawn = self.gpu.draw(&self.model, &self.orbit, &self.style);
+        let mut errors = self.gpu.take_errors();
+        if let Err(e) = drawn {
+            errors.push(e);
+        }
+        match errors.pop() {
+            Some(e) => self.show_error(&e),
+            None => {
+                self.frames += 1;
+                if self.error.is_none() {
+                    self.show_status();
+                }
+            }
+        }
+    }
+
+    fn show_status(&self) {
+        let (w, h) = self.gpu.size();
+        self.status.set_text_content(Some(&format!(
+            "{}: {} triangles, {} edges, outlines {}, width {:.1}; {w}×{h} on {}",
+            self.model.name,
+            self.model.triangles(),
+            EDGES[self.edges].0,
+            if self.style.silhouettes { "on" } else { "off" },
+            self.style.line_width,
+            self.gpu.adapter,
+        )));
+    }
+
+    fn show_error(&mut self, message: &str) {
+        web_sys::console::error_1(&message.into());
+        self.status.set_text_content(Some(message));
+        self.error = Some(message.into());
+    }
+
+    fn set_edges(&mut self, edges: usize) {
+        self.edges = edges % EDGES.len();
+        if let Err(e) = self.gpu.upload(&self.model, EDGES[self.edges].1) {
+            self.show_error(&e);
+        }
+    }
+
+    fn pointer_moved(&mut self, id: i32, x: f64, y: f64, shift: bool) {
+        let Some(k) = self.pointers.iter().position(|p| p.0 == id) else {
+            return;
+        };
+        let (_, px, py, button) = self.pointers[k];
+        let height = f64::from(self.canvas.client_height().max(1));
+        if self.pointers.len() >= 2 {
+            // Two fingers: the midpoint pans, the spread zooms.
+            let other = self.pointers[1 - k.min(1)];
+            let spread =
+                |ax: f64, ay: f64| ((ax - other.1).powi(2) + (ay - other.2).powi(2)).sqrt();
+            let (before, after) = (spread(px, py), spread(x, y));
+            if before > 1.0 && after > 1.0 {
+                self.orbit.zoom((after / before).ln() / 0.9f64.recip().ln());
+            }
+            self.orbit.pan((x - px) * 0.5, (y - py) * 0.5, height);
+        } else if button == 0 && !shift {
+            self.orbit.rotate(x - px, y - py);
+        } else {
+            self.orbit.pan(x - px, y - py, height);
+        }
+        self.pointers[k] = (id, x, y, button);
+    }
+}
+
+/// The adapter as the browser describes it (`GPUAdapterInfo`: vendor, architecture,
+/// description), which wgpu leaves unnamed; asked for with the same options.
+async fn browser_adapter_name(gpu: &JsValue, choice: Option<&str>) -> Option<String> {
+    use js_sys::Reflect;
+    let options = js_sys::Object::new();
+    match choice {
+        Some("fallback") => Reflect::set(&options, &"forceFallbackAdapter".into(), &true.into()),
+        Some(power @ ("high-performance" | "low-power")) => {
+            Reflect::set(&options, &"powerPreference".into(), &power.into())
+        }
+        _ => Ok(true),
+    }
+    .ok()?;
+    let request: js_sys::Function = Reflect::get(gpu, &"requestAdapter".into())
+        .ok()?
+        .dyn_into()
+        .ok()?;
+    let promise: js_sys::Promise = request.call1(gpu, &options).ok()?.dyn_into().ok()?;
+    let adapter = wasm_bindgen_futures::JsFuture::from(promise).await.ok()?;
+    let info = Reflect::get(&adapter, &"info".into()).ok()?;
+    let field = |name: &str| {
+        Reflect::get(&info, &name.into())
+            .ok()
+            .and_then(|v| v.as_string())
+            .filter(|s| !s.is_empty())
+    };
+    let words: Vec<String> = ["vendor", "architecture", "description"]
+        .into_iter()
+        .filter_map(field)
+        .collect();
+    (!words.is_empty()).then(|| words.join(" "))
+}
+
+/// The toolbar: edges, outlines, width, a file picker, and the status line.
+fn controls(doc: &web_sys::Document) -> Result<(HtmlElement, HtmlElement), JsValue> {
+    let bar: HtmlElement = doc.create_element("div")?.unchecked_into();
+    bar.set_class_name("wirepass-controls");
+    let options: String = EDGES
+        .iter()
+        .map(|(name, _)| format!("<option value=\"{name}\">{name}</option>"))
+        .collect();
+    bar.set_inner_html(&format!(
+        "<label>Edges <select name=\"edges\">{options}</select></label> \
+         <label><input type=\"checkbox\" name=\"outlines\" checked> Outlines</label> \
+         <label>Width <input type=\"range\" name=\"width\" min=\"0.5\" max=\"8\" step=\"0.5\" \
+         value=\"{}\"></label> \
+         <label>Open <input type=\"file\" name=\"file\" \
+         accept=\".glb,.gltf,.obj,.stl,.ply\"></label> \
+         <span class=\"wirepass-status\">starting…</span>",
+        wirepass::style::DEFAULT_LINE_WIDTH
+    ));
+    let status = bar
+        .query_selector(".wirepass-status")?
+        .ok_or("no status")?
+        .unchecked_into();
+    Ok((bar, status))
+}
+
+fn document() -> Result<web_sys::Document, JsValue> {
+    web_sys::window()
+        .and_then(|w| w.document())
+        .ok_or_else(|| "no document".into())
+}
+
+/// The canvas's box on the page in device pixels.
+fn canvas_size(canvas: &HtmlCanvasElement) -> (u32, u32) {
+    let ratio = web_sys::window().map_or(1.0, |w| w.device_pixel_ratio());
+    let px = |css: i32| ((f64::from(css.max(1)) * ratio).round() as u32).max(1);
+    (px(canvas.client_width()), px(canvas.client_height()))
+}
+
+/// Asks for a frame on the next animation frame, once however many events ask.
+fn schedule(app: &Shared) {
+    if std::mem::replace(&mut app.borrow_mut().pending, true) {
+        return;
+    }
+    let weak = Rc::downgrade(app);
+    let callback = Closure::once_into_js(move || {
+        if let Some(app) = weak.upgrade() {
+            let mut app = app.borrow_mut();
+            app.pending = false;
+            app.draw();
+        }
+    });
+    if let Some(w) = web_sys::window() {
+        let _ = w.request_animation_frame(callback.unchecked_ref());
+    }
+}
+
+/// Replaces the model with a file's, framed anew; an unreadable file is an error on the
+/// page and leaves the model as it was.
+fn show_file(app: &Shared, name: &str, bytes: &[u8]) -> Result<(), String> {
+    let loaded = Model::from_file(name, bytes).map_err(|e| format!("{name}: {e}"));
+    show(app, loaded)
+}
+
+/// Shows `loaded`, framed anew, or its error.
+fn show(app: &Shared, loaded: Result<Model, String>) -> Result<(), String> {
+    let result = {
+        let mut a = app.borrow_mut();
+        let a = &mut *a;
+        match loaded.and_then(|model| {
+            let edges = EDGES[a.edges].1;
+            a.gpu.upload(&model, edges).map(|()| model)
+        }) {
+            Ok(model) => {
+                let (lo, hi) = model.bounds();
+                a.orbit = Orbit::framing(lo, hi);
+                a.model = model;
+                a.error = None;
+                Ok(())
+            }
+            Err(e) => {
+                // The old model's meshes went with the failed upload: put them back.
+                let restored = a.gpu.upload(&a.model, EDGES[a.edges].1);
+                a.show_error(&e);
+                restored.and(Err(e))
+            }
+        }
+    };
+    schedule(app);
+    result
+}
+
+/// Reads a dropped or picked file and shows it.
+fn open_file(app: &Shared, file: web_sys::File) {
+    let app = app.clone();
+    wasm_bindgen_futures::spawn_local(async move {
+        let name = file.name();
+        match wasm_bindgen_futures::JsFuture::from(file.array_buffer()).await {
+            Ok(buffer) => {
+                let bytes = js_sys::Uint8Array::new(&buffer).to_vec();
+                let _ = show_file(&app, &name, &bytes);
+            }
+            Err(e) => app
+                .borrow_mut()
+                .show_error(&format!("{name}: the browser could not read it ({e:?})")),
+        }
+    });
+}
+
+/// Adds `handler` for `event` on `target` for the page's lifetime.
+fn listen<E: JsCast>(
+    target: &web_sys::EventTarget,
+    event: &str,
+    app: &Shared,
+    handler: impl Fn(&Shared, E) + 'static,
+) -> Result<(), JsValue> {
+    let app = app.clone();
+    let closure = Closure::<dyn Fn(web_sys::Event)>::new(move |e: web_sys::Event| {
+        handler(&app, e.unchecked_into())
+    });
+    target.add_event_listener_with_callback(event, closure.as_ref().unchecked_ref())?;
+    closure.forget();
+    Ok(())
+}
+
+fn wire_events(app: &Shared, root: &HtmlElement) -> Result<(), JsValue> {
+    let canvas: web_sys::EventTarget = app.borrow().canvas.clone().into();
+    listen(
+        &canvas,
+        "pointerdown",
+        app,
+        |app, e: web_sys::PointerEvent| {
+            let mut a = app.borrow_mut();
+            let _ = a.canvas.set_pointer_capture(e.pointer_id());
+            let p = (
+                e.pointer_id(),
+                f64::from(e.offset_x()),
+                f64::from(e.offset_y()),
+                e.button(),
+            );
+            a.pointers.retain(|q| q.0 != p.0);
+            a.pointers.push(p);
+            e.prevent_default();
+        },
+    )?;
+    listen(
+        &canvas,
+        "pointermove",
+        app,
+        |app, e: web_sys::PointerEvent| {
+            let (x, y) = (f64::from(e.offset_x()), f64::from(e.offset_y()));
+            let moved = {
+                let mut a = app.borrow_mut();
+                let before = a.orbit;
+                a.pointer_moved(e.pointer_id(), x, y, e.shift_key());
+                a.orbit != before
+            };
+            if moved {
+                schedule(app);
+            }
+        },
+    )?;
+    for end in ["pointerup", "pointercancel"] {
+        listen(&canvas, end, app, |app, e: web_sys::PointerEvent| {
+            app.borrow_mut().pointers.retain(|p| p.0 != e.pointer_id());
+        })?;
+    }
+    listen(&canvas, "wheel", app, |app, e: web_sys::WheelEvent| {
+        e.prevent_default();
+        let lines = match e.delta_mode() {
+            web_sys::WheelEvent::DOM_DELTA_PIXEL => e.delta_y() / 100.0,
+            web_sys::WheelEvent::DOM_DELTA_LINE => e.delta_y() / 3.0,
+            _ => e.delta_y(),
+        };
+        app.borrow_mut().orbit.zoom(-lines);
+        schedule(app);
+    })?;
+    listen(&canvas, "contextmenu", app, |_, e: web_sys::Event| {
+        e.prevent_default()
+    })?;
+
+    let root_target: web_sys::EventTarget = root.clone().into();
+    listen(&root_target, "dragover", app, |_, e: web_sys::DragEvent| {
+        e.prevent_default()
+    })?;
+    listen(&root_target, "drop", app, |app, e: web_sys::DragEvent| {
+        e.prevent_default();
+        if let Some(file) = e
+            .data_transfer()
+            .and_then(|d| d.files())
+            .and_then(|f| f.get(0))
+        {
+            open_file(app, file);
+        }
+    })?;
+    let find = |name: &str| -> Result<web_sys::Element, JsValue> {
+        root.query_selector(&format!("[name={name}]"))?
+            .ok_or_else(|| JsValue::from_str(&format!("no control {name}")))
+    };
+    listen(
+        &find("file")?.into(),
+        "change",
+        app,
+        |app, e: web_sys::Event| {
+            let input: Option<HtmlInputElement> = e.target().and_then(|t| t.dyn_into().ok());
+            if let Some(file) = input.and_then(|i| i.files()).and_then(|f| f.get(0)) {
+                open_file(app, file);
+            }
+        },
+    )?;
+    listen(
+        &find("edges")?.into(),
+        "change",
+        app,
+        |app, e: web_sys::Event| {
+            let select: Option<HtmlSelectElement> = e.target().and_then(|t| t.dyn_into().ok());
+            if let Some(select) = select {
+                app.borrow_mut()
+                    .set_edges(select.selected_index().max(0) as usize);
+                schedule(app);
+            }
+        },
+    )?;
+    listen(
+        &find("outlines")?.into(),
+        "change",
+        app,
+        |app, e: web_sys::Event| {
+            let input: Option<HtmlInputElement> = e.target().and_then(|t| t.dyn_into().ok());
+            if let Some(input) = input {
+                app.borrow_mut().style.silhouettes = input.checked();
+                schedule(app);
+            }
+        },
+    )?;
+    listen(
+        &find("width")?.into(),
+        "input",
+        app,
+        |app, e: web_sys::Event| {
+            let input: Option<HtmlInputElement> = e.target().and_then(|t| t.dyn_into().ok());
+            if let Some(width) = input.and_then(|i| i.value().parse::<f32>().ok()) {
+                app.borrow_mut().style.line_width = width;
+                schedule(app);
+            }
+        },
+    )?;
+
+    let window: web_sys::EventTarget = web_sys::window().ok_or("no window")?.into();
+    listen(&window, "resize", app, |app, _: web_sys::Event| {
+        schedule(app)
+    })?;
+    let root_for_keys = root.clone();
+    listen(
+        &window,
+        "keydown",
+        app,
+        move |app, e: web_sys::KeyboardEvent| {
+            let sync = |name: &str, apply: &dyn Fn(&web_sys::Element)| {
+                if let Ok(Some(el)) = root_for_keys.query_selector(&format!("[name={name}]")) {
+                    apply(&el);
+                }
+            };
+            {
+                let mut a = app.borrow_mut();
+                match e.key().as_str() {
+                    "e" | "E" => {
+                        let next = a.edges + 1;
+                        a.set_edges(next);
+                        let i = a.edges as i32;
+                        sync("edges", &|el| {
+                            el.unchecked_ref::<HtmlSelectElement>()
+                                .set_selected_index(i)
+                        });
+                    }
+                    "o" | "O" => {
+                        a.style.silhouettes = !a.style.silhouettes;
+                        let on = a.style.silhouettes;
+                        sync("outlines", &|el| {
+                            el.unchecked_ref::<HtmlInputElement>().set_checked(on)
+                        });
+                    }
+                    "+" | "=" | "-" => {
+                        let step = if e.key() == "-" { -0.5 } else { 0.5 };
+                        a.style.line_width = (a.style.line_width + step).clamp(0.5, 8.0);
+                        let w = a.style.line_width.to_string();
+                        sync("width", &|el| {
+                            el.unchecked_ref::<HtmlInputElement>().set_value(&w)
+                        });
+                    }
+                    _ => return,
+                }
+            }
+            schedule(app);
+        },
+    )?;
+    Ok(())
+}

@@ -1,0 +1,80 @@
+//! What the page shows: the built-in scene, or a mesh file read from its bytes (a browser has
+//! no file system: files come by the file picker or drag and drop).
+
+use std::path::Path;
+use wirepass::glam::{DMat4, DVec3};
+use wirepass::mesh::formats::gltf::load_gltf_bytes;
+use wirepass::{EdgeSelection, Mesh};
+
+/// Meshes placed as instances, as a file describes them.
+pub struct Model {
+    /// The file's name, or "the built-in scene".
+    pub name: String,
+    /// Each mesh with the edges its file asks for (`None`: its polygon edges).
+    pub meshes: Vec<(Mesh, Option<EdgeSelection>)>,
+    /// Placements: an index into `meshes` and the model → world transform.
+    pub instances: Vec<(usize, DMat4)>,
+}
+
+impl Model {
+    /// The torus and sphere that `wirepass render` draws when given no mesh.
+    pub fn builtin() -> Result<Model, wirepass::Error> {
+        let parts = wirepass::mesh::default_parts()?;
+        Ok(Model {
+            name: "the built-in scene".into(),
+            instances: (0..parts.len()).map(|i| (i, parts[i].1)).collect(),
+            meshes: parts.into_iter().map(|(m, _)| (m, None)).collect(),
+        })
+    }
+
+    /// Reads a `.glb`, `.gltf` (its buffers embedded), `.obj`, `.stl` or `.ply` file, the
+    /// loader chosen by `name`'s extension. A glTF scene keeps its instances and authored
+    /// edges; every other format is one mesh at the origin.
+    pub fn from_file(name: &str, bytes: &[u8]) -> Result<Model, wirepass::Error> {
+        let path = Path::new(name);
+        let ext = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase());
+        if matches!(ext.as_deref(), Some("gltf" | "glb")) {
+            let doc = load_gltf_bytes(path, bytes, &mut |uri: &str| {
+                Err(format!(
+                    "names the external buffer {uri:?}, which a page cannot fetch beside a \
+                     dropped file: use a .glb, or a .gltf with its buffers embedded"
+                ))
+            })?;
+            return Ok(Model {
+                name: name.into(),
+                meshes: doc.meshes.into_iter().map(|m| (m.mesh, m.edges)).collect(),
+                instances: doc.instances,
+            });
+        }
+        Ok(Model {
+            name: name.into(),
+            meshes: vec![(wirepass::mesh::load_bytes(path, bytes)?, None)],
+            instances: vec![(0, DMat4::IDENTITY)],
+        })
+    }
+
+    /// Triangles over all instances.
+    pub fn triangles(&self) -> u64 {
+        let per_mesh = |i: usize| self.meshes[i].0.triangle_count() as u64;
+        self.instances.iter().map(|&(m, _)| per_mesh(m)).sum()
+    }
+
+    /// World bounds: every instance's mesh box, transformed.
+    pub fn bounds(&self) -> (DVec3, DVec3) {
+        let mut lo = DVec3::splat(f64::INFINITY);
+        let mut hi = DVec3::splat(f64::NEG_INFINITY);
+        for &(m, transform) in &self.instances {
+            let (a, b) = self.meshes[m].0.bounds_f64();
+            for corner in 0..8 {
+                let pick = |bit: u32, a: f64, b: f64| if corner & bit == 0 { a } else { b };
+                let c = DVec3::new(pick(1, a.x, b.x), pick(2, a.y, b.y), pick(4, a.z, b.z));
+                let p = transform.transform_point3(c);
+                lo = lo.min(p);
+                hi = hi.max(p);
+            }
+        }
+        (lo, hi)
+    }
+}
