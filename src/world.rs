@@ -119,22 +119,14 @@ impl World {
 
     /// Axis-aligned world bounds of every object (its mesh's bounding box, transformed).
     pub fn bounds(&self) -> (DVec3, DVec3) {
-        let mut lo = DVec3::splat(f64::INFINITY);
-        let mut hi = DVec3::splat(f64::NEG_INFINITY);
-        for o in &self.objects {
-            let (a, b) = self.meshes[o.mesh].mesh.bounds_f64();
-            for i in 0..8 {
-                let c = DVec3::new(
-                    if i & 1 == 0 { a.x } else { b.x },
-                    if i & 2 == 0 { a.y } else { b.y },
-                    if i & 4 == 0 { a.z } else { b.z },
-                );
-                let p = o.transform.transform_point3(c);
-                lo = lo.min(p);
-                hi = hi.max(p);
-            }
-        }
-        (lo, hi)
+        let placed = self
+            .objects
+            .iter()
+            .map(|o| self.meshes[o.mesh].mesh.placed_bounds(o.transform));
+        placed.fold(
+            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+            |(lo, hi), (a, b)| (lo.min(a), hi.max(b)),
+        )
     }
 }
 

@@ -21,6 +21,7 @@ mod mesh_records;
 mod mesh_store;
 mod options;
 mod outline_pass;
+mod pick;
 mod readback;
 // The WGSL sources and their assembly: public for the tests that validate them.
 #[cfg(feature = "diagnostics")]
@@ -54,6 +55,7 @@ pub(crate) use frame::light_world_dir;
 pub(crate) use host_depth::depth_quantum;
 pub use mesh_store::{MeshId, MeshStore};
 pub use options::{OutputTarget, PassOptions, TriangleIds};
+pub use pick::{EdgeSnap, InstanceHit, Location, PickView, Picked, RectPick, VertexSnap};
 #[cfg(not(target_arch = "wasm32"))]
 pub use readback::read_texture;
 pub use readback::read_texture_async;

@@ -46,6 +46,21 @@ struct TextureCopy {
     height: u32,
 }
 
+/// Reads the `size` texels at `origin` of a 2D texture (mip 0, layer 0) as
+/// [`read_texture_async`] reads a whole one: a pick reads a few bytes, not the frame.
+pub(crate) async fn read_region_async(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    texture: &wgpu::Texture,
+    origin: (u32, u32),
+    size: (u32, u32),
+) -> Result<Vec<u8>> {
+    let aspect = wgpu::TextureAspect::All;
+    let copy = TextureCopy::submit_region(device, queue, texture, aspect, origin, size)?;
+    let bytes = map_read_async(device, &copy.buffer).await?;
+    Ok(copy.unpad(&bytes))
+}
+
 impl TextureCopy {
     fn submit(
         device: &wgpu::Device,
@@ -53,7 +68,27 @@ impl TextureCopy {
         texture: &wgpu::Texture,
         aspect: wgpu::TextureAspect,
     ) -> Result<TextureCopy> {
-        let (width, height) = (texture.width(), texture.height());
+        let size = (texture.width(), texture.height());
+        Self::submit_region(device, queue, texture, aspect, (0, 0), size)
+    }
+
+    fn submit_region(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        texture: &wgpu::Texture,
+        aspect: wgpu::TextureAspect,
+        (x, y): (u32, u32),
+        (width, height): (u32, u32),
+    ) -> Result<TextureCopy> {
+        let inside =
+            |at: u32, len: u32, of: u32| len > 0 && at.checked_add(len).is_some_and(|e| e <= of);
+        if !inside(x, width, texture.width()) || !inside(y, height, texture.height()) {
+            return Err(Error::InvalidSetting(format!(
+                "the {width}x{height} texels at ({x}, {y}) are not inside the {}x{} texture",
+                texture.width(),
+                texture.height()
+            )));
+        }
         let texel = texture
             .format()
             .block_copy_size(Some(aspect))
@@ -72,7 +107,7 @@ impl TextureCopy {
             wgpu::TexelCopyTextureInfo {
                 texture,
                 mip_level: 0,
-                origin: wgpu::Origin3d::ZERO,
+                origin: wgpu::Origin3d { x, y, z: 0 },
                 aspect,
             },
             wgpu::TexelCopyBufferInfo {
@@ -83,7 +118,11 @@ impl TextureCopy {
                     rows_per_image: Some(height),
                 },
             },
-            texture.size(),
+            wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
         );
         queue.submit([encoder.finish()]);
         Ok(TextureCopy {

@@ -278,30 +278,59 @@ impl Mesh {
     /// edges. An edge next to a zero-area triangle, whose normal is undefined, is drawn only
     /// when it is a boundary.
     fn feature_edges(&self, degrees: f32) -> Vec<u8> {
-        let cos_limit = f64::from(degrees).to_radians().cos();
-        let face_normal = |t: usize| {
-            let [a, b, c] = self.triangles[t].map(|v| self.positions[v as usize].as_dvec3());
-            (b - a).cross(c - a).try_normalize()
-        };
-        let normals: Vec<_> = (0..self.triangles.len()).map(face_normal).collect();
-        self.edge_neighbours()
-            .iter()
-            .enumerate()
-            .map(|(t, across)| {
-                let mut mask = 0;
-                for (i, &u) in across.iter().enumerate() {
-                    let feature = u == adjacency::NO_NEIGHBOUR
-                        || match (normals[t], normals[u as usize]) {
-                            (Some(n), Some(m)) => n.dot(m) < cos_limit,
-                            _ => false,
-                        };
-                    if feature {
-                        mask |= 1 << i;
-                    }
-                }
-                mask
-            })
+        let normals: Vec<_> = (0..self.triangles.len())
+            .map(|t| self.face_normal(t))
+            .collect();
+        (0..self.triangles.len())
+            .map(|t| self.feature_mask(t, degrees, &|u| normals[u]))
             .collect()
+    }
+
+    /// The unit normal of triangle `t`'s plane (its winding's side), `None` for a
+    /// zero-area triangle.
+    fn face_normal(&self, t: usize) -> Option<glam::DVec3> {
+        let [a, b, c] = self.triangles[t].map(|v| self.positions[v as usize].as_dvec3());
+        (b - a).cross(c - a).try_normalize()
+    }
+
+    /// Triangle `t`'s mask of [`feature_edges`](Self::feature_edges), given every
+    /// triangle's [`face_normal`](Self::face_normal).
+    fn feature_mask(
+        &self,
+        t: usize,
+        degrees: f32,
+        normal: &dyn Fn(usize) -> Option<glam::DVec3>,
+    ) -> u8 {
+        let cos_limit = f64::from(degrees).to_radians().cos();
+        let mut mask = 0;
+        for (i, &u) in self.edge_neighbours()[t].iter().enumerate() {
+            let feature = u == adjacency::NO_NEIGHBOUR
+                || match (normal(t), normal(u as usize)) {
+                    (Some(n), Some(m)) => n.dot(m) < cos_limit,
+                    _ => false,
+                };
+            if feature {
+                mask |= 1 << i;
+            }
+        }
+        mask
+    }
+
+    /// Triangle `t`'s 3-bit mask of edges drawn for `selection` (bit `i`: the edge from
+    /// corner `i` to `i + 1`), as [`edge_mask`](Self::edge_mask) has it, without computing
+    /// the whole mesh's.
+    pub fn triangle_edge_mask(&self, t: usize, selection: EdgeSelection) -> u8 {
+        match selection {
+            EdgeSelection::All => ALL_EDGES,
+            EdgeSelection::Polygon => self.polygon_edges[t],
+            EdgeSelection::Feature(degrees) => {
+                self.feature_mask(t, degrees, &|u| self.face_normal(u))
+            }
+            EdgeSelection::Authored => self
+                .authored_edges
+                .as_ref()
+                .map_or(self.polygon_edges[t], |mask| mask[t]),
+        }
     }
 
     /// The triangle across each triangle edge (edge `i` runs from corner `i` to `i + 1`),
@@ -395,6 +424,22 @@ impl Mesh {
     pub fn bounds_f64(&self) -> (glam::DVec3, glam::DVec3) {
         let (lo, hi) = self.bounds();
         (lo.as_dvec3(), hi.as_dvec3())
+    }
+
+    /// Axis-aligned bounds `(min, max)` of [`bounds_f64`](Self::bounds_f64)'s box placed by
+    /// `transform` (model → world): the box around its eight transformed corners.
+    pub fn placed_bounds(&self, transform: glam::DMat4) -> (glam::DVec3, glam::DVec3) {
+        let (a, b) = self.bounds_f64();
+        let mut lo = glam::DVec3::splat(f64::INFINITY);
+        let mut hi = glam::DVec3::splat(f64::NEG_INFINITY);
+        for corner in 0..8 {
+            let pick = |bit: u32, a: f64, b: f64| if corner & bit == 0 { a } else { b };
+            let c = glam::DVec3::new(pick(1, a.x, b.x), pick(2, a.y, b.y), pick(4, a.z, b.z));
+            let p = transform.transform_point3(c);
+            lo = lo.min(p);
+            hi = hi.max(p);
+        }
+        (lo, hi)
     }
 
     /// Axis-aligned bounds `(min, max)` of the positions that triangles use.
@@ -497,6 +542,30 @@ mod tests {
         let mut bad = p;
         bad[1].y = f32::NAN;
         assert!(Mesh::new(bad, None, vec![[0, 1, 2]], None).is_err());
+    }
+
+    #[test]
+    fn one_triangle_s_mask_is_the_whole_mesh_s() {
+        let sphere = procedural::sphere(500).unwrap();
+        let scene = procedural::default_scene();
+        let authored = quad().with_authored_edges(vec![0b001, 0b110]).unwrap();
+        for mesh in [&sphere, &scene, &authored] {
+            for selection in [
+                EdgeSelection::All,
+                EdgeSelection::Polygon,
+                EdgeSelection::Feature(15.0),
+                EdgeSelection::Authored,
+            ] {
+                let whole = mesh.edge_mask(selection);
+                for (t, &m) in whole.iter().enumerate() {
+                    assert_eq!(
+                        mesh.triangle_edge_mask(t, selection),
+                        m,
+                        "{selection:?} {t}"
+                    );
+                }
+            }
+        }
     }
 
     #[test]

@@ -89,7 +89,7 @@ pub fn draw_deferred_with(
 }
 
 /// [`draw_deferred_with`] onto a canvas of the caller's: over the host's depth buffer, say
-/// (its pixels where the host is in front get the id [`HOST`]), or a region of the shot's
+/// (its pixels where the host is in front get the id [`HOST`](crate::world::HOST)), or a region of the shot's
 /// image (a tile: the frame is the region's size).
 pub fn draw_deferred_on(
     ctx: &GpuContext,

@@ -63,18 +63,13 @@ impl Model {
 
     /// World bounds: every instance's mesh box, transformed.
     pub fn bounds(&self) -> (DVec3, DVec3) {
-        let mut lo = DVec3::splat(f64::INFINITY);
-        let mut hi = DVec3::splat(f64::NEG_INFINITY);
-        for &(m, transform) in &self.instances {
-            let (a, b) = self.meshes[m].0.bounds_f64();
-            for corner in 0..8 {
-                let pick = |bit: u32, a: f64, b: f64| if corner & bit == 0 { a } else { b };
-                let c = DVec3::new(pick(1, a.x, b.x), pick(2, a.y, b.y), pick(4, a.z, b.z));
-                let p = transform.transform_point3(c);
-                lo = lo.min(p);
-                hi = hi.max(p);
-            }
-        }
-        (lo, hi)
+        let placed = self
+            .instances
+            .iter()
+            .map(|&(m, transform)| self.meshes[m].0.placed_bounds(transform));
+        placed.fold(
+            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+            |(lo, hi), (a, b)| (lo.min(a), hi.max(b)),
+        )
     }
 }
