@@ -2,17 +2,19 @@
 //! surface's render pass (the deferred method), or the forward baseline draws into a texture
 //! that is blitted to the surface, for comparison. The device has the WebGPU default limits.
 //!
-//! Mouse: left drag orbits, right or middle drag pans, the wheel zooms.
+//! Mouse: left drag orbits, right or middle drag pans, the wheel zooms, a left click picks
+//! (the window title says what the pixel shows: the triangle, its polygon, the exact point,
+//! and the nearest drawn edge and vertex).
 //! Keys: `E` cycles the edges (polygon, all, feature), `O` toggles outlines, `M` switches the
 //! method, `+`/`-` change the line width, `Esc` quits.
 //!
 //! `cargo run --release --example viewer -- [MESH] [--method deferred|forward]
-//! [--edges polygon|all|feature] [--frames N] [--screenshot OUT.png]`
+//! [--edges polygon|all|feature] [--frames N] [--screenshot OUT.png] [--pick X,Y]`
 //!
 //! With `--frames N` the viewer orbits a little each frame and closes after N frames; with
 //! `--screenshot` it reads the last frame back from the surface, checks that it shows the
 //! background, the shaded mesh and its lines, and writes it as a PNG (CI runs it so under
-//! Xvfb).
+//! Xvfb). With `--pick X,Y` it prints what pixel X,Y of the last frame shows.
 
 use std::sync::Arc;
 use winit::application::ApplicationHandler;
@@ -53,6 +55,7 @@ struct Options {
     edges: usize,
     frames: Option<u64>,
     screenshot: Option<std::path::PathBuf>,
+    pick: Option<(u32, u32)>,
 }
 
 fn options() -> Result<Options, AnyError> {
@@ -62,6 +65,7 @@ fn options() -> Result<Options, AnyError> {
         edges: 0,
         frames: None,
         screenshot: None,
+        pick: None,
     };
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
@@ -83,6 +87,12 @@ fn options() -> Result<Options, AnyError> {
             }
             "--frames" => o.frames = Some(value()?.parse()?),
             "--screenshot" => o.screenshot = Some(value()?.into()),
+            "--pick" => {
+                let v = value()?;
+                let bad = || format!("--pick {v:?} is not X,Y");
+                let (x, y) = v.split_once(',').ok_or_else(bad)?;
+                o.pick = Some((x.parse().map_err(|_| bad())?, y.parse().map_err(|_| bad())?));
+            }
             flag if flag.starts_with("--") => return Err(format!("unknown flag {flag}").into()),
             path => o.mesh = path.into(),
         }
@@ -110,6 +120,12 @@ struct Viewer {
     edges: usize,
     drag: Option<MouseButton>,
     cursor: (f64, f64),
+    /// Where the left button went down, to tell a click from a drag.
+    press: Option<(f64, f64)>,
+    /// The mesh on the CPU, for the exact point of a pick.
+    mesh: Mesh,
+    /// The last deferred frame and its scene, which a click picks from.
+    last: Option<(wirepass::PreparedFrame, Scene<'static>)>,
 }
 
 impl Viewer {
@@ -205,6 +221,9 @@ impl Viewer {
             edges: o.edges,
             drag: None,
             cursor: (0.0, 0.0),
+            press: None,
+            mesh: mesh.clone(),
+            last: None,
         };
         viewer.title();
         Ok(viewer)
@@ -360,10 +379,44 @@ impl Viewer {
                     ..Default::default()
                 });
                 self.deferred.render(&mut pass, &frame)?;
+                drop(pass);
+                self.last = Some((frame, Scene::new(scene.view, instances.to_vec())));
             }
         }
         self.queue.submit([encoder.finish()]);
         Ok(())
+    }
+
+    /// What pixel `at` of the last deferred frame shows, in words.
+    fn pick(&self, at: (u32, u32)) -> Result<String, AnyError> {
+        use wirepass::gpu::{PickView, Picked};
+        let (frame, scene) = self
+            .last
+            .as_ref()
+            .ok_or("picking needs the deferred method")?;
+        let hit = match frame.pick(&self.device, &self.queue, &self.store, scene, at)? {
+            Picked::Background => return Ok("background".into()),
+            Picked::Host => return Ok("the host's geometry".into()),
+            Picked::Instance(hit) => hit,
+        };
+        let view = PickView {
+            view: scene.view,
+            image: frame.output_size(),
+        };
+        let edges = EDGES[self.edges].1;
+        let l = hit.locate(&self.mesh, edges, DMat4::IDENTITY, &view, at, 8.0)?;
+        let mut words = format!(
+            "triangle {} (polygon {}) at ({:.4}, {:.4}, {:.4})",
+            hit.triangle, l.polygon, l.point.x, l.point.y, l.point.z
+        );
+        if let Some(e) = l.edge {
+            let [a, b] = e.vertices;
+            words += &format!(", edge {a}-{b} {:.1} px", e.distance_px);
+        }
+        if let Some(v) = l.vertex {
+            words += &format!(", vertex {} {:.1} px", v.vertex, v.distance_px);
+        }
+        Ok(words)
     }
 
     /// Reads `texture` back as RGBA8.
@@ -545,6 +598,9 @@ impl App {
             let offscreen = viewer.draw_offscreen()?;
             check_frame(&rgba, &offscreen, &viewer.style)?;
         }
+        if let Some(at) = self.options.pick {
+            println!("pick {},{}: {}", at.0, at.1, viewer.pick(at)?);
+        }
         event_loop.exit();
         Ok(())
     }
@@ -600,6 +656,21 @@ impl ApplicationHandler for App {
                         }
                         WindowEvent::MouseInput { state, button, .. } => {
                             v.drag = (state == ElementState::Pressed).then_some(button);
+                            let pressed = state == ElementState::Pressed;
+                            if button == MouseButton::Left && pressed {
+                                v.press = Some(v.cursor);
+                            } else if button == MouseButton::Left {
+                                let (x, y) = v.cursor;
+                                let click = v.press.take().is_some_and(|(px, py)| {
+                                    (x - px).abs() < 3.0 && (y - py).abs() < 3.0
+                                });
+                                if click && x >= 0.0 && y >= 0.0 {
+                                    let words = v
+                                        .pick((x as u32, y as u32))
+                                        .unwrap_or_else(|e| format!("no pick: {e}"));
+                                    v.window.set_title(&format!("wirepass viewer: {words}"));
+                                }
+                            }
                         }
                         WindowEvent::CursorMoved { position, .. } => {
                             v.mouse_moved(position.x, position.y)

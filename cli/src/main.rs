@@ -35,6 +35,10 @@ enum Command {
     Bench(BenchArgs),
     /// Compare two images with FLIP: print mean, p99 and max; exit non-zero over the threshold.
     Diff(DiffArgs),
+    /// Print, as JSON, what pixel --at X,Y of the scene's deferred frame shows: the object,
+    /// its mesh, the file's triangle and polygon, the exact point and normal, and the drawn
+    /// edge and vertex nearest it within --snap pixels.
+    Pick(PickArgs),
 }
 
 fn parse_edges(s: &str) -> std::result::Result<EdgeSelection, String> {
@@ -189,6 +193,47 @@ fn render_command(args: &RenderArgs) -> Result<()> {
         world.triangle_count(),
         ctx.describe()
     );
+    Ok(())
+}
+
+#[derive(clap::Args)]
+struct PickArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// The pixel, X,Y (0,0 is the top-left pixel).
+    #[arg(long, value_parser = parse_pixel)]
+    at: (u32, u32),
+    /// Snapping radius for the nearest drawn edge and vertex, in pixels.
+    #[arg(long, default_value = "8")]
+    snap: f64,
+}
+
+fn parse_pixel(s: &str) -> std::result::Result<(u32, u32), String> {
+    let bad = || format!("{s:?} is not X,Y, two whole numbers");
+    let (x, y) = s.split_once(',').ok_or_else(bad)?;
+    Ok((
+        x.trim().parse().map_err(|_| bad())?,
+        y.trim().parse().map_err(|_| bad())?,
+    ))
+}
+
+fn pick_command(args: &PickArgs) -> Result<()> {
+    if !(args.snap >= 0.0 && args.snap.is_finite()) {
+        return Err(wirepass::Error::InvalidSetting(format!(
+            "--snap {} is not a finite number of pixels, 0 or more",
+            args.snap
+        )));
+    }
+    let (world, view, style, size) = args.scene.load()?;
+    let ctx = GpuContext::new()?;
+    let shot = Shot {
+        world: &world,
+        view,
+        style: &style,
+        size,
+    };
+    let report = wirepass::tools::pick::pick(&ctx, &shot, args.at, args.snap)?;
+    println!("{}", report.to_json());
     Ok(())
 }
 
@@ -383,6 +428,7 @@ fn main() -> ExitCode {
         Command::Compare(args) => compare_command(args),
         Command::Bench(args) => bench_command(args),
         Command::Diff(args) => diff_command(args),
+        Command::Pick(args) => pick_command(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -308,3 +308,67 @@ fn renders_a_scene_file_with_global_ids_in_the_dump() {
         "{err}"
     );
 }
+
+/// Runs `wirepass` and returns (success, stdout, stderr).
+fn wirepass_out(args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_wirepass"))
+        .args(args)
+        .output()
+        .expect("the wirepass binary runs");
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(!stderr.contains("panicked"), "panic for {args:?}: {stderr}");
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    (out.status.success(), stdout, stderr)
+}
+
+#[test]
+fn pick_prints_what_a_pixel_shows_as_json() {
+    let args = |at: &'static str| ["pick", "sphere:2000", "--size", "160x120", "--at", at];
+    let (ok, out, err) = wirepass_out(&args("80,60"));
+    assert!(ok, "{err}");
+    let json: serde_json::Value =
+        serde_json::from_str(&out).unwrap_or_else(|e| panic!("{e}: {out}"));
+    assert_eq!(json["shows"], "object", "{out}");
+    assert_eq!(json["object"], 0);
+    assert_eq!(json["pixel"], serde_json::json!([80, 60]));
+    assert!(json["triangle"].as_u64().is_some_and(|t| t < 2100), "{out}");
+    let v = |key: &str| -> Vec<f64> {
+        json[key]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect()
+    };
+    let n = v("normal");
+    assert!(
+        (n.iter().map(|x| x * x).sum::<f64>() - 1.0).abs() < 1e-9,
+        "{out}"
+    );
+    // The centre of the framed unit sphere is on its near side, facing the eye.
+    let p = v("point");
+    assert!(
+        (p.iter().map(|x| x * x).sum::<f64>().sqrt() - 1.0).abs() < 0.01,
+        "{out}"
+    );
+    assert!(
+        json["edge"]["distance_px"]
+            .as_f64()
+            .is_some_and(|d| d <= 8.0),
+        "{out}"
+    );
+
+    let (ok, out, err) = wirepass_out(&args("0,0"));
+    assert!(ok, "{err}");
+    assert!(out.contains("\"shows\": \"background\""), "{out}");
+
+    for bad in ["160,0", "3", "a,b"] {
+        let (ok, _, err) = wirepass_out(&args(bad));
+        assert!(!ok, "--at {bad} was accepted");
+        let lines: Vec<_> = err
+            .lines()
+            .filter(|l| !l.contains("XDG_RUNTIME_DIR"))
+            .collect();
+        assert!(!lines.is_empty() && lines[0].contains("error"), "{err}");
+    }
+}

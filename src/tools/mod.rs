@@ -1,6 +1,6 @@
 //! What the `wirepass` command, the tests and the benchmarks are built from, over the
 //! library: scenes loaded from files and specs ([`load`], [`scene_file`]), offscreen frames
-//! of every method and their dumps ([`offline`]), the comparison against the ground truth
+//! of every method and their dumps ([`offline`]), what a pixel shows ([`pick`](mod@pick)), the comparison against the ground truth
 //! ([`compare`]), the benchmark ([`bench`](mod@bench)) and image regression ([`regression`]).
 //!
 //! Everything here may use the whole library below it (the pass, the loaders, the ground
@@ -14,6 +14,8 @@ pub mod compare;
 pub mod load;
 #[cfg(feature = "tools")]
 pub mod offline;
+#[cfg(feature = "tools")]
+pub mod pick;
 #[cfg(feature = "regression")]
 pub mod regression;
 #[cfg(feature = "tools")]
