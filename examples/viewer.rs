@@ -407,7 +407,7 @@ impl Viewer {
         let l = hit.locate(&self.mesh, edges, DMat4::IDENTITY, &view, at, 8.0)?;
         let mut words = format!(
             "triangle {} (polygon {}) at ({:.4}, {:.4}, {:.4})",
-            hit.triangle, l.polygon, l.point.x, l.point.y, l.point.z
+            l.triangle, l.polygon, l.point.x, l.point.y, l.point.z
         );
         if let Some(e) = l.edge {
             let [a, b] = e.vertices;

@@ -35,7 +35,10 @@ pub struct InstanceHit {
     pub instance: usize,
     /// Its mesh.
     pub mesh: MeshId,
-    /// The triangle, in the order of the [`Mesh`] that was inserted (a loaded file's order).
+    /// The triangle the rasterizer put at the pixel, in the order of the [`Mesh`] that was
+    /// inserted (a loaded file's order). On a pixel whose centre lies on or next to an edge
+    /// the rasterizer's rounding may give the neighbour; [`InstanceHit::locate`] finds the
+    /// exact one ([`Location::triangle`]).
     pub triangle: u32,
 }
 
@@ -157,6 +160,16 @@ impl PreparedFrame {
 /// Where exactly a pixel's ray meets a picked triangle, and what is near it on screen.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Location {
+    /// The triangle the pixel's centre shows exactly, in the mesh's order: the picked one,
+    /// or, where the rasterizer's rounding put a neighbour at a pixel on their shared edge,
+    /// that neighbour (the triangle around the picked one's corners that the ray meets
+    /// first).
+    pub triangle: u32,
+    /// Whether the ray meets that triangle itself. False where the rasterizer covered a
+    /// pixel whose centre lies just off the surface (beside a silhouette or a boundary, a
+    /// hair's breadth away): the pixel then shows what is behind, and `point` lies on the
+    /// triangle's plane, outside it.
+    pub inside: bool,
     /// The world-space point where the ray through the pixel's centre meets the
     /// triangle's plane, in f64.
     pub point: DVec3,
@@ -263,6 +276,8 @@ impl InstanceHit {
         snap_radius: f64,
     ) -> Result<Location> {
         let t = self.triangle as usize;
+        let mut exact = t;
+        let mut inside = false;
         if t >= mesh.triangle_count() {
             return Err(Error::Misuse(format!(
                 "triangle {t} of a mesh with {} triangles: not the mesh that was picked",
@@ -270,24 +285,13 @@ impl InstanceHit {
             )));
         }
         let world = |v: u32| transform.transform_point3(mesh.positions()[v as usize].as_dvec3());
-        let [a, b, c] = mesh.triangles()[t].map(world);
         let centre = DVec2::new(f64::from(pixel.0) + 0.5, f64::from(pixel.1) + 0.5);
         let (origin, dir) = view.ray(centre)?;
-        let normal = (b - a).cross(c - a).try_normalize().ok_or_else(|| {
-            Error::InvalidMesh(format!("triangle {t} has no area: it has no point to pick"))
-        })?;
-        let along = normal.dot(dir);
-        if along == 0.0 {
-            return Err(Error::InvalidSetting(format!(
-                "the pixel's ray runs in the plane of triangle {t}"
-            )));
-        }
-        let point = origin + dir * (normal.dot(a - origin) / along);
-        let normal = if along > 0.0 { -normal } else { normal };
 
-        // Candidates for snapping: the triangles around this one's corners (by position,
-        // across split vertices) that face the eye as it does: the surface the pixel shows
-        // around it, without the hidden far side of a silhouette.
+        // The triangles around this one's corners (by position, across split vertices) that
+        // face the eye as it does: the surface the pixel shows around it, without the
+        // hidden far side of a silhouette. They hold the exact triangle where the
+        // rasterizer's rounding put a neighbour at the pixel, and the snapping candidates.
         let eye = view.view.eye();
         let facing = |u: usize| {
             let [p, q, r] = mesh.triangles()[u].map(world);
@@ -304,6 +308,44 @@ impl InstanceHit {
                         && facing(u) * side > 0.0)
             })
             .collect();
+
+        // Where the ray meets triangle u's plane, along the ray, and whether inside it.
+        let meet = |u: usize| -> Option<(f64, DVec3, DVec3, bool)> {
+            let [a, b, c] = mesh.triangles()[u].map(world);
+            let normal = (b - a).cross(c - a);
+            let along = normal.dot(dir);
+            if along == 0.0 || !along.is_finite() {
+                return None;
+            }
+            let s = normal.dot(a - origin) / along;
+            let p = origin + dir * s;
+            let inside = [(a, b), (b, c), (c, a)]
+                .iter()
+                .all(|&(e0, e1)| (e1 - e0).cross(p - e0).dot(normal) >= 0.0);
+            Some((s, p, normal, inside))
+        };
+        let (_, point, normal, _) = near
+            .iter()
+            .filter_map(|&u| meet(u).filter(|m| m.3).map(|m| (u, m)))
+            .min_by(|x, y| x.1 .0.total_cmp(&y.1 .0))
+            .map(|(u, m)| {
+                exact = u;
+                inside = true;
+                m
+            })
+            .or_else(|| meet(t))
+            .ok_or_else(|| {
+                Error::InvalidSetting(format!(
+                    "triangle {t} has no area, or the pixel's ray runs in its plane"
+                ))
+            })?;
+        let normal = normal.normalize();
+        let normal = if normal.dot(dir) > 0.0 {
+            -normal
+        } else {
+            normal
+        };
+
         let mut edge: Option<EdgeSnap> = None;
         let mut vertex: Option<VertexSnap> = None;
         for &u in &near {
@@ -349,9 +391,11 @@ impl InstanceHit {
             }
         }
         Ok(Location {
+            triangle: exact as u32,
+            inside,
             point,
             normal,
-            polygon: polygon_of(mesh, t),
+            polygon: polygon_of(mesh, exact),
             edge,
             vertex,
         })

@@ -577,8 +577,10 @@ mod tests {
         }
     }
 
+    /// A polygon of 10 000 corners triangulates fully, every boundary edge marked. (Its speed
+    /// is the benchmarks' business: tests assert no times.)
     #[test]
-    fn ear_clipping_a_10k_gon_is_fast() {
+    fn ear_clipping_a_10k_gon() {
         let n = 10_000;
         let pts: Vec<Vec3> = (0..n)
             .map(|i| {
@@ -586,13 +588,11 @@ mod tests {
                 Vec3::new(a.cos(), a.sin(), 0.0)
             })
             .collect();
-        let start = std::time::Instant::now();
         let mut tris = Vec::new();
         triangulate(&pts, &mut tris);
         assert_eq!(tris.len(), 9_998);
         let marked: u32 = tris.iter().map(|&t| polygon_edges(t, n).count_ones()).sum();
         assert_eq!(marked, n as u32);
-        assert!(start.elapsed().as_secs_f64() < 2.0, "{:?}", start.elapsed());
     }
 
     /// A star of `n` corners alternating between radius 1 and 0.4.

@@ -22,8 +22,11 @@ pub struct PickReport {
     pub object: Option<usize>,
     /// The object's mesh, by name.
     pub mesh: Option<String>,
-    /// The triangle in the mesh file's order.
+    /// The triangle in the mesh file's order, exact at the pixel's centre.
     pub triangle: Option<u32>,
+    /// Whether the pixel's centre lies on that triangle (false: just off a silhouette the
+    /// rasterizer covered).
+    pub inside: Option<bool>,
     /// The polygon (face) in the mesh file's order.
     pub polygon: Option<u32>,
     /// Where the pixel centre's ray meets the triangle, world space.
@@ -107,6 +110,7 @@ pub fn pick(ctx: &GpuContext, shot: &Shot<'_>, at: (u32, u32), snap: f64) -> Res
         object: None,
         mesh: None,
         triangle: None,
+        inside: None,
         polygon: None,
         point: None,
         normal: None,
@@ -138,7 +142,8 @@ pub fn pick(ctx: &GpuContext, shot: &Shot<'_>, at: (u32, u32), snap: f64) -> Res
     report.shows = "object";
     report.object = Some(hit.instance);
     report.mesh = Some(mesh.name.clone());
-    report.triangle = Some(hit.triangle);
+    report.triangle = Some(at.triangle);
+    report.inside = Some(at.inside);
     report.polygon = Some(at.polygon);
     report.point = Some(at.point.to_array());
     report.normal = Some(at.normal.to_array());
