@@ -55,7 +55,9 @@ pub(crate) use frame::light_world_dir;
 pub(crate) use host_depth::depth_quantum;
 pub use mesh_store::{MeshId, MeshStore};
 pub use options::{OutputTarget, PassOptions, TriangleIds};
-pub use pick::{EdgeSnap, InstanceHit, Location, PickView, Picked, RectPick, VertexSnap};
+pub use pick::{
+    EdgeSnap, InstanceHit, Location, PickView, Picked, PickedIds, RectPick, VertexSnap,
+};
 #[cfg(not(target_arch = "wasm32"))]
 pub use readback::read_texture;
 pub use readback::read_texture_async;

@@ -67,17 +67,8 @@ impl PreparedFrame {
         scene: &Scene<'_>,
         (x, y): (u32, u32),
     ) -> Result<Picked> {
-        let rect = self.pick_rect_async(device, queue, store, scene, (x, y), (1, 1), true);
-        let rect = rect.await?;
-        Ok(match (rect.triangles.first(), rect.host) {
-            (Some(&(instance, triangle)), _) => Picked::Instance(InstanceHit {
-                instance,
-                mesh: scene.instances[instance].mesh,
-                triangle,
-            }),
-            (None, true) => Picked::Host,
-            (None, false) => Picked::Background,
-        })
+        let ids = self.read_ids(device, queue, (x, y), (1, 1))?.await?;
+        ids.first(store, scene)
     }
 
     /// [`pick_async`](Self::pick_async), waiting for the GPU: for native hosts and tools.
@@ -107,14 +98,21 @@ impl PreparedFrame {
         size: (u32, u32),
         triangles: bool,
     ) -> Result<RectPick> {
-        let order = self.instance_order();
-        if scene.instances.len() != order.len() {
-            return Err(Error::Misuse(format!(
-                "the scene has {} instances, but the frame was prepared from one with {}",
-                scene.instances.len(),
-                order.len()
-            )));
-        }
+        let ids = self.read_ids(device, queue, origin, size)?.await?;
+        ids.resolve(store, scene, triangles)
+    }
+
+    /// Starts reading back the id target under the `size` output pixels at `origin`. The
+    /// future owns what it needs (not the frame, the store or the scene), so a host whose
+    /// state lives behind a `RefCell` can await it without holding a borrow, and
+    /// [`resolve`](PickedIds::resolve) the result afterwards.
+    pub fn read_ids(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        origin: (u32, u32),
+        size: (u32, u32),
+    ) -> Result<impl std::future::Future<Output = Result<PickedIds>> + 'static> {
         let (w, h) = self.output_size();
         let fits =
             |at: u32, len: u32, of: u32| len > 0 && at.checked_add(len).is_some_and(|e| e <= of);
@@ -126,10 +124,47 @@ impl PreparedFrame {
         }
         let g = self.guard();
         let texels = (origin.0 + g, origin.1 + g);
-        let bytes = read_region_async(device, queue, self.id_texture(), texels, size).await?;
-        let words: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
+        let order = self.instance_order().to_vec();
+        let (device, queue) = (device.clone(), queue.clone());
+        let texture = self.id_texture().clone();
+        Ok(async move {
+            let bytes = read_region_async(&device, &queue, &texture, texels, size).await?;
+            Ok(PickedIds {
+                order,
+                words: bytemuck::pod_collect_to_vec(&bytes),
+            })
+        })
+    }
+}
+
+/// The id target under some pixels of a frame, read back by
+/// [`PreparedFrame::read_ids`], with the frame's instance order.
+#[derive(Clone, Debug)]
+pub struct PickedIds {
+    order: Vec<u32>,
+    /// (instance slot, stored triangle) per pixel, row by row.
+    words: Vec<u32>,
+}
+
+impl PickedIds {
+    /// What the pixels show, in the terms of the scene and store the frame was prepared
+    /// with (an error if the scene has another number of instances, or a mesh has left the
+    /// store since).
+    pub fn resolve(
+        &self,
+        store: &MeshStore,
+        scene: &Scene<'_>,
+        triangles: bool,
+    ) -> Result<RectPick> {
+        if scene.instances.len() != self.order.len() {
+            return Err(Error::Misuse(format!(
+                "the scene has {} instances, but the frame was prepared from one with {}",
+                scene.instances.len(),
+                self.order.len()
+            )));
+        }
         let mut pick = RectPick::default();
-        for pair in words.chunks_exact(2) {
+        for pair in self.words.chunks_exact(2) {
             let (slot, stored) = (pair[0], pair[1]);
             if slot == BACKGROUND_ID {
                 continue;
@@ -138,10 +173,10 @@ impl PreparedFrame {
                 pick.host = true;
                 continue;
             }
-            let instance = *order
-                .get(slot as usize)
-                .ok_or_else(|| Error::Device(format!("the id target holds instance slot {slot}")))?
-                as usize;
+            let instance =
+                *self.order.get(slot as usize).ok_or_else(|| {
+                    Error::Device(format!("the id target holds instance slot {slot}"))
+                })? as usize;
             pick.instances.push(instance);
             if triangles {
                 let mesh = scene.instances[instance].mesh;
@@ -154,6 +189,24 @@ impl PreparedFrame {
         pick.triangles.sort_unstable();
         pick.triangles.dedup();
         Ok(pick)
+    }
+
+    /// What the first pixel shows (the one pixel of a single-pixel read).
+    pub fn first(&self, store: &MeshStore, scene: &Scene<'_>) -> Result<Picked> {
+        let one = PickedIds {
+            order: self.order.clone(),
+            words: self.words.iter().copied().take(2).collect(),
+        };
+        let rect = one.resolve(store, scene, true)?;
+        Ok(match (rect.triangles.first(), rect.host) {
+            (Some(&(instance, triangle)), _) => Picked::Instance(InstanceHit {
+                instance,
+                mesh: scene.instances[instance].mesh,
+                triangle,
+            }),
+            (None, true) => Picked::Host,
+            (None, false) => Picked::Background,
+        })
     }
 }
 

@@ -5,7 +5,7 @@
 use crate::model::Model;
 use std::sync::{Arc, Mutex};
 use wirepass::camera::Orbit;
-use wirepass::gpu::{Composite, MeshId, RenderTarget};
+use wirepass::gpu::{Composite, MeshId, PickView, Picked, PickedIds, RenderTarget};
 use wirepass::{
     wgpu, DeferredPass, EdgeSelection, Instance, MeshStore, OutputTarget, PassOptions, Scene, Style,
 };
@@ -57,8 +57,11 @@ pub struct Gpu {
     view_format: wgpu::TextureFormat,
     pass: DeferredPass,
     store: MeshStore,
-    /// The store's id of each model mesh, uploaded with the current edge choice.
-    ids: Vec<MeshId>,
+    /// The store's id of each model mesh, uploaded with the current edge choice, and the
+    /// edges it draws.
+    ids: Vec<(MeshId, EdgeSelection)>,
+    /// The last frame drawn and its scene, which a click picks from.
+    last: Option<(wirepass::PreparedFrame, Scene<'static>)>,
     /// What the device reported on its own (WebGPU reports validation errors there, since a
     /// page cannot wait on an error scope), for the page to show.
     pub errors: Arc<Mutex<Vec<String>>>,
@@ -140,6 +143,7 @@ impl Gpu {
             view_format,
             pass,
             ids: Vec::new(),
+            last: None,
             errors,
         })
     }
@@ -152,7 +156,8 @@ impl Gpu {
     /// Uploads `model`'s meshes drawing `edges` (`None`: the file's own), replacing those
     /// uploaded before.
     pub fn upload(&mut self, model: &Model, edges: Option<EdgeSelection>) -> Result<(), String> {
-        for id in self.ids.drain(..) {
+        self.last = None;
+        for (id, _) in self.ids.drain(..) {
             self.store.remove(id).map_err(|e| e.to_string())?;
         }
         for (mesh, own) in &model.meshes {
@@ -161,7 +166,7 @@ impl Gpu {
                 .store
                 .insert(&self.device, &self.queue, &mesh, selection)
                 .map_err(|e| e.to_string())?;
-            self.ids.push(id);
+            self.ids.push((id, selection));
         }
         Ok(())
     }
@@ -229,7 +234,7 @@ impl Gpu {
         let instances: Vec<Instance> = model
             .instances
             .iter()
-            .map(|&(m, transform)| Instance::new(self.ids[m], transform))
+            .map(|&(m, transform)| Instance::new(self.ids[m].0, transform))
             .collect();
         let scene = Scene::borrowed(orbit.camera().to_view(aspect), &instances);
         let err = |e: wirepass::Error| e.to_string();
@@ -265,7 +270,57 @@ impl Gpu {
             self.pass.render(&mut pass, &frame).map_err(err)?;
         }
         self.queue.submit([encoder.finish()]);
+        self.last = Some((frame, Scene::new(scene.view, instances)));
         Ok(())
+    }
+
+    /// Starts reading what pixel `at` of the last frame shows; the future holds no borrow
+    /// of the page's state.
+    pub fn read_pick(
+        &self,
+        at: (u32, u32),
+    ) -> Result<impl std::future::Future<Output = wirepass::Result<PickedIds>> + 'static, String>
+    {
+        let (frame, _) = self.last.as_ref().ok_or("nothing is drawn yet")?;
+        frame
+            .read_ids(&self.device, &self.queue, at, (1, 1))
+            .map_err(|e| e.to_string())
+    }
+
+    /// What pixel `at` of the last frame shows, in words, from its ids read back.
+    pub fn describe_pick(
+        &self,
+        model: &Model,
+        ids: &PickedIds,
+        at: (u32, u32),
+    ) -> Result<String, String> {
+        let (frame, scene) = self.last.as_ref().ok_or("nothing is drawn yet")?;
+        let err = |e: wirepass::Error| e.to_string();
+        let hit = match ids.first(&self.store, scene).map_err(err)? {
+            Picked::Background => return Ok(format!("({}, {}): background", at.0, at.1)),
+            Picked::Host => return Ok(format!("({}, {}): the host", at.0, at.1)),
+            Picked::Instance(hit) => hit,
+        };
+        let (m, transform) = model.instances[hit.instance];
+        let view = PickView {
+            view: scene.view,
+            image: frame.output_size(),
+        };
+        let l = hit
+            .locate(&model.meshes[m].0, self.ids[m].1, transform, &view, at, 8.0)
+            .map_err(err)?;
+        let mut words = format!(
+            "instance {}, triangle {} (polygon {}) at ({:.4}, {:.4}, {:.4})",
+            hit.instance, l.triangle, l.polygon, l.point.x, l.point.y, l.point.z
+        );
+        if let Some(e) = l.edge {
+            let [a, b] = e.vertices;
+            words += &format!("; edge {a}-{b} at {:.1} px", e.distance_px);
+        }
+        if let Some(v) = l.vertex {
+            words += &format!("; vertex {} at {:.1} px", v.vertex, v.distance_px);
+        }
+        Ok(words)
     }
 
     /// Reads `texture` (of the canvas's format) back as RGBA8, sRGB.

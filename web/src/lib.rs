@@ -1,7 +1,8 @@
 //! The wirepass viewer page: the built-in scene, or a mesh file dropped on the page or
 //! opened with its picker (`.glb`, `.gltf` with embedded buffers, `.obj`, `.stl`, `.ply`),
 //! drawn by the deferred pass straight into a WebGPU canvas. Mouse and touch: drag orbits,
-//! right or middle drag (or shift-drag, or two fingers) pans, the wheel (or a pinch) zooms.
+//! right or middle drag (or shift-drag, or two fingers) pans, the wheel (or a pinch) zooms,
+//! a click (or tap) picks: the toolbar says what the pixel shows.
 //! Keys: `E` cycles the edges, `O` toggles outlines, `+`/`-` change the line width.
 //!
 //! `?adapter=high-performance|low-power|fallback` asks the browser for another adapter.
@@ -33,6 +34,10 @@ struct App {
     edges: usize,
     /// Pointers down on the canvas: id, position, button.
     pointers: Vec<(i32, f64, f64, i16)>,
+    /// Where the primary button went down, to tell a click (a pick) from a drag.
+    press: Option<(i32, f64, f64)>,
+    /// What the last click picked, in words.
+    picked: Option<String>,
     /// A frame is requested and not drawn yet.
     pending: bool,
     frames: u32,
@@ -116,6 +121,11 @@ impl Viewer {
     /// The last error the page showed (a file that could not be read, a device error).
     pub fn error(&self) -> Option<String> {
         self.app.borrow().error.clone()
+    }
+
+    /// What the last click on the canvas picked, in words (also shown in the toolbar).
+    pub fn picked(&self) -> Option<String> {
+        self.app.borrow().picked.clone()
     }
 
     /// The adapter the page runs on, as the browser names it.
@@ -208,6 +218,8 @@ impl App {
             style: Style::default(),
             edges: 0,
             pointers: Vec::new(),
+            press: None,
+            picked: None,
             pending: false,
             frames: 0,
             error: None,
@@ -430,6 +442,43 @@ fn open_file(app: &Shared, file: web_sys::File) {
     });
 }
 
+/// Picks what the canvas shows at CSS position `(x, y)` and says so in the toolbar.
+fn pick(app: &Shared, x: f64, y: f64) {
+    let (at, read) = {
+        let a = app.borrow();
+        let (w, h) = a.gpu.size();
+        let scale = |css: f64, px: u32, client: i32| {
+            ((css * f64::from(px) / f64::from(client.max(1))).floor() as u32).min(px - 1)
+        };
+        let at = (
+            scale(x.max(0.0), w, a.canvas.client_width()),
+            scale(y.max(0.0), h, a.canvas.client_height()),
+        );
+        (at, a.gpu.read_pick(at))
+    };
+    let app = app.clone();
+    wasm_bindgen_futures::spawn_local(async move {
+        let said = match read {
+            Ok(read) => match read.await {
+                Ok(ids) => {
+                    let a = app.borrow();
+                    a.gpu.describe_pick(&a.model, &ids, at)
+                }
+                Err(e) => Err(e.to_string()),
+            },
+            Err(e) => Err(e),
+        };
+        let mut a = app.borrow_mut();
+        match said {
+            Ok(words) => {
+                a.status.set_text_content(Some(&format!("picked {words}")));
+                a.picked = Some(words);
+            }
+            Err(e) => a.show_error(&format!("pick: {e}")),
+        }
+    });
+}
+
 /// Adds `handler` for `event` on `target` for the page's lifetime.
 fn listen<E: JsCast>(
     target: &web_sys::EventTarget,
@@ -461,6 +510,7 @@ fn wire_events(app: &Shared, root: &HtmlElement) -> Result<(), JsValue> {
                 f64::from(e.offset_y()),
                 e.button(),
             );
+            a.press = (p.3 == 0 && a.pointers.is_empty()).then_some((p.0, p.1, p.2));
             a.pointers.retain(|q| q.0 != p.0);
             a.pointers.push(p);
             e.prevent_default();
@@ -485,7 +535,19 @@ fn wire_events(app: &Shared, root: &HtmlElement) -> Result<(), JsValue> {
     )?;
     for end in ["pointerup", "pointercancel"] {
         listen(&canvas, end, app, |app, e: web_sys::PointerEvent| {
-            app.borrow_mut().pointers.retain(|p| p.0 != e.pointer_id());
+            let (x, y) = (f64::from(e.offset_x()), f64::from(e.offset_y()));
+            let click = {
+                let mut a = app.borrow_mut();
+                a.pointers.retain(|p| p.0 != e.pointer_id());
+                let press = a.press.take();
+                e.type_() == "pointerup"
+                    && press.is_some_and(|(id, px, py)| {
+                        id == e.pointer_id() && (x - px).abs() < 3.0 && (y - py).abs() < 3.0
+                    })
+            };
+            if click {
+                pick(app, x, y);
+            }
         })?;
     }
     listen(&canvas, "wheel", app, |app, e: web_sys::WheelEvent| {

@@ -490,6 +490,45 @@ async fn the_viewer_page_draws_turns_and_shows_a_dropped_glb() {
     console_log!("first frame: {background:.3} background, {surface:.3} surface, {lines:.4} lines");
     assert!(background > 0.05 && surface > 0.05 && lines > 0.002);
 
+    // A click on the surface picks it: the toolbar says which triangle.
+    let canvas_el: web_sys::HtmlElement = root
+        .query_selector("canvas")
+        .unwrap()
+        .unwrap()
+        .unchecked_into();
+    let rect = canvas_el.get_bounding_client_rect();
+    let sky = wirepass::Style::default().background.to_srgb8();
+    let w = viewer.width() as usize;
+    let surface_pixel = first
+        .chunks_exact(4)
+        .enumerate()
+        .position(|(i, p)| {
+            // Well inside the surface: this pixel and its neighbours are neither sky nor line.
+            let plain = |q: &[u8]| (0..3).any(|k| q[k].abs_diff(sky[k]) > 40) && q[0] > 100;
+            i > w
+                && i + w < first.len() / 4
+                && plain(p)
+                && plain(&first[4 * (i - w)..])
+                && plain(&first[4 * (i + w)..])
+        })
+        .expect("a surface pixel");
+    let (sx, sy) = ((surface_pixel % w) as f64, (surface_pixel / w) as f64);
+    let (cx, cy) = (rect.left() + sx + 0.5, rect.top() + sy + 0.5);
+    canvas_el
+        .dispatch_event(&pointer("pointerdown", cx, cy, 1))
+        .unwrap();
+    canvas_el
+        .dispatch_event(&pointer("pointerup", cx, cy, 0))
+        .unwrap();
+    until("a pick", 30.0, || {
+        viewer.picked().is_some() || viewer.error().is_some()
+    })
+    .await;
+    assert_eq!(viewer.error(), None);
+    let picked = viewer.picked().unwrap();
+    console_log!("a click at ({sx}, {sy}) picked {picked}");
+    assert!(picked.contains("triangle"), "{picked}");
+
     // A drag of 120 px to the right across the canvas.
     let canvas: web_sys::HtmlElement = root
         .query_selector("canvas")
