@@ -11,11 +11,11 @@ mod common;
 
 use wirepass::glam::{DMat4, DQuat, DVec3};
 use wirepass::gpu::{
-    read_texture, texture_2d, Canvas, DeferredPass, HostDepth, OutputTarget, PassOptions, PickView,
-    Picked, PreparedFrame,
+    read_texture, texture_2d, Canvas, DeferredPass, HostDepth, PassOptions, PickView, Picked,
+    PreparedFrame,
 };
-use wirepass::tools::offline::Uploaded;
 use wirepass::truth::draw_raycast;
+use wirepass::world::offscreen::{encode_shaded, Uploaded};
 use wirepass::world::{Object, Shot, World, WorldMesh, BACKGROUND};
 use wirepass::{wgpu, Camera, EdgeSelection, Error, InstanceStyle, Scene, Style};
 
@@ -90,22 +90,15 @@ fn encoded(world: World, canvas: Option<&wgpu::Texture>) -> Frame {
             matrices: view,
         });
     }
-    let frame = pass
-        .prepare(&ctx.device, &up.store, &scene, &style(), on)
-        .unwrap();
-    let usage = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC;
-    let output = texture_2d(&ctx.device, "output", SIZE, pass.output_format(), usage);
-    let target = output.create_view(&Default::default());
-    let mut encoder = ctx.device.create_command_encoder(&Default::default());
-    pass.encode(
-        &ctx.device,
-        &mut encoder,
-        &up.store,
-        &frame,
-        OutputTarget::Shaded(&target),
-    )
-    .unwrap();
-    ctx.queue.submit([encoder.finish()]);
+    let style = style();
+    let shot = Shot {
+        world: &world,
+        view,
+        style: &style,
+        size: SIZE,
+    };
+    let (frame, _image) =
+        encode_shaded(&ctx.device, &ctx.queue, &shot, &up, &mut pass, on).unwrap();
     ctx.finish().unwrap();
     Frame {
         world,
@@ -114,6 +107,14 @@ fn encoded(world: World, canvas: Option<&wgpu::Texture>) -> Frame {
         frame,
         view: PickView { view, image: SIZE },
     }
+}
+
+/// Where world point `p` falls in the image, in pixels (x right, y down), and its depth.
+fn on_screen(view: &PickView, p: DVec3) -> ((f64, f64), f64) {
+    let clip = view.view.view_projection() * p.extend(1.0);
+    let ndc = clip.truncate() / clip.w;
+    let (w, h) = (f64::from(view.image.0), f64::from(view.image.1));
+    (((ndc.x + 1.0) * 0.5 * w, (1.0 - ndc.y) * 0.5 * h), ndc.z)
 }
 
 #[test]
@@ -207,16 +208,11 @@ fn every_pixel_picks_what_the_id_map_and_the_ground_truth_show() {
             }
             located += 1;
             // The point lies on the pixel's ray, at the ground truth's depth.
-            let clip = f.view.view.view_projection() * at.point.extend(1.0);
-            let ndc = clip.truncate() / clip.w;
-            let px = (
-                (ndc.x + 1.0) * 0.5 * f64::from(SIZE.0),
-                (1.0 - ndc.y) * 0.5 * f64::from(SIZE.1),
-            );
+            let (px, depth) = on_screen(&f.view, at.point);
             worst_reprojection = worst_reprojection
                 .max((px.0 - (f64::from(x) + 0.5)).abs())
                 .max((px.1 - (f64::from(y) + 0.5)).abs());
-            worst_depth = worst_depth.max((ndc.z - f64::from(truth.depth[k])).abs());
+            worst_depth = worst_depth.max((depth - f64::from(truth.depth[k])).abs());
             // The normal faces the eye.
             let eye = f.view.view.eye();
             assert!(
@@ -272,18 +268,18 @@ f 1 2 3 4\nf 2 5 3\nf 5 6 7 8 9\n";
     let world = World::single(mesh, EdgeSelection::Polygon);
     let f = encoded(world, None);
     let mesh = &f.world.meshes[0].mesh;
+    let locate = |hit: &wirepass::gpu::InstanceHit, px, radius| {
+        let (edges, at) = (EdgeSelection::Polygon, DMat4::IDENTITY);
+        hit.locate(mesh, edges, at, &f.view, px, radius).unwrap()
+    };
     let mut polygons = Vec::new();
     for t in 0..6u32 {
         // The centroid of each triangle, on screen.
         let [a, b, c] =
             mesh.triangles()[t as usize].map(|v| mesh.positions()[v as usize].as_dvec3());
         let centroid = (a + b + c) / 3.0;
-        let clip = f.view.view.view_projection() * centroid.extend(1.0);
-        let ndc = clip.truncate() / clip.w;
-        let px = (
-            ((ndc.x + 1.0) * 0.5 * f64::from(SIZE.0)) as u32,
-            ((1.0 - ndc.y) * 0.5 * f64::from(SIZE.1)) as u32,
-        );
+        let ((sx, sy), _) = on_screen(&f.view, centroid);
+        let px = (sx as u32, sy as u32);
         let Picked::Instance(hit) = f
             .frame
             .pick(&ctx.device, &ctx.queue, &f.up.store, &f.scene, px)
@@ -292,28 +288,14 @@ f 1 2 3 4\nf 2 5 3\nf 5 6 7 8 9\n";
             panic!("triangle {t}'s centroid shows no triangle");
         };
         assert_eq!(hit.triangle, t);
-        let at = hit
-            .locate(
-                mesh,
-                EdgeSelection::Polygon,
-                DMat4::IDENTITY,
-                &f.view,
-                px,
-                1.0,
-            )
-            .unwrap();
+        let at = locate(&hit, px, 1.0);
         polygons.push(at.polygon);
     }
     assert_eq!(polygons, [0, 0, 1, 2, 2, 2]);
 
     // Vertex 7 (the pentagon's top), one pixel off: it snaps, with its index and position.
     let p = mesh.positions()[7].as_dvec3();
-    let clip = f.view.view.view_projection() * p.extend(1.0);
-    let ndc = clip.truncate() / clip.w;
-    let (sx, sy) = (
-        (ndc.x + 1.0) * 0.5 * f64::from(SIZE.0),
-        (1.0 - ndc.y) * 0.5 * f64::from(SIZE.1),
-    );
+    let ((sx, sy), _) = on_screen(&f.view, p);
     let px = ((sx - 1.0) as u32, (sy + 1.0) as u32);
     let Picked::Instance(hit) = f
         .frame
@@ -322,16 +304,7 @@ f 1 2 3 4\nf 2 5 3\nf 5 6 7 8 9\n";
     else {
         panic!("no triangle next to vertex 7");
     };
-    let at = hit
-        .locate(
-            mesh,
-            EdgeSelection::Polygon,
-            DMat4::IDENTITY,
-            &f.view,
-            px,
-            3.0,
-        )
-        .unwrap();
+    let at = locate(&hit, px, 3.0);
     let vertex = at.vertex.expect("a vertex within 3 px");
     assert_eq!(vertex.vertex, 7);
     assert!((vertex.position - p).length() < 1e-12);
@@ -340,16 +313,7 @@ f 1 2 3 4\nf 2 5 3\nf 5 6 7 8 9\n";
     assert!(edge.vertices.contains(&7), "{edge:?}");
     assert!(edge.t >= 0.0 && edge.t <= 1.0);
     // None within a radius of zero.
-    let at = hit
-        .locate(
-            mesh,
-            EdgeSelection::Polygon,
-            DMat4::IDENTITY,
-            &f.view,
-            px,
-            0.0,
-        )
-        .unwrap();
+    let at = locate(&hit, px, 0.0);
     assert_eq!((at.vertex, at.edge), (None, None));
 }
 

@@ -4,10 +4,8 @@
 //! [`InstanceHit::locate`](crate::gpu::InstanceHit::locate)).
 
 use crate::error::Result;
-use crate::gpu::{
-    texture_2d, Canvas, DeferredPass, GpuContext, OutputTarget, PassOptions, PickView, Picked,
-};
-use crate::tools::offline::Uploaded;
+use crate::gpu::{Canvas, DeferredPass, GpuContext, PassOptions, PickView, Picked};
+use crate::world::offscreen::{encode_shaded, Uploaded};
 use crate::world::Shot;
 use serde::Serialize;
 
@@ -77,31 +75,8 @@ pub fn pick(ctx: &GpuContext, shot: &Shot<'_>, at: (u32, u32), snap: f64) -> Res
     let up = Uploaded::new(device, queue, shot.world)?;
     let scene = up.scene(shot.world, shot.view);
     let mut pass = DeferredPass::new(device, PassOptions::default())?;
-    let frame = pass.prepare(
-        device,
-        &up.store,
-        &scene,
-        shot.style,
-        Canvas::new(shot.size),
-    )?;
-    let usage = wgpu::TextureUsages::STORAGE_BINDING;
-    let output = texture_2d(
-        device,
-        "wirepass pick",
-        shot.size,
-        pass.output_format(),
-        usage,
-    );
-    let view = output.create_view(&Default::default());
-    let mut encoder = device.create_command_encoder(&Default::default());
-    pass.encode(
-        device,
-        &mut encoder,
-        &up.store,
-        &frame,
-        OutputTarget::Shaded(&view),
-    )?;
-    queue.submit([encoder.finish()]);
+    let canvas = Canvas::new(shot.size);
+    let (frame, _image) = encode_shaded(device, queue, shot, &up, &mut pass, canvas)?;
     let picked = frame.pick(device, queue, &up.store, &scene, at);
     ctx.finish()?;
     let mut report = PickReport {

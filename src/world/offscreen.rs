@@ -86,6 +86,20 @@ pub async fn draw_deferred(
     pass: &mut DeferredPass,
     canvas: Canvas<'_>,
 ) -> Result<Rendering> {
+    let (frame, output) = encode_shaded(device, queue, shot, up, pass, canvas)?;
+    read_deferred(device, queue, shot, up, pass, &frame, &output).await
+}
+
+/// Prepares `shot` on `canvas` and encodes it with `pass` into a new storage texture of the
+/// canvas's size (`OutputTarget::Shaded`), and submits: the frame and its image.
+pub fn encode_shaded(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    shot: &Shot<'_>,
+    up: &Uploaded,
+    pass: &mut DeferredPass,
+    canvas: Canvas<'_>,
+) -> Result<(PreparedFrame, wgpu::Texture)> {
     let region = canvas.region;
     if region.image != shot.size {
         return Err(Error::Misuse(format!(
@@ -116,7 +130,7 @@ pub async fn draw_deferred(
         OutputTarget::Shaded(&view),
     )?;
     queue.submit([encoder.finish()]);
-    read_deferred(device, queue, shot, up, pass, &frame, &output).await
+    Ok((frame, output))
 }
 
 /// Reads back a deferred frame that `pass` has encoded and submitted, wherever its output

@@ -237,35 +237,16 @@ async fn misuse_is_reported_without_blocking() {
 #[wasm_bindgen_test]
 async fn picking_works_in_the_page() {
     use wirepass::gpu::{Canvas, PickView, Picked};
-    use wirepass::world::offscreen::Uploaded;
+    use wirepass::world::offscreen::{encode_shaded, Uploaded};
     use wirepass::world::BACKGROUND;
     let (device, queue, errors) = device().await;
     let case = cases::all().remove(0);
     let up = Uploaded::new(&device, &queue, &case.world).unwrap();
     let scene = up.scene(&case.world, case.view);
     let mut pass = DeferredPass::new(&device, PassOptions::default()).unwrap();
-    let frame = pass
-        .prepare(
-            &device,
-            &up.store,
-            &scene,
-            &case.style,
-            Canvas::new(cases::SIZE),
-        )
-        .unwrap();
-    let usage = wgpu::TextureUsages::STORAGE_BINDING;
-    let output = texture_2d(&device, "pick", cases::SIZE, pass.output_format(), usage);
-    let view = output.create_view(&Default::default());
-    let mut encoder = device.create_command_encoder(&Default::default());
-    pass.encode(
-        &device,
-        &mut encoder,
-        &up.store,
-        &frame,
-        OutputTarget::Shaded(&view),
-    )
-    .unwrap();
-    queue.submit([encoder.finish()]);
+    let canvas = Canvas::new(cases::SIZE);
+    let (frame, _image) =
+        encode_shaded(&device, &queue, &case.shot(), &up, &mut pass, canvas).unwrap();
 
     let truth = cases::truth(&case).unwrap();
     let first = case.world.first_ids();
