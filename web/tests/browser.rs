@@ -15,7 +15,7 @@
 mod cases;
 
 use std::sync::{Arc, Mutex};
-use wasm_bindgen::JsCast;
+use wasm_bindgen::{JsCast, JsValue};
 use wasm_bindgen_futures::JsFuture;
 use wasm_bindgen_test::{console_log, wasm_bindgen_test, wasm_bindgen_test_configure};
 use wirepass::gpu::{read_texture_async, texture_2d};
@@ -222,7 +222,14 @@ async fn misuse_is_reported_without_blocking() {
         .unwrap();
     sleep(100).await;
     let reported = errors.lock().unwrap().clone();
-    console_log!("reported by the device: {reported:?}");
+    console_log!(
+        "the device reported {} errors, the first: {}",
+        reported.len(),
+        reported
+            .first()
+            .and_then(|e| e.lines().next())
+            .unwrap_or("none")
+    );
     assert!(
         result.is_err() || !reported.is_empty(),
         "a texture of another device went unreported"
@@ -339,6 +346,43 @@ async fn picking_works_in_the_page() {
         "{:?}",
         errors.lock().unwrap()
     );
+}
+
+/// A browser without WebGPU (here `navigator.gpu` hidden for the test, then restored) gets a
+/// message on the page saying so, and `start` rejects with it: no blank canvas, no panic.
+#[wasm_bindgen_test]
+async fn a_browser_without_webgpu_gets_a_message() {
+    use js_sys::{Object, Reflect};
+    let window = web_sys::window().unwrap();
+    let navigator: JsValue = window.navigator().into();
+    let hidden = Object::new();
+    Reflect::set(&hidden, &"value".into(), &JsValue::UNDEFINED).unwrap();
+    Reflect::set(&hidden, &"configurable".into(), &true.into()).unwrap();
+    let target: &Object = navigator.unchecked_ref();
+    Object::define_property(target, &JsValue::from_str("gpu"), &hidden);
+    let document = window.document().unwrap();
+    let root: web_sys::HtmlElement = document.create_element("div").unwrap().unchecked_into();
+    document.body().unwrap().append_child(&root).unwrap();
+    let started = wirepass_web::start(root.clone()).await;
+    // Restore the browser's own navigator.gpu for the other tests.
+    Reflect::delete_property(target, &JsValue::from_str("gpu")).unwrap();
+    assert!(!Reflect::get(&navigator, &"gpu".into())
+        .unwrap()
+        .is_undefined());
+
+    let message = started
+        .err()
+        .and_then(|e| e.as_string())
+        .expect("start rejects");
+    console_log!("without WebGPU: {message}");
+    assert!(message.contains("WebGPU"), "{message}");
+    let shown = root
+        .query_selector(".wirepass-error")
+        .unwrap()
+        .and_then(|p| p.text_content())
+        .unwrap_or_default();
+    assert_eq!(shown, message);
+    assert!(root.query_selector("canvas").unwrap().is_none());
 }
 
 async fn sleep(ms: i32) {
