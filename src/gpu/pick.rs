@@ -128,7 +128,15 @@ impl PreparedFrame {
         let (device, queue) = (device.clone(), queue.clone());
         let texture = self.id_texture().clone();
         Ok(async move {
-            let bytes = read_region_async(&device, &queue, &texture, texels, size).await?;
+            let bytes = read_region_async(
+                &device,
+                &queue,
+                &texture,
+                wgpu::TextureAspect::All,
+                texels,
+                size,
+            )
+            .await?;
             Ok(PickedIds {
                 order,
                 words: bytemuck::pod_collect_to_vec(&bytes),

@@ -17,7 +17,8 @@ pub fn read_texture(
     texture: &wgpu::Texture,
     aspect: wgpu::TextureAspect,
 ) -> Result<Vec<u8>> {
-    let copy = TextureCopy::submit(device, queue, texture, aspect)?;
+    let whole = ((0, 0), (texture.width(), texture.height()));
+    let copy = TextureCopy::submit(device, queue, texture, aspect, whole)?;
     let bytes = map_read(device, &copy.buffer)?;
     Ok(copy.unpad(&bytes))
 }
@@ -32,9 +33,8 @@ pub async fn read_texture_async(
     texture: &wgpu::Texture,
     aspect: wgpu::TextureAspect,
 ) -> Result<Vec<u8>> {
-    let copy = TextureCopy::submit(device, queue, texture, aspect)?;
-    let bytes = map_read_async(device, &copy.buffer).await?;
-    Ok(copy.unpad(&bytes))
+    let size = (texture.width(), texture.height());
+    read_region_async(device, queue, texture, aspect, (0, 0), size).await
 }
 
 /// A texture copied into a mappable buffer, rows padded to wgpu's copy alignment.
@@ -46,39 +46,29 @@ struct TextureCopy {
     height: u32,
 }
 
-/// Reads the `size` texels at `origin` of a 2D texture (mip 0, layer 0) as
-/// [`read_texture_async`] reads a whole one: a pick reads a few bytes, not the frame.
+/// Reads the `size` texels at `origin` of a 2D texture (mip 0, layer 0), as
+/// [`read_texture_async`] does for all of them: a pick reads a few bytes, not the frame.
 pub(crate) async fn read_region_async(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     texture: &wgpu::Texture,
+    aspect: wgpu::TextureAspect,
     origin: (u32, u32),
     size: (u32, u32),
 ) -> Result<Vec<u8>> {
-    let aspect = wgpu::TextureAspect::All;
-    let copy = TextureCopy::submit_region(device, queue, texture, aspect, origin, size)?;
+    let copy = TextureCopy::submit(device, queue, texture, aspect, (origin, size))?;
     let bytes = map_read_async(device, &copy.buffer).await?;
     Ok(copy.unpad(&bytes))
 }
 
 impl TextureCopy {
+    /// Copies the `size` texels at `origin` into a mappable buffer and submits the copy.
     fn submit(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         texture: &wgpu::Texture,
         aspect: wgpu::TextureAspect,
-    ) -> Result<TextureCopy> {
-        let size = (texture.width(), texture.height());
-        Self::submit_region(device, queue, texture, aspect, (0, 0), size)
-    }
-
-    fn submit_region(
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        texture: &wgpu::Texture,
-        aspect: wgpu::TextureAspect,
-        (x, y): (u32, u32),
-        (width, height): (u32, u32),
+        ((x, y), (width, height)): ((u32, u32), (u32, u32)),
     ) -> Result<TextureCopy> {
         let inside =
             |at: u32, len: u32, of: u32| len > 0 && at.checked_add(len).is_some_and(|e| e <= of);

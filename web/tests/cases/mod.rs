@@ -17,7 +17,9 @@ use wirepass::gpu::{texture_2d, Canvas, Composite, HostDepth, OutputTarget, Rend
 use wirepass::truth::{draw_raycast, draw_raycast_over, HostOccluders};
 use wirepass::world::offscreen::{draw_deferred, read_deferred, Uploaded};
 use wirepass::world::{default_world, Object, Rendering, Shot, World, WorldMesh};
-use wirepass::{wgpu, DeferredPass, DepthRange, EdgeSelection, InstanceStyle, Mesh, PassOptions};
+use wirepass::{
+    wgpu, DeferredPass, DepthRange, EdgeSelection, InstanceStyle, Mesh, PassOptions, PreparedFrame,
+};
 use wirepass::{Result, Style};
 
 /// Every frame is this size: small enough for the ray cast to run in a page in seconds.
@@ -238,46 +240,15 @@ pub async fn draw(device: &wgpu::Device, queue: &wgpu::Queue, case: &Case) -> Re
             draw_deferred(device, queue, &shot, &up, &mut pass, canvas).await
         }
         (Output::RenderPass(format), _) => {
-            let options = PassOptions {
-                render_target: Some(RenderTarget {
-                    format: *format,
-                    sample_count: 1,
-                    depth_stencil: None,
-                    content: Composite::Shaded,
-                }),
-                ..Default::default()
-            };
-            let mut pass = DeferredPass::new(device, options)?.with_diagnostics();
+            let mut pass = DeferredPass::new(device, canvas_pass(*format))?.with_diagnostics();
             let scene = up.scene(&case.world, case.view);
             let frame = pass.prepare(device, &up.store, &scene, &case.style, SIZE)?;
             let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
             let target = texture_2d(device, "canvas-format target", SIZE, *format, usage);
             let view = target.create_view(&Default::default());
-            let mut encoder = device.create_command_encoder(&Default::default());
-            pass.encode(
-                device,
-                &mut encoder,
-                &up.store,
-                &frame,
-                OutputTarget::RenderPass,
-            )?;
-            {
-                let [r, g, b, a] = case.style.background.0.map(f64::from);
-                let mut host = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some("host"),
-                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                        view: &view,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(wgpu::Color { r, g, b, a }),
-                            store: wgpu::StoreOp::Store,
-                        },
-                    })],
-                    ..Default::default()
-                });
-                pass.render(&mut host, &frame)?;
-            }
+            let [r, g, b, a] = case.style.background.0.map(f64::from);
+            let clear = wgpu::Color { r, g, b, a };
+            let encoder = encode_into(device, &mut pass, &up, &frame, &view, clear)?;
             queue.submit([encoder.finish()]);
             let mut frame =
                 read_deferred(device, queue, &shot, &up, &mut pass, &frame, &target).await?;
@@ -366,16 +337,7 @@ pub async fn frame_time(
     let (lo, hi) = world.bounds();
     let aspect = f64::from(size.0) / f64::from(size.1);
     let scene = up.scene(&world, Camera::framing(lo, hi, aspect).to_view(aspect));
-    let options = PassOptions {
-        render_target: Some(RenderTarget {
-            format,
-            sample_count: 1,
-            depth_stencil: None,
-            content: Composite::Shaded,
-        }),
-        ..Default::default()
-    };
-    let mut pass = DeferredPass::new(device, options)?;
+    let mut pass = DeferredPass::new(device, canvas_pass(format))?;
     let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
     let target = texture_2d(device, "frame timer", size, format, usage);
     let view = target.create_view(&Default::default());
@@ -387,30 +349,7 @@ pub async fn frame_time(
     for _ in 0..frames + 2 {
         let start = clock();
         let frame = pass.prepare(device, &up.store, &scene, &style, size)?;
-        let mut encoder = device.create_command_encoder(&Default::default());
-        pass.encode(
-            device,
-            &mut encoder,
-            &up.store,
-            &frame,
-            OutputTarget::RenderPass,
-        )?;
-        {
-            let mut host = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("frame timer"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::WHITE),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                ..Default::default()
-            });
-            pass.render(&mut host, &frame)?;
-        }
+        let mut encoder = encode_into(device, &mut pass, &up, &frame, &view, wgpu::Color::WHITE)?;
         let one = wgpu::Extent3d {
             width: 1,
             height: 1,
@@ -424,4 +363,53 @@ pub async fn frame_time(
     let mut times = times.split_off(2);
     times.sort_by(f64::total_cmp);
     Ok(times[times.len() / 2])
+}
+
+/// A pass that composites into a page canvas's render pass of `format`.
+fn canvas_pass(format: wgpu::TextureFormat) -> PassOptions {
+    PassOptions {
+        render_target: Some(RenderTarget {
+            format,
+            sample_count: 1,
+            depth_stencil: None,
+            content: Composite::Shaded,
+        }),
+        ..Default::default()
+    }
+}
+
+/// Encodes `frame` and draws it into the host's render pass on `view`, cleared to `clear`,
+/// as a page draws into its canvas; the encoder is the caller's to finish.
+fn encode_into(
+    device: &wgpu::Device,
+    pass: &mut DeferredPass,
+    up: &Uploaded,
+    frame: &PreparedFrame,
+    view: &wgpu::TextureView,
+    clear: wgpu::Color,
+) -> Result<wgpu::CommandEncoder> {
+    let mut encoder = device.create_command_encoder(&Default::default());
+    pass.encode(
+        device,
+        &mut encoder,
+        &up.store,
+        frame,
+        OutputTarget::RenderPass,
+    )?;
+    let mut host = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("host"),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Clear(clear),
+                store: wgpu::StoreOp::Store,
+            },
+        })],
+        ..Default::default()
+    });
+    pass.render(&mut host, frame)?;
+    drop(host);
+    Ok(encoder)
 }
