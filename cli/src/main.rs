@@ -302,7 +302,7 @@ struct BenchArgs {
     /// (`polygon,feature:30`), each on its own upload, beside --edges in the same run.
     #[arg(long, value_delimiter = ',', value_parser = parse_edges)]
     compare_edges: Vec<EdgeSelection>,
-    /// Time only these methods, comma separated: floor, deferred, forward, two-pass
+    /// Time only these methods, comma separated: floor, deferred, forward, two-pass, gs
     /// [default: all of them].
     #[arg(long, value_delimiter = ',', value_parser = parse_timed)]
     methods: Vec<wirepass::tools::bench::Timed>,
@@ -363,6 +363,9 @@ fn bench_command(args: &BenchArgs) -> Result<()> {
     progress.finish_and_clear();
     let device = wirepass::tools::bench::DeviceInfo::of(&ctx);
     println!("{}\n", device.describe());
+    if let Some(gl) = runs.iter().find_map(|r| r.gl.as_ref()) {
+        println!("gs on {gl}\n");
+    }
     println!("{}", wirepass::tools::bench::markdown(&runs));
     let by_edges = wirepass::tools::bench::edges_markdown(&runs);
     if !by_edges.is_empty() {

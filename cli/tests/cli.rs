@@ -372,3 +372,55 @@ fn pick_prints_what_a_pixel_shows_as_json() {
         assert!(!lines.is_empty() && lines[0].contains("error"), "{err}");
     }
 }
+
+/// Where no OpenGL context can be made (here: a libEGL that is not there), the benchmark and
+/// `compare` report `gs` skipped with the reason, and time and judge the other methods.
+#[test]
+fn gs_is_skipped_with_its_reason_where_opengl_is_missing() {
+    let missing = "/nonexistent/libEGL.so.1";
+    let out = temp("bench-without-gl");
+    let bench = Command::new(env!("CARGO_BIN_EXE_wirepass"))
+        .env("WIREPASS_EGL_LIBRARY", missing)
+        .args(["bench", "sphere:500", "--size", "64x48", "--frames", "1"])
+        .args(["--warmup", "0", "--methods", "forward,gs", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&bench.stdout);
+    assert!(
+        bench.status.success(),
+        "{}",
+        String::from_utf8_lossy(&bench.stderr)
+    );
+    let gs_row = stdout
+        .lines()
+        .find(|l| l.contains("| gs |"))
+        .unwrap_or_default();
+    assert!(
+        gs_row.contains("skipped") && gs_row.contains(missing),
+        "{stdout}"
+    );
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("bench.json")).unwrap()).unwrap();
+    let runs = json["runs"].as_array().unwrap();
+    let forward = runs.iter().find(|r| r["method"] == "forward").unwrap();
+    assert!(forward["total_median_ms"].as_f64().unwrap() > 0.0);
+    let gs = runs.iter().find(|r| r["method"] == "gs").unwrap();
+    assert!(gs["skipped"].as_str().unwrap().contains(missing), "{gs}");
+
+    let out = temp("compare-without-gl");
+    let compare = Command::new(env!("CARGO_BIN_EXE_wirepass"))
+        .env("WIREPASS_EGL_LIBRARY", missing)
+        .args(["compare", "sphere:500", "--size", "64x48", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(compare.status.success());
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
+    let skipped = report["methods"]["gs"]["skipped"]
+        .as_str()
+        .unwrap_or_default();
+    assert!(skipped.contains(missing), "{report}");
+    assert!(report["methods"]["forward"]["id_agreement"].is_number());
+}

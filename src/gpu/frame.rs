@@ -145,9 +145,26 @@ pub(crate) struct FrameData {
     pub uniform_instances: bool,
 }
 
-impl FrameData {
+/// What a frame's GPU data is made from, on the CPU: the uniforms, one record per instance
+/// slot and the draw list. The deferred pass and the baselines upload it as [`FrameData`];
+/// the tools' OpenGL baseline binds the same bytes.
+pub(crate) struct FrameRecords {
+    pub uniforms: FrameUniforms,
+    pub records: Vec<InstanceRecord>,
+    pub draws: Vec<DrawGroup>,
+    /// For each instance slot, the scene's instance index (slots group instances by mesh).
+    pub order: Vec<u32>,
+    pub store: StoreBuffers,
+    /// Pixels of guard band around the output in the targets.
+    pub guard: u32,
+    pub outlines: bool,
+    pub patches: bool,
+    pub mixed_colors: bool,
+}
+
+impl FrameRecords {
     /// Validates the scene, style and region against the device and the store, and builds
-    /// the frame's GPU data; with `guarded`, the targets have a guard band ([`guard_band`]).
+    /// the frame's records; with `guarded`, the targets have a guard band ([`guard_band`]).
     pub fn new(
         device: &wgpu::Device,
         store: &MeshStore,
@@ -155,7 +172,7 @@ impl FrameData {
         style: &Style,
         region: Region,
         guarded: bool,
-    ) -> Result<FrameData> {
+    ) -> Result<FrameRecords> {
         region.validate()?;
         scene.validate()?;
         style.validate()?;
@@ -274,6 +291,42 @@ impl FrameData {
             host_depth: 0,
             _pad: [0; 2],
         };
+        Ok(FrameRecords {
+            uniforms,
+            records,
+            draws,
+            order,
+            store: buffers,
+            guard,
+            outlines,
+            patches,
+            mixed_colors,
+        })
+    }
+}
+
+impl FrameData {
+    /// Validates the scene, style and region against the device and the store, and uploads
+    /// the frame's records ([`FrameRecords::new`]).
+    pub fn new(
+        device: &wgpu::Device,
+        store: &MeshStore,
+        scene: &Scene<'_>,
+        style: &Style,
+        region: Region,
+        guarded: bool,
+    ) -> Result<FrameData> {
+        let FrameRecords {
+            uniforms,
+            records,
+            draws,
+            order,
+            store: buffers,
+            guard,
+            outlines,
+            patches,
+            mixed_colors,
+        } = FrameRecords::new(device, store, scene, style, region, guarded)?;
         let frame = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("wirepass frame"),
             contents: bytemuck::bytes_of(&uniforms),

@@ -54,6 +54,7 @@ pub(crate) use frame::light_world_dir;
 #[cfg(feature = "truth")]
 pub(crate) use host_depth::depth_quantum;
 pub use mesh_store::{MeshId, MeshStore};
+// For the tools' OpenGL baseline, which draws the same store and records.
 pub use options::{OutputTarget, PassOptions, TriangleIds};
 pub use pick::{
     EdgeSnap, InstanceHit, Location, PickView, Picked, PickedIds, RectPick, VertexSnap,
@@ -70,3 +71,10 @@ pub use timing::GpuTimer;
 use timing::GpuTimer;
 #[cfg(feature = "diagnostics")]
 pub use variants::shader_modules;
+#[cfg(all(feature = "tools", not(target_arch = "wasm32")))]
+pub(crate) use {
+    baselines::NO_EDGE,
+    frame::{FrameRecords, INSTANCE_BYTES, UNIFORM_INSTANCE_CAPACITY},
+    mesh_store::VERTEX_BYTES,
+    readback::read_buffer,
+};

@@ -10,6 +10,7 @@ use crate::gpu::{
 };
 use crate::mesh::EdgeSelection;
 use crate::style::Style;
+use crate::tools::gs::{GsFrame, GsPass};
 use crate::tools::offline::Uploaded;
 use crate::world::{Shot, World};
 use std::collections::BTreeMap;
@@ -66,6 +67,14 @@ pub struct Run {
     /// The deferred method's edge pass: share of output tiles the tile dispatch visited and
     /// of pixels the refine dispatch decided, in the last frame.
     pub edge_work: Option<EdgeShares>,
+    /// Why the method was not timed (`gs` where no OpenGL context with geometry shaders
+    /// could be made); its times are then NaN.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub skipped: Option<String>,
+    /// For `gs`, which runs on OpenGL rather than the wgpu adapter: the GL renderer and
+    /// version, and how its GPU time was taken.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub gl: Option<String>,
 }
 
 /// The deferred edge pass's later dispatches, as shares of the output.
@@ -98,6 +107,8 @@ enum Subject {
     ),
     Forward(ForwardPass, RasterFrame, wgpu::Texture),
     TwoPass(TwoPass, RasterFrame, wgpu::Texture),
+    /// The published method on OpenGL, timed with GL timer queries.
+    Gs(Box<GsPass>, GsFrame),
 }
 
 impl Subject {
@@ -108,7 +119,29 @@ impl Subject {
             Subject::Edges(edges, ..) => format!("deferred {}", edges_name(*edges)),
             Subject::Forward(..) => "forward".into(),
             Subject::TwoPass(..) => "two-pass".into(),
+            Subject::Gs(..) => "gs".into(),
         }
+    }
+
+    /// Draws one frame and waits for it: the GPU time of each timestamped span, and the CPU
+    /// time to record and submit the frame, in milliseconds.
+    fn time(
+        &self,
+        (device, queue): (&wgpu::Device, &wgpu::Queue),
+        data: (&MeshStore, &EdgeLines),
+        timer: &mut GpuTimer,
+    ) -> Result<(Vec<(&'static str, f64)>, f64)> {
+        if let Subject::Gs(pass, frame) = self {
+            let (gpu, cpu) = pass.draw_timed(frame)?;
+            return Ok((vec![("draw", gpu)], cpu));
+        }
+        let start = Instant::now();
+        let mut encoder = device.create_command_encoder(&Default::default());
+        self.encode(device, &mut encoder, data, timer)?;
+        timer.resolve(&mut encoder);
+        queue.submit([encoder.finish()]);
+        let recorded = start.elapsed().as_secs_f64() * 1e3;
+        Ok((timer.read(device)?, recorded))
     }
 
     fn encode(
@@ -192,9 +225,14 @@ impl Subject {
                     },
                 )
             }
+            Subject::Gs(..) => Err(Error::Misuse(
+                "gs draws on OpenGL, not into a wgpu encoder".into(),
+            )),
         }
     }
 
+    /// GPU memory the method allocates beyond the wgpu mesh store, which all the wgpu
+    /// methods share.
     fn bytes(&self, lines: &EdgeLines) -> u64 {
         let texture = |t: &wgpu::Texture| u64::from(t.width()) * u64::from(t.height()) * 4;
         // Colour, id (8 bytes), depth and diagnostic targets of the forward methods.
@@ -204,6 +242,7 @@ impl Subject {
             Subject::Edges(_, up, p, _, t) => up.store.gpu_bytes() + p.target_bytes() + texture(t),
             Subject::Forward(_, _, t) => forward(t),
             Subject::TwoPass(_, _, t) => forward(t) + lines.gpu_bytes(),
+            Subject::Gs(pass, frame) => pass.gpu_bytes() + frame.gpu_bytes(),
         }
     }
 }
@@ -220,15 +259,18 @@ pub enum Timed {
     Forward,
     /// The two-pass method (biased fill, then lines).
     TwoPass,
+    /// The published single-pass method with its geometry shader, on OpenGL.
+    Gs,
 }
 
 impl Timed {
     /// Every method, in the order they are timed within a frame.
-    pub const ALL: [Timed; 4] = [
+    pub const ALL: [Timed; 5] = [
         Timed::Floor,
         Timed::Deferred,
         Timed::Forward,
         Timed::TwoPass,
+        Timed::Gs,
     ];
 
     /// The method's name in tables and `bench.json`.
@@ -238,6 +280,7 @@ impl Timed {
             Timed::Deferred => "deferred",
             Timed::Forward => "forward",
             Timed::TwoPass => "two-pass",
+            Timed::Gs => "gs",
         }
     }
 }
@@ -251,7 +294,7 @@ impl std::str::FromStr for Timed {
             .find(|m| m.name() == s.trim())
             .ok_or_else(|| {
                 Error::InvalidSetting(format!(
-                    "unknown method {s:?}: floor, deferred, forward or two-pass"
+                    "unknown method {s:?}: floor, deferred, forward, two-pass or gs"
                 ))
             })
     }
@@ -369,6 +412,20 @@ pub fn bench_scene(
         let frame = two_pass.prepare(device, &up.store, &scene, shot.style, size)?;
         subjects.push(Subject::TwoPass(two_pass, frame, attachment()));
     }
+    // Where no OpenGL context with geometry shaders can be made, gs is reported skipped.
+    let mut skipped = Vec::new();
+    if timed(Timed::Gs) {
+        let gpu = (device, queue);
+        let made = GsPass::new().and_then(|mut pass| {
+            let frame = pass.prepare(gpu, &up.store, &scene, shot.style, (size, false))?;
+            Ok(Subject::Gs(Box::new(pass), frame))
+        });
+        match made {
+            Ok(subject) => subjects.push(subject),
+            Err(Error::NoAdapter(why)) => skipped.push(("gs", why)),
+            Err(e) => return Err(e),
+        }
+    }
     ctx.finish()?;
 
     // Room for every span a frame can have (the host's depth seeding included), and more.
@@ -378,13 +435,8 @@ pub fn bench_scene(
     let mut cpu = vec![Vec::new(); subjects.len()];
     for frame in 0..warmup + frames {
         for (i, subject) in subjects.iter().enumerate() {
-            let start = Instant::now();
-            let mut encoder = device.create_command_encoder(&Default::default());
-            subject.encode(device, &mut encoder, (&up.store, &lines), &mut timer)?;
-            timer.resolve(&mut encoder);
-            queue.submit([encoder.finish()]);
-            let recorded = start.elapsed().as_secs_f64() * 1e3;
-            let spans = timer.read(device)?;
+            let (spans, recorded) =
+                subject.time((device, queue), (&up.store, &lines), &mut timer)?;
             ctx.finish()?;
             if frame >= warmup {
                 cpu[i].push(recorded);
@@ -433,9 +485,38 @@ pub fn bench_scene(
                 .collect(),
             total_median_ms: Stats::of(&totals[i]).median_ms,
             cpu: Stats::of(&cpu[i]),
-            gpu_bytes: store_bytes + subject.bytes(&lines),
+            gpu_bytes: match subject {
+                Subject::Gs(..) => subject.bytes(&lines),
+                _ => store_bytes + subject.bytes(&lines),
+            },
             edge_work: shares[i],
+            skipped: None,
+            gl: match subject {
+                Subject::Gs(pass, _) => Some(format!(
+                    "{}; timed by {}",
+                    pass.description(),
+                    pass.timing()
+                )),
+                _ => None,
+            },
         })
+        .chain(skipped.into_iter().map(|(method, why)| Run {
+            scene: name.to_owned(),
+            triangles: shot.world.triangle_count(),
+            size: [size.0, size.1],
+            method: method.to_owned(),
+            passes: BTreeMap::new(),
+            total_median_ms: f64::NAN,
+            cpu: Stats {
+                median_ms: f64::NAN,
+                p10_ms: f64::NAN,
+                p90_ms: f64::NAN,
+            },
+            gpu_bytes: 0,
+            edge_work: None,
+            skipped: Some(why),
+            gl: None,
+        }))
         .collect())
 }
 
@@ -499,6 +580,18 @@ pub fn markdown(runs: &[Run]) -> String {
          |---|---:|---|---|---:|---:|---:|---:|---:|\n",
     );
     for r in runs {
+        if let Some(why) = &r.skipped {
+            out += &format!(
+                "| {} | {} | {}x{} | {} | – | skipped: {} | – | – | – |\n",
+                r.scene,
+                r.triangles,
+                r.size[0],
+                r.size[1],
+                r.method,
+                why.replace('|', "/")
+            );
+            continue;
+        }
         let deferred = runs
             .iter()
             .find(|d| d.scene == r.scene && d.size == r.size && d.method == "deferred")
@@ -682,11 +775,12 @@ mod plot {
         });
     }
 
-    const COLORS: [RGBColor; 4] = [
+    const COLORS: [RGBColor; 5] = [
         RGBColor(120, 120, 120),
         RGBColor(31, 119, 180),
         RGBColor(214, 39, 40),
         RGBColor(44, 160, 44),
+        RGBColor(255, 127, 14),
     ];
     /// The deferred method's own passes, drawn thin beside the totals.
     const PASSES: [(&str, RGBColor); 2] = [

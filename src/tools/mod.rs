@@ -10,6 +10,8 @@
 pub mod bench;
 #[cfg(feature = "tools")]
 pub mod compare;
+#[cfg(all(feature = "tools", not(target_arch = "wasm32")))]
+pub mod gs;
 #[cfg(feature = "tools")]
 pub mod load;
 #[cfg(feature = "tools")]

@@ -24,6 +24,10 @@ pub enum Method {
     Forward,
     /// Two-pass baseline: shaded fill with depth bias, then the drawn edges as 1 px lines.
     TwoPass,
+    /// The forward single-pass method as published, with its geometry shader over an
+    /// indexed draw, on native OpenGL ([`gs`](crate::tools::gs)); it draws what `forward`
+    /// draws.
+    Gs,
 }
 
 impl Method {
@@ -33,6 +37,7 @@ impl Method {
         Method::Deferred,
         Method::Forward,
         Method::TwoPass,
+        Method::Gs,
     ];
 
     /// The name used on the command line and in reports.
@@ -42,6 +47,7 @@ impl Method {
             Method::Deferred => "deferred",
             Method::Forward => "forward",
             Method::TwoPass => "two-pass",
+            Method::Gs => "gs",
         }
     }
 }
@@ -67,6 +73,7 @@ pub fn draw(ctx: &GpuContext, shot: &Shot<'_>, method: Method) -> Result<Renderi
         Method::Deferred => draw_deferred(ctx, shot),
         Method::Forward => draw_forward(ctx, shot),
         Method::TwoPass => draw_two_pass(ctx, shot),
+        Method::Gs => draw_gs(ctx, shot),
     }
 }
 
@@ -201,6 +208,29 @@ pub fn draw_two_pass(ctx: &GpuContext, shot: &Shot<'_>) -> Result<Rendering> {
         frame.instance_order(),
         &output,
         maps,
+    )
+}
+
+/// Renders `shot` with the published geometry-shader method on OpenGL and reads back the
+/// image and maps, which hold what the forward method's hold. An
+/// [`Error::NoAdapter`] where no OpenGL context with geometry shaders can be made.
+pub fn draw_gs(ctx: &GpuContext, shot: &Shot<'_>) -> Result<Rendering> {
+    let mut pass = crate::tools::gs::GsPass::new()?;
+    let up = Uploaded::new(&ctx.device, &ctx.queue, shot.world)?;
+    let scene = up.scene(shot.world, shot.view);
+    let gpu = (&ctx.device, &ctx.queue);
+    let frame = pass.prepare(gpu, &up.store, &scene, shot.style, (shot.size, true))?;
+    pass.draw(&frame, true)?;
+    let pixels = pass.read(&frame)?;
+    let order = frame.instance_order().to_vec();
+    pass.release(frame);
+    offscreen::maps_rendering(
+        shot,
+        (shot.size, &up),
+        &order,
+        pixels.rgba,
+        &pixels.ids,
+        &pixels.diagnostic,
     )
 }
 

@@ -202,10 +202,24 @@ pub async fn read_rendering(
         .chunks_exact(per_pixel / 4)
         .map(|w| [w[0], w[1]])
         .collect();
+    maps_rendering(shot, (size, up), order, rgba, &raw, &diagnostic)
+}
+
+/// A frame read back as the forward passes' maps hold it (the 8-bit output, (slot,
+/// triangle) ids, and per pixel the distance, ≥ 1e38 meaning none, and the reverse depth),
+/// converted to [`Rendering`]'s conventions.
+pub fn maps_rendering(
+    shot: &Shot<'_>,
+    (size, up): ((u32, u32), &Uploaded),
+    order: &[u32],
+    rgba: Vec<u8>,
+    raw: &[[u32; 2]],
+    diagnostic: &[[f32; 4]],
+) -> Result<Rendering> {
     Ok(Rendering {
         size,
         rgba,
-        ids: up.global_ids(shot.world, order, &raw)?,
+        ids: up.global_ids(shot.world, order, raw)?,
         // Reverse depth back to the standard convention.
         depth: diagnostic
             .iter()

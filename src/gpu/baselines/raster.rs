@@ -14,7 +14,7 @@ use crate::scene::Scene;
 use crate::style::Style;
 
 /// The distance the shaders write where no edge is drawn (WGSL `NO_EDGE`).
-const NO_EDGE: f32 = 3.0e38;
+pub(crate) const NO_EDGE: f32 = 3.0e38;
 
 /// Format of the forward passes' diagnostic map: the **bit patterns** of `f32` values
 /// (red = distance in pixels, green = reverse depth), because float render targets are not
