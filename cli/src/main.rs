@@ -6,6 +6,7 @@ use std::process::ExitCode;
 use wirepass::glam::Vec3;
 use wirepass::gpu::GpuContext;
 use wirepass::style::{DepthFade, DEFAULT_LINE_WIDTH};
+use wirepass::tools::bench::Timed;
 use wirepass::tools::load::{load_world, parse_size, parse_vec3, CameraPlacement, WorldOptions};
 use wirepass::tools::offline::{draw, Method};
 use wirepass::world::{Shot, World};
@@ -294,10 +295,11 @@ struct BenchArgs {
     /// Directory for bench.json, bench.csv and the plots.
     #[arg(long)]
     out: PathBuf,
-    /// Time the deferred method with its outline pass (on) or without (off, the same lines
-    /// the forward baselines draw).
-    #[arg(long, default_value = "on", value_parser = parse_switch, action = clap::ArgAction::Set)]
-    silhouettes: bool,
+    /// Time the deferred method with its outline pass (on), without (off, the same lines
+    /// the forward baselines draw), or both (`on,off`); the methods that draw no outline
+    /// (forward, two-pass, gs) are timed with the first setting only.
+    #[arg(long, default_value = "on", value_delimiter = ',', value_parser = parse_switch)]
+    silhouettes: Vec<bool>,
     /// Also time the deferred method drawing these edge selections, comma separated
     /// (`polygon,feature:30`), each on its own upload, beside --edges in the same run.
     #[arg(long, value_delimiter = ',', value_parser = parse_edges)]
@@ -305,10 +307,10 @@ struct BenchArgs {
     /// Time only these methods, comma separated: floor, deferred, forward, two-pass, gs
     /// [default: all of them].
     #[arg(long, value_delimiter = ',', value_parser = parse_timed)]
-    methods: Vec<wirepass::tools::bench::Timed>,
+    methods: Vec<Timed>,
 }
 
-fn parse_timed(s: &str) -> std::result::Result<wirepass::tools::bench::Timed, String> {
+fn parse_timed(s: &str) -> std::result::Result<Timed, String> {
     s.parse().map_err(|e: wirepass::Error| e.to_string())
 }
 
@@ -324,7 +326,8 @@ fn bench_command(args: &BenchArgs) -> Result<()> {
         args.scenes.iter().map(|s| Some(s.as_str())).collect()
     };
     let ctx = GpuContext::new()?;
-    let progress = indicatif::ProgressBar::new((specs.len() * sizes.len()) as u64);
+    let settings = specs.len() * sizes.len() * args.silhouettes.len();
+    let progress = indicatif::ProgressBar::new(settings as u64);
     if !std::io::IsTerminal::is_terminal(&std::io::stderr()) {
         progress.set_draw_target(indicatif::ProgressDrawTarget::hidden());
     }
@@ -341,36 +344,49 @@ fn bench_command(args: &BenchArgs) -> Result<()> {
         print_notes(&loaded.notes);
         let world = loaded.world;
         for &size in &sizes {
-            progress.set_message(format!("{name} at {}x{}", size.0, size.1));
-            let style = Style {
-                silhouettes: args.silhouettes,
-                line_width: args.line_width.unwrap_or(DEFAULT_LINE_WIDTH),
-                ..Style::default()
-            };
-            style.validate()?;
-            let timing = wirepass::tools::bench::Timing {
-                frames: args.frames,
-                warmup: args.warmup,
-                edges: args.compare_edges.clone(),
-                methods: args.methods.clone(),
-            };
-            runs.extend(wirepass::tools::bench::bench(
-                &ctx, name, &world, size, &style, timing,
-            )?);
-            progress.inc(1);
+            for (k, &silhouettes) in args.silhouettes.iter().enumerate() {
+                let switch = if silhouettes { "on" } else { "off" };
+                progress.set_message(format!(
+                    "{name} at {}x{}, outlines {switch}",
+                    size.0, size.1
+                ));
+                let style = Style {
+                    silhouettes,
+                    line_width: args.line_width.unwrap_or(DEFAULT_LINE_WIDTH),
+                    ..Style::default()
+                };
+                style.validate()?;
+                // Only the deferred methods draw outlines: the others once.
+                let mut methods = args.methods.clone();
+                if k > 0 {
+                    if methods.is_empty() {
+                        methods = Timed::ALL.to_vec();
+                    }
+                    methods.retain(|m| m.draws_outlines());
+                    if methods.is_empty() {
+                        progress.inc(1);
+                        continue;
+                    }
+                }
+                let timing = wirepass::tools::bench::Timing {
+                    frames: args.frames,
+                    warmup: args.warmup,
+                    edges: args.compare_edges.clone(),
+                    methods,
+                };
+                runs.extend(wirepass::tools::bench::bench(
+                    &ctx, name, &world, size, &style, timing,
+                )?);
+                progress.inc(1);
+            }
         }
     }
     progress.finish_and_clear();
     let device = wirepass::tools::bench::DeviceInfo::of(&ctx);
-    println!("{}\n", device.describe());
-    if let Some(gl) = runs.iter().find_map(|r| r.gl.as_ref()) {
-        println!("gs on {gl}\n");
-    }
-    println!("{}", wirepass::tools::bench::markdown(&runs));
-    let by_edges = wirepass::tools::bench::edges_markdown(&runs);
-    if !by_edges.is_empty() {
-        println!("{by_edges}");
-    }
+    print!(
+        "{}",
+        wirepass::tools::bench::report_markdown(&device, &runs)
+    );
     wirepass::tools::bench::write_outputs(&args.out, &device, &runs)?;
     eprintln!("wrote {}", args.out.display());
     Ok(())

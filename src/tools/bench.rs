@@ -53,6 +53,8 @@ pub struct Run {
     pub size: [u32; 2],
     /// Method name.
     pub method: String,
+    /// Whether the style drew outlines (only the deferred methods draw them).
+    pub outlines: bool,
     /// GPU time of each pass, and of each group of passes: `edge` is the sum of its
     /// dispatches (`edge.classify`, `edge.border`, `edge.clear` or `edge.background`,
     /// `edge.outlined`, `edge.tiles`, `edge.refine`; the floor's `edge.floor`),
@@ -273,6 +275,11 @@ impl Timed {
         Timed::Gs,
     ];
 
+    /// Whether the method draws outlines, and so is timed with them on and off.
+    pub fn draws_outlines(self) -> bool {
+        matches!(self, Timed::Floor | Timed::Deferred)
+    }
+
     /// The method's name in tables and `bench.json`.
     pub fn name(self) -> &'static str {
         match self {
@@ -479,6 +486,7 @@ pub fn bench_scene(
             triangles: shot.world.triangle_count(),
             size: [size.0, size.1],
             method: subject.name(),
+            outlines: shot.style.silhouettes,
             passes: gpu[i]
                 .iter()
                 .map(|(name, v)| (name.clone(), Stats::of(v)))
@@ -505,6 +513,7 @@ pub fn bench_scene(
             triangles: shot.world.triangle_count(),
             size: [size.0, size.1],
             method: method.to_owned(),
+            outlines: shot.style.silhouettes,
             passes: BTreeMap::new(),
             total_median_ms: f64::NAN,
             cpu: Stats {
@@ -540,7 +549,9 @@ pub fn edges_markdown(runs: &[Run]) -> String {
         let others: Vec<&Run> = runs
             .iter()
             .filter(|r| {
-                r.scene == base.scene && r.size == base.size && r.method.starts_with("deferred ")
+                same_shot(r, base)
+                    && r.outlines == base.outlines
+                    && r.method.starts_with("deferred ")
             })
             .collect();
         if others.is_empty() {
@@ -576,17 +587,18 @@ pub fn edges_markdown(runs: &[Run]) -> String {
 /// same scene and size.
 pub fn markdown(runs: &[Run]) -> String {
     let mut out = String::from(
-        "| scene | triangles | size | method | visibility ms | edge/draw ms | total ms | vs deferred | GPU MiB |\n\
-         |---|---:|---|---|---:|---:|---:|---:|---:|\n",
+        "| scene | triangles | size | outlines | method | visibility ms | edge/draw ms | total ms | vs deferred | GPU MiB |\n\
+         |---|---:|---|---|---|---:|---:|---:|---:|---:|\n",
     );
     for r in runs {
         if let Some(why) = &r.skipped {
             out += &format!(
-                "| {} | {} | {}x{} | {} | – | skipped: {} | – | – | – |\n",
+                "| {} | {} | {}x{} | {} | {} | – | skipped: {} | – | – | – |\n",
                 r.scene,
                 r.triangles,
                 r.size[0],
                 r.size[1],
+                switch(r.outlines),
                 r.method,
                 why.replace('|', "/")
             );
@@ -594,7 +606,7 @@ pub fn markdown(runs: &[Run]) -> String {
         }
         let deferred = runs
             .iter()
-            .find(|d| d.scene == r.scene && d.size == r.size && d.method == "deferred")
+            .find(|d| same_shot(d, r) && d.outlines == r.outlines && d.method == "deferred")
             .map(|d| d.total_median_ms);
         let pass = |name: &str| {
             r.passes
@@ -620,11 +632,12 @@ pub fn markdown(runs: &[Run]) -> String {
             ));
         }
         out += &format!(
-            "| {} | {} | {}x{} | {} | {} | {} | {:.3} | {} | {:.1} |\n",
+            "| {} | {} | {}x{} | {} | {} | {} | {} | {:.3} | {} | {:.1} |\n",
             r.scene,
             r.triangles,
             r.size[0],
             r.size[1],
+            switch(r.outlines),
             r.method,
             pass("visibility"),
             other.join(", "),
@@ -634,6 +647,90 @@ pub fn markdown(runs: &[Run]) -> String {
                 .map(|d| format!("{:.2}×", r.total_median_ms / d))
                 .unwrap_or_else(|| "–".into()),
             r.gpu_bytes as f64 / (1024.0 * 1024.0),
+        );
+    }
+    out
+}
+
+/// `on` or `off`.
+fn switch(on: bool) -> &'static str {
+    if on {
+        "on"
+    } else {
+        "off"
+    }
+}
+
+/// Whether two runs timed the same scene at the same size.
+fn same_shot(a: &Run, b: &Run) -> bool {
+    a.scene == b.scene && a.size == b.size
+}
+
+/// One row per scene and size: each method's total (the deferred method's with outlines and
+/// without), the edge pass against the floor's compute pass, and the deferred method
+/// against the published one (`gs`); ms, medians. Ratios are given with outlines on / off
+/// where both were timed.
+pub fn summary_markdown(runs: &[Run]) -> String {
+    let mut out = String::from(
+        "| scene | triangles | size | floor | deferred | deferred, no outlines | forward | two-pass | gs | edge ÷ floor | deferred ÷ gs |\n\
+         |---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+    );
+    let mut shots: Vec<&Run> = Vec::new();
+    for r in runs {
+        if !shots.iter().any(|s| same_shot(s, r)) {
+            shots.push(r);
+        }
+    }
+    for shot in shots {
+        let find = |method: &str, outlines: Option<bool>| {
+            runs.iter().find(|r| {
+                same_shot(r, shot)
+                    && r.method == method
+                    && r.skipped.is_none()
+                    && outlines.is_none_or(|o| r.outlines == o)
+            })
+        };
+        let ms =
+            |r: Option<&Run>| r.map_or("–".to_owned(), |r| format!("{:.2}", r.total_median_ms));
+        let floor = find("floor", None);
+        let on = find("deferred", Some(true));
+        let off = find("deferred", Some(false));
+        let gs = find("gs", None);
+        let edge = |r: &Run| r.passes.get("edge").map(|s| s.median_ms);
+        let ratios = |f: &dyn Fn(&Run) -> Option<f64>| {
+            let parts: Vec<String> = [on, off]
+                .into_iter()
+                .flatten()
+                .filter_map(|d| f(d).map(|v| format!("{v:.2}×")))
+                .collect();
+            if parts.is_empty() {
+                "–".to_owned()
+            } else {
+                parts.join(" / ")
+            }
+        };
+        let edge_floor = ratios(&|d| Some(edge(d)? / edge(floor?)?));
+        let deferred_gs = ratios(&|d| Some(d.total_median_ms / gs?.total_median_ms));
+        out += &format!(
+            "| {} | {} | {}x{} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
+            shot.scene,
+            shot.triangles,
+            shot.size[0],
+            shot.size[1],
+            ms(floor),
+            ms(on),
+            ms(off),
+            ms(find("forward", None)),
+            ms(find("two-pass", None)),
+            match find("gs", None) {
+                Some(r) => ms(Some(r)),
+                None if runs.iter().any(|r| same_shot(r, shot) && r.method == "gs") => {
+                    "skipped".to_owned()
+                }
+                None => "–".to_owned(),
+            },
+            edge_floor,
+            deferred_gs,
         );
     }
     out
@@ -686,11 +783,32 @@ impl DeviceInfo {
     }
 }
 
-/// Writes `bench.json`, `bench.csv`, `time_vs_triangles.png` and `time_vs_pixels.png` into
-/// `dir`.
+/// The whole report in markdown: the adapter (and the OpenGL renderer `gs` ran on), the
+/// summary by scene ([`summary_markdown`]), every run's passes ([`markdown`]) and the edge
+/// selections' table ([`edges_markdown`]).
+pub fn report_markdown(device: &DeviceInfo, runs: &[Run]) -> String {
+    let mut out = format!("{}\n\n", device.describe());
+    if let Some(gl) = runs.iter().find_map(|r| r.gl.as_ref()) {
+        out += &format!("gs on {gl}\n\n");
+    }
+    out += &summary_markdown(runs);
+    out += "\n";
+    out += &markdown(runs);
+    let by_edges = edges_markdown(runs);
+    if !by_edges.is_empty() {
+        out += "\n";
+        out += &by_edges;
+    }
+    out
+}
+
+/// Writes `bench.md` ([`report_markdown`]), `bench.json`, `bench.csv`,
+/// `time_vs_triangles.png` and `time_vs_pixels.png` into `dir`.
 pub fn write_outputs(dir: &std::path::Path, device: &DeviceInfo, runs: &[Run]) -> Result<()> {
     let io = |path: std::path::PathBuf| move |source| Error::Io { path, source };
     std::fs::create_dir_all(dir).map_err(io(dir.to_owned()))?;
+    let path = dir.join("bench.md");
+    std::fs::write(&path, report_markdown(device, runs)).map_err(io(path.clone()))?;
     let json = serde_json::json!({ "device": device, "runs": runs });
     let path = dir.join("bench.json");
     let text = serde_json::to_string_pretty(&json)
@@ -698,26 +816,31 @@ pub fn write_outputs(dir: &std::path::Path, device: &DeviceInfo, runs: &[Run]) -
     std::fs::write(&path, text).map_err(io(path.clone()))?;
     let path = dir.join("bench.csv");
     std::fs::write(&path, csv(runs)).map_err(io(path.clone()))?;
+    // Lines join procedural scenes of one kind (`sphere:N`); a mesh file is a point.
+    let family = |r: &Run| match r.scene.split_once(':') {
+        Some((kind, _)) if !r.scene.contains('/') => kind.to_owned(),
+        _ => r.scene.clone(),
+    };
     plot::time_against(
         &dir.join("time_vs_triangles.png"),
         runs,
         "triangles",
         |r| r.triangles as f64,
-        |r| format!("{}x{}", r.size[0], r.size[1]),
+        (|r: &Run| format!("{}x{}", r.size[0], r.size[1]), family),
     )?;
     plot::time_against(
         &dir.join("time_vs_pixels.png"),
         runs,
         "pixels",
         |r| f64::from(r.size[0]) * f64::from(r.size[1]),
-        |r| r.scene.clone(),
+        (|r: &Run| r.scene.clone(), |_: &Run| String::new()),
     )
 }
 
 /// One row per run and pass (plus a `total` row per run).
 pub fn csv(runs: &[Run]) -> String {
     let mut out = String::from(
-        "scene,triangles,width,height,method,pass,median_ms,p10_ms,p90_ms,cpu_median_ms,gpu_bytes\n",
+        "scene,triangles,width,height,outlines,method,pass,median_ms,p10_ms,p90_ms,cpu_median_ms,gpu_bytes\n",
     );
     for r in runs {
         let total = Stats {
@@ -735,11 +858,12 @@ pub fn csv(runs: &[Run]) -> String {
                 }
             };
             out += &format!(
-                "{},{},{},{},{},{},{},{},{},{:.6},{}\n",
+                "{},{},{},{},{},{},{},{},{},{},{:.6},{}\n",
                 r.scene.replace(',', ";"),
                 r.triangles,
                 r.size[0],
                 r.size[1],
+                switch(r.outlines),
                 r.method,
                 pass,
                 num(s.median_ms),
@@ -790,8 +914,9 @@ mod plot {
 
     /// One plotted line.
     struct Line {
-        label: String,
-        color: RGBColor,
+        /// In the legend; the first line of each method and group only.
+        label: Option<String>,
+        color: RGBAColor,
         /// Stroke width in pixels.
         width: u32,
         points: Vec<(f64, f64)>,
@@ -809,28 +934,45 @@ mod plot {
         format!("{}{unit}", text.trim_end_matches(".0"))
     }
 
+    /// Whether `r` is a deferred method (or the floor) timed without outlines: drawn as a
+    /// line of its own, fainter.
+    fn without_outlines(r: &Run) -> bool {
+        !r.outlines && (r.method == "floor" || r.method.starts_with("deferred"))
+    }
+
     /// Median GPU time against `x` (log-log): the total per method, one colour per method
-    /// and one line per method and `group` (the variable held fixed along the line), and
-    /// thinner lines for the deferred method's edge and outline passes.
+    /// and one line per method, `group` (the variable held fixed along the line, named in
+    /// the legend) and `family` (scenes whose points a line may join: the spheres of
+    /// `sphere:N`, say; a mesh file is a point of its own), and thinner lines for the
+    /// deferred method's edge and outline passes. The deferred methods timed without
+    /// outlines are fainter lines of their own.
     pub fn time_against(
         path: &Path,
         runs: &[Run],
         x_name: &str,
         x: impl Fn(&Run) -> f64,
-        group: impl Fn(&Run) -> String,
+        (group, family): (impl Fn(&Run) -> String, impl Fn(&Run) -> String),
     ) -> Result<()> {
         register_font();
         let fail = |e: String| Error::Image {
             path: path.to_owned(),
             message: e,
         };
+        let group = |r: &Run| {
+            let suffix = if without_outlines(r) {
+                ", no outlines"
+            } else {
+                ""
+            };
+            format!("{}{suffix}", group(r))
+        };
         let mut methods: Vec<&str> = Vec::new();
-        let mut keys: Vec<(&str, String)> = Vec::new();
-        for r in runs {
+        let mut keys: Vec<(&str, String, String)> = Vec::new();
+        for r in runs.iter().filter(|r| r.skipped.is_none()) {
             if !methods.contains(&r.method.as_str()) {
                 methods.push(&r.method);
             }
-            let key = (r.method.as_str(), group(r));
+            let key = (r.method.as_str(), group(r), family(r));
             if !keys.contains(&key) {
                 keys.push(key);
             }
@@ -840,21 +982,30 @@ mod plot {
             .map(|l| &l.1)
             .collect::<std::collections::BTreeSet<_>>();
         let mut lines: Vec<Line> = Vec::new();
-        for (method, fixed) in &keys {
+        let mut labelled = std::collections::BTreeSet::new();
+        for (method, fixed, kind) in &keys {
             let chosen = || {
-                runs.iter()
-                    .filter(|r| r.method == *method && group(r) == *fixed)
+                runs.iter().filter(|r| {
+                    r.skipped.is_none()
+                        && r.method == *method
+                        && group(r) == *fixed
+                        && family(r) == *kind
+                })
             };
             let suffix = if groups.len() > 1 {
                 format!(" ({fixed})")
             } else {
                 String::new()
             };
+            let first = labelled.insert((*method, fixed.clone()));
+            let label = |name: String| first.then_some(name);
+            let faint = fixed.ends_with(", no outlines");
+            let shade = |c: RGBColor| c.mix(if faint { 0.45 } else { 1.0 });
             let m = methods.iter().position(|n| n == method).unwrap_or(0);
             let total = chosen().map(|r| (x(r), r.total_median_ms)).collect();
             lines.push(Line {
-                label: format!("{method}{suffix}"),
-                color: COLORS[m % COLORS.len()],
+                label: label(format!("{method}{suffix}")),
+                color: shade(COLORS[m % COLORS.len()]),
                 width: 2,
                 points: total,
             });
@@ -865,8 +1016,8 @@ mod plot {
                         .collect();
                     if !points.is_empty() {
                         lines.push(Line {
-                            label: format!("deferred: {pass} pass{suffix}"),
-                            color,
+                            label: label(format!("deferred: {pass} pass{suffix}")),
+                            color: shade(color),
                             width: 1,
                             points,
                         });
@@ -916,13 +1067,14 @@ mod plot {
             points: series,
         } in lines
         {
-            chart
+            let drawn = chart
                 .draw_series(LineSeries::new(series.clone(), color.stroke_width(width)))
-                .map_err(|e| fail(e.to_string()))?
-                .label(label)
-                .legend(move |(x, y)| {
+                .map_err(|e| fail(e.to_string()))?;
+            if let Some(label) = label {
+                drawn.label(label).legend(move |(x, y)| {
                     PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(width))
                 });
+            }
             chart
                 .draw_series(
                     series

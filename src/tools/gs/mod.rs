@@ -4,13 +4,12 @@
 //! pulling; this is the method itself, for the benchmark and `compare` to measure the
 //! deferred pass against.
 //!
-//! It runs in an OpenGL 3.3+ core context of its own, made headless through EGL
-//! ([`egl`]), rather than in wgpu's GL device: the comparison then runs beside whichever
-//! backend wgpu uses (lavapipe's Vulkan by default), the context's state is this module's
-//! alone, and desktop GL is what the method was written for. It draws the bytes the wgpu
-//! passes draw: the mesh store is read back from the GPU, and the frame and instance records
-//! are the ones [`FrameRecords`] builds for every pass, bound as uniform blocks of the same
-//! layout (`shaders/gs.glsl`).
+//! It runs in an OpenGL 3.3+ core context of its own, made headless through EGL (`egl.rs`),
+//! rather than in wgpu's GL device: the comparison then runs beside whichever backend wgpu
+//! uses (lavapipe's Vulkan by default), the context's state is this module's alone, and
+//! desktop GL is what the method was written for. It draws the bytes the wgpu passes draw:
+//! the mesh store is read back from the GPU, and the frame and instance records are the ones
+//! every pass builds, bound as uniform blocks of the same layout (`shaders/gs.glsl`).
 
 mod egl;
 
