@@ -57,6 +57,11 @@ layout(std140) uniform Instances {
     Instance instances[INSTANCE_CAPACITY];
 };
 
+// What the geometry stage hands the fragment stage: `dist` component j is the distance in
+// pixels to the edge opposite corner j, interpolated without perspective; the local point and
+// normal; the face normal; the instance (within the draw) and the triangle (of its mesh).
+#define VARYINGS Fragment { noperspective vec3 dist; vec3 local; vec3 normal; flat vec3 face_normal; flat uint instance; flat uint tri; }
+
 const uint INSTANCE_EDGES = 1u;
 // The distance a masked edge's component carries (forward.wgsl's MASKED).
 const float MASKED = 1.0e6;
@@ -104,15 +109,7 @@ in Corner {
     flat uint instance;
 } corners[];
 
-out Fragment {
-    // Component j: distance in pixels to the edge opposite corner j.
-    noperspective vec3 dist;
-    vec3 local;
-    vec3 normal;
-    flat vec3 face_normal;
-    flat uint instance;
-    flat uint tri;
-} fragment;
+out VARYINGS fragment;
 
 // Per stored triangle: bits 0-2 the drawn edges (src/gpu/mesh_store.rs, triangle_info).
 uniform usamplerBuffer info;
@@ -177,14 +174,7 @@ vec3 unpack_normal(uint bits) {
 
 #ifdef FRAGMENT
 
-in Fragment {
-    noperspective vec3 dist;
-    vec3 local;
-    vec3 normal;
-    flat vec3 face_normal;
-    flat uint instance;
-    flat uint tri;
-} fragment;
+in VARYINGS fragment;
 
 // The instance slot of the draw's first instance.
 uniform uint first_slot;

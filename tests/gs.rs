@@ -175,3 +175,26 @@ fn gs_draws_many_instances_as_forward_does() {
     let gs = draw(&world, camera, size, Method::Gs);
     assert_equal("300 instances", &forward, &gs);
 }
+
+/// Without `glClipControl` the vertex stage maps depth to -w..w and turns the image upside
+/// down itself: the image is the same (the rasterizer's fill rule now sees the triangles
+/// mirrored, which may move a pixel centre lying exactly on an edge to its neighbour).
+#[test]
+fn gs_without_clip_control_draws_the_same() {
+    let mesh = load("suzanne.obj");
+    let (lo, hi) = mesh.bounds_f64();
+    let size = (320, 240);
+    let camera = Camera::framing(lo, hi, 320.0 / 240.0);
+    let world = World::single(mesh, EdgeSelection::Polygon);
+    let forward = draw(&world, camera, size, Method::Forward);
+    let style = Style::default();
+    let shot = Shot {
+        world: &world,
+        view: camera.to_view(320.0 / 240.0),
+        style: &style,
+        size,
+    };
+    let pass = wirepass::tools::gs::GsPass::without_clip_control().unwrap();
+    let gs = offline::draw_gs_with(gpu(), &shot, pass).unwrap();
+    assert_equal("suzanne without glClipControl", &forward, &gs);
+}

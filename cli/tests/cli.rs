@@ -170,8 +170,8 @@ fn bench_writes_table_json_csv_and_plots() {
     );
     assert!(json["device"]["name"].is_string());
     let runs = json["runs"].as_array().unwrap();
-    // 2 scenes × 2 sizes × (floor, deferred, forward, two-pass).
-    assert_eq!(runs.len(), 16);
+    // 2 scenes × 2 sizes × (floor, deferred, forward, two-pass, gs).
+    assert_eq!(runs.len(), 20);
     for run in runs {
         for key in [
             "scene",
@@ -199,10 +199,14 @@ fn bench_writes_table_json_csv_and_plots() {
         runs.iter().map(|r| r["method"].as_str().unwrap()).collect();
     assert_eq!(
         methods.into_iter().collect::<Vec<_>>(),
-        ["deferred", "floor", "forward", "two-pass"]
+        ["deferred", "floor", "forward", "gs", "two-pass"]
     );
+    let gs = runs.iter().find(|r| r["method"] == "gs").unwrap();
+    assert!(gs["gl"].as_str().unwrap().contains("OpenGL"), "{gs}");
     let csv = std::fs::read_to_string(out.join("bench.csv")).unwrap();
-    assert!(csv.lines().count() > 16);
+    assert!(csv.lines().count() > 20);
+    let report = std::fs::read_to_string(out.join("bench.md")).unwrap();
+    assert!(report.contains("| deferred ÷ gs |"), "{report}");
     for plot in ["time_vs_triangles.png", "time_vs_pixels.png"] {
         let img = image::open(out.join(plot)).unwrap();
         assert!(img.width() > 100, "{plot}");
@@ -394,7 +398,7 @@ fn gs_is_skipped_with_its_reason_where_opengl_is_missing() {
     );
     let gs_row = stdout
         .lines()
-        .find(|l| l.contains("| gs |"))
+        .find(|l| l.starts_with("| sphere:500 ") && l.contains("| gs |"))
         .unwrap_or_default();
     assert!(
         gs_row.contains("skipped") && gs_row.contains(missing),
@@ -423,4 +427,54 @@ fn gs_is_skipped_with_its_reason_where_opengl_is_missing() {
         .unwrap_or_default();
     assert!(skipped.contains(missing), "{report}");
     assert!(report["methods"]["forward"]["id_agreement"].is_number());
+}
+
+/// `--silhouettes on,off` times the deferred method and the floor both ways, the methods
+/// that draw no outline once; the summary puts the two deferred totals side by side.
+#[test]
+fn bench_times_outlines_on_and_off_in_one_run() {
+    let out = temp("bench-outlines");
+    let args = [
+        "sphere:2000",
+        "--size",
+        "64x48",
+        "--frames",
+        "2",
+        "--warmup",
+        "0",
+    ];
+    let json = bench_json(
+        &[
+            &args[..],
+            &["--silhouettes", "on,off", "--methods", "deferred,gs"],
+        ]
+        .concat(),
+        &out,
+    );
+    let runs: Vec<(String, bool)> = json["runs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| {
+            (
+                r["method"].as_str().unwrap().to_owned(),
+                r["outlines"].as_bool().unwrap(),
+            )
+        })
+        .collect();
+    let expected = [("deferred", true), ("gs", true), ("deferred", false)];
+    assert_eq!(runs, expected.map(|(m, o)| (m.to_owned(), o)));
+    let report = std::fs::read_to_string(out.join("bench.md")).unwrap();
+    let row = report
+        .lines()
+        .find(|l| l.starts_with("| sphere:2000 | 1980 | 64x48 | – |"))
+        .unwrap_or_else(|| panic!("no summary row: {report}"));
+    // deferred, deferred without outlines and gs each have a time; edge ÷ floor has none
+    // (the floor was not timed), deferred ÷ gs both ratios.
+    let cells: Vec<&str> = row.split('|').map(str::trim).collect();
+    for k in [5, 6, 9] {
+        assert!(cells[k].parse::<f64>().is_ok(), "{k}: {row}");
+    }
+    assert_eq!(cells[10], "–", "{row}");
+    assert_eq!(cells[11].matches('×').count(), 2, "{row}");
 }

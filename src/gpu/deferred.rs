@@ -7,7 +7,7 @@ use super::bindings::Sources;
 use super::canvas::Canvas;
 use super::composite::{Composite, CompositePipeline};
 use super::edge_pass::{round_to_half, EdgePass};
-use super::frame::FrameData;
+use super::frame::{FrameData, FrameRecords};
 use super::host_depth::{HostFrame, HostImport};
 use super::mesh_store::MeshStore;
 use super::options::{OutputTarget, PassOptions, TriangleIds};
@@ -384,7 +384,8 @@ impl DeferredPass {
         } else {
             style
         };
-        let data = FrameData::new(device, store, scene, style, region, true)?;
+        let records = FrameRecords::new(device, store, scene, style, region, true)?;
+        let data = FrameData::new(device, store, records);
         let host = match &canvas.host_depth {
             Some(h) => Some(self.host.prepare(device, h, &scene.view, region.image)?),
             None => None,

@@ -155,6 +155,7 @@ pub(crate) struct FrameRecords {
     /// For each instance slot, the scene's instance index (slots group instances by mesh).
     pub order: Vec<u32>,
     pub store: StoreBuffers,
+    pub region: Region,
     /// Pixels of guard band around the output in the targets.
     pub guard: u32,
     pub outlines: bool,
@@ -297,6 +298,7 @@ impl FrameRecords {
             draws,
             order,
             store: buffers,
+            region,
             guard,
             outlines,
             patches,
@@ -306,16 +308,8 @@ impl FrameRecords {
 }
 
 impl FrameData {
-    /// Validates the scene, style and region against the device and the store, and uploads
-    /// the frame's records ([`FrameRecords::new`]).
-    pub fn new(
-        device: &wgpu::Device,
-        store: &MeshStore,
-        scene: &Scene<'_>,
-        style: &Style,
-        region: Region,
-        guarded: bool,
-    ) -> Result<FrameData> {
+    /// Uploads a frame's records, built for `store`.
+    pub fn new(device: &wgpu::Device, store: &MeshStore, built: FrameRecords) -> FrameData {
         let FrameRecords {
             uniforms,
             records,
@@ -325,8 +319,9 @@ impl FrameData {
             guard,
             outlines,
             patches,
+            region,
             mixed_colors,
-        } = FrameRecords::new(device, store, scene, style, region, guarded)?;
+        } = built;
         let frame = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("wirepass frame"),
             contents: bytemuck::bytes_of(&uniforms),
@@ -354,7 +349,7 @@ impl FrameData {
             contents: &contents,
             usage,
         });
-        Ok(FrameData {
+        FrameData {
             uniforms,
             frame,
             instances,
@@ -368,7 +363,7 @@ impl FrameData {
             patches,
             mixed_colors,
             uniform_instances,
-        })
+        }
     }
 
     /// Clusters of all instances together.

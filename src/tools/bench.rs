@@ -592,16 +592,8 @@ pub fn markdown(runs: &[Run]) -> String {
     );
     for r in runs {
         if let Some(why) = &r.skipped {
-            out += &format!(
-                "| {} | {} | {}x{} | {} | {} | – | skipped: {} | – | – | – |\n",
-                r.scene,
-                r.triangles,
-                r.size[0],
-                r.size[1],
-                switch(r.outlines),
-                r.method,
-                why.replace('|', "/")
-            );
+            let why = why.replace('|', "/");
+            out += &format!("{} – | skipped: {why} | – | – | – |\n", row_head(r));
             continue;
         }
         let deferred = runs
@@ -632,13 +624,8 @@ pub fn markdown(runs: &[Run]) -> String {
             ));
         }
         out += &format!(
-            "| {} | {} | {}x{} | {} | {} | {} | {} | {:.3} | {} | {:.1} |\n",
-            r.scene,
-            r.triangles,
-            r.size[0],
-            r.size[1],
-            switch(r.outlines),
-            r.method,
+            "{} {} | {} | {:.3} | {} | {:.1} |\n",
+            row_head(r),
             pass("visibility"),
             other.join(", "),
             r.total_median_ms,
@@ -650,6 +637,19 @@ pub fn markdown(runs: &[Run]) -> String {
         );
     }
     out
+}
+
+/// A row's first cells in [`markdown`]: scene, triangles, size, outlines and method.
+fn row_head(r: &Run) -> String {
+    format!(
+        "| {} | {} | {}x{} | {} | {} |",
+        r.scene,
+        r.triangles,
+        r.size[0],
+        r.size[1],
+        switch(r.outlines),
+        r.method
+    )
 }
 
 /// `on` or `off`.

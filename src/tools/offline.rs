@@ -215,7 +215,15 @@ pub fn draw_two_pass(ctx: &GpuContext, shot: &Shot<'_>) -> Result<Rendering> {
 /// image and maps, which hold what the forward method's hold. An
 /// [`Error::NoAdapter`] where no OpenGL context with geometry shaders can be made.
 pub fn draw_gs(ctx: &GpuContext, shot: &Shot<'_>) -> Result<Rendering> {
-    let mut pass = crate::tools::gs::GsPass::new()?;
+    draw_gs_with(ctx, shot, crate::tools::gs::GsPass::new()?)
+}
+
+/// [`draw_gs`] with a pass of the caller's.
+pub fn draw_gs_with(
+    ctx: &GpuContext,
+    shot: &Shot<'_>,
+    mut pass: crate::tools::gs::GsPass,
+) -> Result<Rendering> {
     let up = Uploaded::new(&ctx.device, &ctx.queue, shot.world)?;
     let scene = up.scene(shot.world, shot.view);
     let gpu = (&ctx.device, &ctx.queue);

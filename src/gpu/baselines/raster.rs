@@ -6,7 +6,7 @@
 use crate::error::{Error, Result};
 use crate::gpu::bindings::{self, store_resources, Res, Sources};
 use crate::gpu::canvas::Region;
-use crate::gpu::frame::FrameData;
+use crate::gpu::frame::{FrameData, FrameRecords};
 use crate::gpu::mesh_store::MeshStore;
 use crate::gpu::targets::texture_2d;
 use crate::gpu::targets::{clear_color, cleared, BACKGROUND_ID, DEPTH_FORMAT, ID_FORMAT};
@@ -150,7 +150,8 @@ impl RasterFrame {
         style: &Style,
         size: (u32, u32),
     ) -> Result<RasterFrame> {
-        let data = FrameData::new(device, store, scene, style, Region::whole(size), false)?;
+        let records = FrameRecords::new(device, store, scene, style, Region::whole(size), false)?;
+        let data = FrameData::new(device, store, records);
         let make = |label, format, usage| texture_2d(device, label, size, format, usage);
         use wgpu::TextureUsages as U;
         Ok(RasterFrame {

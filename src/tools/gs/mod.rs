@@ -115,6 +115,17 @@ impl GsPass {
     /// Makes the context and the programs; an [`Error::NoAdapter`] where no OpenGL
     /// [`GL_VERSION`] core context can be made.
     pub fn new() -> Result<GsPass> {
+        GsPass::build(true)
+    }
+
+    /// [`new`](Self::new) drawing as on a driver without `glClipControl` (OpenGL 4.5 or
+    /// ARB_clip_control), whose depth range and first row the vertex stage turns instead:
+    /// the same image, for tests of that path on drivers that have it.
+    pub fn without_clip_control() -> Result<GsPass> {
+        GsPass::build(false)
+    }
+
+    fn build(clip_control_if_any: bool) -> Result<GsPass> {
         let context = egl::Context::new()?;
         let gl = context.load();
         // SAFETY: `gl` belongs to the context current on this thread; every call below
@@ -142,8 +153,9 @@ impl GsPass {
             let alignment = gl
                 .get_parameter_i32(glow::UNIFORM_BUFFER_OFFSET_ALIGNMENT)
                 .max(1) as u32;
-            let clip_control = (version.major, version.minor) >= (4, 5)
-                || gl.supported_extensions().contains("GL_ARB_clip_control");
+            let clip_control = clip_control_if_any
+                && ((version.major, version.minor) >= (4, 5)
+                    || gl.supported_extensions().contains("GL_ARB_clip_control"));
             let programs = [
                 program(&gl, capacity, clip_control, false)?,
                 program(&gl, capacity, clip_control, true)?,
