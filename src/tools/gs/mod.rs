@@ -219,7 +219,9 @@ impl GsPass {
         let records = FrameRecords::new(device, store, scene, style, Region::whole(size), false)?;
         let version = (store.store_id(), store.version());
         if self.store.as_ref().map(|s| s.version) != Some(version) {
-            self.store = None;
+            if let Some(old) = self.store.take() {
+                self.delete_store(old);
+            }
             self.store = Some(self.copy_store(device, queue, store, version)?);
         }
         let gl = self.current()?;
@@ -550,6 +552,20 @@ impl GsPass {
             gl.delete_buffer(frame.instances);
         }
     }
+
+    /// Deletes a copied store's OpenGL objects.
+    fn delete_store(&self, store: Store) {
+        let _ = self.context.make_current();
+        let gl = &self.gl;
+        // SAFETY: as in `new`; the store is not used again.
+        unsafe {
+            gl.delete_vertex_array(store.vertex_array);
+            gl.delete_texture(store.info);
+            for b in store.buffers {
+                gl.delete_buffer(b);
+            }
+        }
+    }
 }
 
 impl GsFrame {
@@ -569,17 +585,13 @@ impl GsFrame {
 
 impl Drop for GsPass {
     fn drop(&mut self) {
+        if let Some(old) = self.store.take() {
+            self.delete_store(old);
+        }
         let _ = self.context.make_current();
         let gl = &self.gl;
         // SAFETY: the context is still current (it is dropped after this).
         unsafe {
-            if let Some(s) = self.store.take() {
-                gl.delete_vertex_array(s.vertex_array);
-                gl.delete_texture(s.info);
-                for b in s.buffers {
-                    gl.delete_buffer(b);
-                }
-            }
             for p in &self.programs {
                 gl.delete_program(p.program);
             }
