@@ -81,6 +81,23 @@ const INSTANCE_OUTLINES: u32 = 2u;
 // Instance ids of the id target, BACKGROUND_ID (background) and HOST_ID (host geometry in
 // front), are written before this file from `gpu::BACKGROUND_ID` and `gpu::HOST_ID`.
 
+// How host depth maps to the pass's reverse depth (src/gpu/host_depth.rs, HostParams).
+struct HostParams {
+    // Host NDC (u, v, depth, 1) of a point -> its reverse depth, as dot(a, q) / dot(b, q);
+    // used when the host rendered with other matrices than the scene's.
+    a: vec4<f32>,
+    b: vec4<f32>,
+    // 0: same matrices, standard depth (reverse = 1 - host); 1: same, reversed
+    // (reverse = host); 2: other matrices (a, b).
+    mode: u32,
+    // Whether greater host depth is nearer (a reversed host convention).
+    reversed: u32,
+    _pad: u32,
+    // The smallest step of the host's depth format near its far end: 2^-bits for unorm
+    // formats, the f32 step at 1 for float ones (relative for a reversed float format).
+    quantum: f32,
+}
+
 // Host geometry hides a point only when it is nearer by more than this margin (in reverse
 // depth, for a host depth of reverse value `r` and format step `quantum`), so a host that
 // draws the wireframed meshes itself too does not hide their lines with its own copy of

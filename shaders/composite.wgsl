@@ -1,7 +1,18 @@
 // Draws a frame's result (premultiplied linear RGBA, written by the edge pass in its result
 // mode) into the host's own render pass: one triangle over the viewport, blended with
 // (One, OneMinusSrcAlpha). The host's colour attachment decides the encoding: sRGB formats
-// store sRGB and blend in linear light, float formats hold linear values. Self-contained.
+// store sRGB and blend in linear light, float formats hold linear values. Assembled after
+// common.wgsl.
+//
+// Flags: TESTED (the frame was seeded from the host's depth, and the render pass has the
+// host's depth attachment). The result decides per pixel whether an instance or the host
+// shows, from the host's farthest sample there; where the host's own geometry in front of an
+// instance covers only some of a pixel's samples, the draw then tests each sample against
+// the host's depth, so those samples keep the host's colour and the host's antialiased edges
+// survive. The fragment's depth is the instance's at the nearest of the pixel's samples,
+// moved forward by the margin that lets the pass's surfaces win ties with a host's own copy
+// of them (the seeding's rule); pixels where no instance shows (lines over the host or the
+// background) pass at every sample, as the result already hides what the host hides.
 
 @group(0) @binding(34) var result: texture_2d<f32>;
 
@@ -11,9 +22,69 @@ fn vs_main(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
     return vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
 }
 
-@fragment
-fn fs_main(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f32> {
+fn result_at(position: vec4<f32>) -> vec4<f32> {
     let size = vec2<i32>(textureDimensions(result));
     let xy = clamp(vec2<i32>(floor(position.xy)), vec2<i32>(0), size - 1);
     return textureLoad(result, xy, 0);
 }
+
+#if TESTED
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(0) @binding(31) var<uniform> host: HostParams;
+@group(0) @binding(10) var ids: texture_2d<u32>;
+@group(0) @binding(35) var depth: texture_2d<f32>;
+
+struct Tested {
+    @location(0) color: vec4<f32>,
+    @builtin(frag_depth) depth: f32,
+}
+
+// The reverse depth of the instance that target pixel xy shows, or -1 where none does
+// (background, the host, outside the targets).
+fn instance_depth(xy: vec2<i32>) -> f32 {
+    let p = clamp(xy, vec2<i32>(0), vec2<i32>(frame.target_size) - 1);
+    let id = textureLoad(ids, p, 0).x;
+    let shows = id != BACKGROUND_ID && id != HOST_ID && all(p == xy);
+    return select(-1.0, textureLoad(depth, p, 0).x, shows);
+}
+
+// The host's depth of reverse depth r at full-image pixel `pixel`: host_value's mapping
+// (host_depth.wgsl) inverted.
+fn host_depth_of(r: f32, pixel: vec2<f32>) -> f32 {
+    let same = select(1.0 - r, r, host.mode == 1u);
+    let ndc = vec2<f32>(pixel.x / frame.image_size.x * 2.0 - 1.0,
+                        1.0 - pixel.y / frame.image_size.y * 2.0);
+    // r = dot(a, q) / dot(b, q) with q = (ndc, d, 1), solved for d.
+    let num = dot(host.a.xy, ndc) + host.a.w - r * (dot(host.b.xy, ndc) + host.b.w);
+    let den = r * host.b.z - host.a.z;
+    return select(same, num / den, host.mode == 2u && den != 0.0);
+}
+
+// The larger change from r to a neighbour that shows an instance (a or b, -1 for none).
+fn axis_change(r: f32, a: f32, b: f32) -> f32 {
+    return max(select(0.0, abs(r - a), a >= 0.0), select(0.0, abs(b - r), b >= 0.0));
+}
+
+@fragment
+fn fs_main(@builtin(position) position: vec4<f32>) -> Tested {
+    let xy = vec2<i32>(floor(position.xy + frame.output_offset));
+    let r = instance_depth(xy);
+    // The instance's depth change to its neighbours, per axis the larger (a crease may lie
+    // within the pixel), summed: a sample lies within half a pixel per axis, and the change
+    // over a whole pixel bounds the surface there on either side of a crease.
+    let x = vec2<i32>(1, 0);
+    let y = vec2<i32>(0, 1);
+    let change = axis_change(r, instance_depth(xy - x), instance_depth(xy + x))
+        + axis_change(r, instance_depth(xy - y), instance_depth(xy + y));
+    let nearest = min(r + change + host_margin(r, host.quantum), 1.0);
+    let pixel = floor(position.xy + frame.output_offset + frame.target_origin) + 0.5;
+    let d = clamp(host_depth_of(nearest, pixel), 0.0, 1.0);
+    let everywhere = select(0.0, 1.0, host.reversed == 1u);
+    return Tested(result_at(position), select(everywhere, d, r >= 0.0));
+}
+#else
+@fragment
+fn fs_main(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f32> {
+    return result_at(position);
+}
+#endif

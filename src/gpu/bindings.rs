@@ -53,8 +53,13 @@ pub(crate) enum Res {
     HostParams = 31,
     /// The host-depth pass's output, the target [`Res::HostDepth`] then reads.
     HostOut = 32,
+    /// The host-depth pass's seed depth for a multisampled host (host_depth.wgsl).
+    HostSeedOut = 33,
     /// A frame's result, which the composite draws into the host's render pass.
     Result = 34,
+    /// The visibility pass's depth target (reverse depth), which the composite tests the
+    /// host's depth samples against.
+    Depth = 35,
 }
 
 impl Res {
@@ -88,11 +93,11 @@ impl Res {
             AccRw | CullRw | WorkRw | TilesRw => write,
             Ids | HostDepth => texture(wgpu::TextureSampleType::Uint),
             // Unfilterable float: what every backend can load a depth texture as.
-            HostColor | HostSource | Result => {
+            HostColor | HostSource | Result | Depth => {
                 texture(wgpu::TextureSampleType::Float { filterable: false })
             }
             OutColor => storage_texture(color),
-            HostOut => storage_texture(super::targets::HOST_FORMAT),
+            HostOut | HostSeedOut => storage_texture(super::targets::HOST_FORMAT),
             OutDiagnostic => storage_texture(super::targets::DIAGNOSTIC_FORMAT),
             OutIds => storage_texture(super::targets::RESOLVED_ID_FORMAT),
             _ => read,
@@ -360,7 +365,9 @@ pub(crate) fn bind_group(
                 wgpu::BindingResource::TextureView(sources.out_ids.ok_or_else(|| missing(r))?)
             }
             // Bound by the host-depth pass and the composite themselves.
-            HostSource | HostParams | HostOut | Result => return Err(missing(r)),
+            HostSource | HostParams | HostOut | HostSeedOut | Result | Depth => {
+                return Err(missing(r))
+            }
         };
         entries.push(wgpu::BindGroupEntry {
             binding: r as u32,
@@ -464,7 +471,9 @@ mod tests {
             "host_source" => HostSource,
             "host" => HostParams,
             "host_out" => HostOut,
+            "seed_out" => HostSeedOut,
             "result" => Result,
+            "depth" => Depth,
             _ => return None,
         })
     }
@@ -491,7 +500,7 @@ mod tests {
             }
         }
         assert!(
-            seen.len() >= 29,
+            seen.len() >= 31,
             "every resource is bound somewhere: {seen:?}"
         );
     }

@@ -3,6 +3,7 @@
 //! with the host's sample count and depth-stencil format.
 
 use super::bindings::Res;
+use super::host_depth::HostFrame;
 use super::shaders;
 use super::targets::RESULT_FORMAT;
 use crate::error::{Error, Result};
@@ -31,8 +32,11 @@ pub struct RenderTarget {
     pub format: wgpu::TextureFormat,
     /// Samples per pixel of the render pass's attachments.
     pub sample_count: u32,
-    /// Format of the render pass's depth-stencil attachment, if it has one; the draw neither
-    /// tests nor writes it.
+    /// Format of the render pass's depth-stencil attachment, if it has one. The draw never
+    /// writes it; for a frame prepared with the host's depth
+    /// ([`Canvas::with_host_depth`](super::Canvas::with_host_depth)) it tests each sample's
+    /// depth, so that the host's own antialiased edges in front of a shaded instance keep
+    /// their samples (the attachment must then hold that same depth).
     pub depth_stencil: Option<wgpu::TextureFormat>,
     /// What to draw.
     pub content: Composite,
@@ -96,14 +100,37 @@ impl RenderTarget {
     }
 }
 
-/// The composite pipeline for one render target.
+/// The composite's pipelines for one render target: the plain draw, and where the render
+/// pass has a depth attachment, the draws that test the host's depth per sample (for a
+/// standard and a reversed host depth; composite.wgsl says why).
 pub(crate) struct CompositePipeline {
-    pub pipeline: wgpu::RenderPipeline,
-    pub layout: wgpu::BindGroupLayout,
+    plain: Draw,
+    tested: Option<[Draw; 2]>,
+}
+
+struct Draw {
+    pipeline: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
+}
+
+/// A frame's composite draw: its bind group, and which of the pipelines it binds for.
+pub(crate) struct FrameComposite {
+    group: wgpu::BindGroup,
+    /// `Some(reversed)`: a tested draw over a host depth of that convention.
+    tested: Option<bool>,
+}
+
+/// What a tested draw reads besides the result: the frame's uniforms, the host depth's
+/// mapping, and the visibility pass's ids and depth.
+pub(crate) struct HostSamples<'a> {
+    pub frame: &'a wgpu::Buffer,
+    pub host: &'a HostFrame,
+    pub ids: &'a wgpu::Texture,
+    pub depth: &'a wgpu::Texture,
 }
 
 impl CompositePipeline {
-    /// Checks `target` against the device and builds its pipeline.
+    /// Checks `target` against the device and builds its pipelines.
     pub fn new(device: &wgpu::Device, target: &RenderTarget) -> Result<Self> {
         let features = target.format.guaranteed_format_features(device.features());
         if !features
@@ -139,9 +166,102 @@ impl CompositePipeline {
             }
         }
         let scope = crate::gpu::validation::Validation::begin(device);
+        let plain = Draw::new(device, target, None);
+        let tested = target
+            .depth_stencil
+            .filter(|f| f.has_depth_aspect())
+            .map(|_| {
+                [
+                    Draw::new(device, target, Some(wgpu::CompareFunction::LessEqual)),
+                    Draw::new(device, target, Some(wgpu::CompareFunction::GreaterEqual)),
+                ]
+            });
+        if let Some(e) = scope.end() {
+            return Err(Error::Device(format!(
+                "building the composite pipeline: {e}"
+            )));
+        }
+        Ok(Self { plain, tested })
+    }
+
+    /// A frame's bind group over its result texture, for the tested draw where the render
+    /// pass has a depth attachment and the frame has the host's depth (`samples`).
+    pub fn bind(
+        &self,
+        device: &wgpu::Device,
+        result: &wgpu::Texture,
+        samples: Option<HostSamples<'_>>,
+    ) -> FrameComposite {
+        debug_assert_eq!(result.format(), RESULT_FORMAT);
+        let view = |t: &wgpu::Texture| t.create_view(&Default::default());
+        let result = view(result);
+        let entry = |res: Res, resource| wgpu::BindGroupEntry {
+            binding: res as u32,
+            resource,
+        };
+        let (draw, samples) = match (&self.tested, samples) {
+            (Some(tested), Some(s)) => (&tested[usize::from(s.host.reversed())], Some(s)),
+            _ => (&self.plain, None),
+        };
+        let tested = samples.as_ref().map(|s| s.host.reversed());
+        let mut entries = vec![entry(
+            Res::Result,
+            wgpu::BindingResource::TextureView(&result),
+        )];
+        let views = samples.as_ref().map(|s| (view(s.ids), view(s.depth)));
+        if let (Some(s), Some((ids, depth))) = (&samples, &views) {
+            entries.extend([
+                entry(Res::Frame, s.frame.as_entire_binding()),
+                entry(Res::HostParams, s.host.params().as_entire_binding()),
+                entry(Res::Ids, wgpu::BindingResource::TextureView(ids)),
+                entry(Res::Depth, wgpu::BindingResource::TextureView(depth)),
+            ]);
+        }
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("wirepass composite"),
+            layout: &draw.layout,
+            entries: &entries,
+        });
+        FrameComposite { group, tested }
+    }
+
+    /// Records a frame's draw into the host's render pass.
+    pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>, frame: &FrameComposite) -> Result<()> {
+        let draw = match (&self.tested, frame.tested) {
+            (_, None) => &self.plain,
+            (Some(tested), Some(reversed)) => &tested[usize::from(reversed)],
+            (None, Some(_)) => {
+                return Err(Error::Device(
+                    "a tested composite without its pipeline".into(),
+                ))
+            }
+        };
+        pass.set_pipeline(&draw.pipeline);
+        pass.set_bind_group(0, &frame.group, &[]);
+        pass.draw(0..3, 0..1);
+        Ok(())
+    }
+}
+
+impl Draw {
+    /// The plain draw (`compare` None), or a tested one comparing the fragment's depth with
+    /// the host's by `compare`.
+    fn new(
+        device: &wgpu::Device,
+        target: &RenderTarget,
+        compare: Option<wgpu::CompareFunction>,
+    ) -> Draw {
+        let stage = wgpu::ShaderStages::FRAGMENT;
+        let mut entries = vec![Res::Result.layout_entry(stage, RESULT_FORMAT)];
+        if compare.is_some() {
+            entries.extend(
+                [Res::Frame, Res::HostParams, Res::Ids, Res::Depth]
+                    .map(|r| r.layout_entry(stage, RESULT_FORMAT)),
+            );
+        }
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("wirepass composite"),
-            entries: &[Res::Result.layout_entry(wgpu::ShaderStages::FRAGMENT, RESULT_FORMAT)],
+            entries: &entries,
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("wirepass composite"),
@@ -150,7 +270,7 @@ impl CompositePipeline {
         });
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("wirepass composite"),
-            source: wgpu::ShaderSource::Wgsl(shaders::COMPOSITE.into()),
+            source: wgpu::ShaderSource::Wgsl(shaders::composite_source(compare.is_some()).into()),
         });
         let premultiplied = wgpu::BlendComponent {
             src_factor: wgpu::BlendFactor::One,
@@ -167,10 +287,11 @@ impl CompositePipeline {
                 buffers: &[],
             },
             primitive: wgpu::PrimitiveState::default(),
+            // Neither draw writes the host's depth or stencil.
             depth_stencil: target.depth_stencil.map(|format| wgpu::DepthStencilState {
                 format,
                 depth_write_enabled: Some(false),
-                depth_compare: Some(wgpu::CompareFunction::Always),
+                depth_compare: Some(compare.unwrap_or(wgpu::CompareFunction::Always)),
                 stencil: Default::default(),
                 bias: Default::default(),
             }),
@@ -194,25 +315,6 @@ impl CompositePipeline {
             multiview_mask: None,
             cache: None,
         });
-        if let Some(e) = scope.end() {
-            return Err(Error::Device(format!(
-                "building the composite pipeline: {e}"
-            )));
-        }
-        Ok(Self { pipeline, layout })
-    }
-
-    /// The bind group reading a frame's result texture.
-    pub fn bind(&self, device: &wgpu::Device, result: &wgpu::Texture) -> wgpu::BindGroup {
-        debug_assert_eq!(result.format(), RESULT_FORMAT);
-        let view = result.create_view(&Default::default());
-        device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("wirepass composite"),
-            layout: &self.layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: Res::Result as u32,
-                resource: wgpu::BindingResource::TextureView(&view),
-            }],
-        })
+        Draw { pipeline, layout }
     }
 }

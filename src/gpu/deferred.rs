@@ -5,7 +5,7 @@
 
 use super::bindings::Sources;
 use super::canvas::Canvas;
-use super::composite::{Composite, CompositePipeline};
+use super::composite::{Composite, CompositePipeline, FrameComposite, HostSamples};
 use super::edge_pass::{round_to_half, EdgePass};
 use super::frame::{FrameData, FrameRecords};
 use super::host_depth::{HostFrame, HostImport};
@@ -33,8 +33,8 @@ pub struct PreparedFrame {
     pub(crate) targets: Targets,
     pub(crate) cull: wgpu::Buffer,
     host: Option<HostFrame>,
-    /// The composite's bind group over this frame's result, with a render target.
-    composite: Option<wgpu::BindGroup>,
+    /// The composite's draw of this frame's result, with a render target.
+    composite: Option<FrameComposite>,
     /// Which of the pass's encodes last wrote this frame's result (0: none yet).
     encoded: AtomicU64,
 }
@@ -397,6 +397,7 @@ impl DeferredPass {
             result: self.composite.is_some(),
             diagnostic: self.diagnostics,
             host: host.is_some(),
+            host_seed: host.as_ref().is_some_and(HostFrame::multisampled),
         };
         if self.targets.as_ref().map(Targets::spec) != Some(spec) {
             self.targets = Some(Targets::new(device, spec)?);
@@ -435,7 +436,15 @@ impl DeferredPass {
             .clone()
             .ok_or_else(|| Error::Device("no cluster list".into()))?;
         let composite = match (&self.composite, &targets.result) {
-            (Some((pipeline, _)), Some(result)) => Some(pipeline.bind(device, result)),
+            (Some((pipeline, _)), Some(result)) => {
+                let samples = host.as_ref().map(|host| HostSamples {
+                    frame: &data.frame,
+                    host,
+                    ids: &targets.ids,
+                    depth: &targets.depth,
+                });
+                Some(pipeline.bind(device, result, samples))
+            }
             _ => None,
         };
         Ok(PreparedFrame {
@@ -693,6 +702,11 @@ impl DeferredPass {
     /// and no other frame of this pass encoded since (each frame's result lives in the
     /// pass's one result texture until the next encode).
     ///
+    /// A frame prepared with the host's depth, drawn into a render pass with a depth
+    /// attachment, is tested against that attachment per sample (it must hold the depth
+    /// the frame was prepared with), so a multisampled host's own edges in front of an
+    /// instance keep their antialiasing; the attachment is never written.
+    ///
     /// wirepass cannot see the render pass's attachments: if they differ from the render
     /// target (format, sample count, a depth-stencil attachment), wgpu rejects the draw with a
     /// validation error, not a `wirepass::Error`. [`RenderTarget::check_attachments`] checks
@@ -723,9 +737,6 @@ impl DeferredPass {
                     .into(),
             ));
         }
-        pass.set_pipeline(&pipeline.pipeline);
-        pass.set_bind_group(0, group, &[]);
-        pass.draw(0..3, 0..1);
-        Ok(())
+        pipeline.draw(pass, group)
     }
 }

@@ -25,7 +25,7 @@ use crate::error::{Error, Result};
 use glam::{DMat4, DVec4};
 use wgpu::util::DeviceExt;
 
-/// Mirror of WGSL `HostParams` (host_depth.wgsl).
+/// Mirror of WGSL `HostParams` (common.wgsl).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 struct HostParams {
@@ -49,6 +49,24 @@ pub(crate) struct HostFrame {
     view: wgpu::TextureView,
     params: wgpu::Buffer,
     multisampled: bool,
+    reversed: bool,
+}
+
+impl HostFrame {
+    /// The uniform mapping the host's depth to the pass's (WGSL `HostParams`).
+    pub fn params(&self) -> &wgpu::Buffer {
+        &self.params
+    }
+
+    /// Whether greater host depth is nearer.
+    pub fn reversed(&self) -> bool {
+        self.reversed
+    }
+
+    /// Whether the host's depth has several samples per pixel (and the frame a seed target).
+    pub fn multisampled(&self) -> bool {
+        self.multisampled
+    }
 }
 
 impl HostImport {
@@ -151,6 +169,7 @@ impl HostImport {
             view,
             params,
             multisampled,
+            reversed,
         })
     }
 
@@ -175,29 +194,44 @@ impl HostImport {
             .as_ref()
             .ok_or_else(|| Error::Device("the targets have no host depth".into()))?;
         let host_view = host_target.create_view(&Default::default());
+        // A multisampled host's seed depth has a target of its own; a single-sampled host's
+        // is its depth.
+        let seed_target = match (host.multisampled, &targets.host_seed) {
+            (false, _) => None,
+            (true, Some(t)) => Some(t.create_view(&Default::default())),
+            (true, None) => return Err(Error::Device("the targets have no seed depth".into())),
+        };
+        let seed_view = seed_target.as_ref().unwrap_or(&host_view);
+        let mut entries = vec![
+            wgpu::BindGroupEntry {
+                binding: Res::Frame as u32,
+                resource: frame.frame.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: Res::HostSource as u32,
+                resource: wgpu::BindingResource::TextureView(&host.view),
+            },
+            wgpu::BindGroupEntry {
+                binding: Res::HostParams as u32,
+                resource: host.params.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: Res::HostOut as u32,
+                resource: wgpu::BindingResource::TextureView(&host_view),
+            },
+        ];
+        if let Some(seed) = &seed_target {
+            entries.push(wgpu::BindGroupEntry {
+                binding: Res::HostSeedOut as u32,
+                resource: wgpu::BindingResource::TextureView(seed),
+            });
+        }
         let resolve_group = super::bindings::bind_host_resources(
             device,
             &wgpu::BindGroupDescriptor {
                 label: Some("wirepass host depth"),
                 layout: resolve_layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: Res::Frame as u32,
-                        resource: frame.frame.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: Res::HostSource as u32,
-                        resource: wgpu::BindingResource::TextureView(&host.view),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: Res::HostParams as u32,
-                        resource: host.params.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: Res::HostOut as u32,
-                        resource: wgpu::BindingResource::TextureView(&host_view),
-                    },
-                ],
+                entries: &entries,
             },
         )?;
         let seed_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -205,7 +239,7 @@ impl HostImport {
             layout: seed_layout,
             entries: &[wgpu::BindGroupEntry {
                 binding: Res::HostDepth as u32,
-                resource: wgpu::BindingResource::TextureView(&host_view),
+                resource: wgpu::BindingResource::TextureView(seed_view),
             }],
         });
         {
@@ -280,14 +314,18 @@ fn build_resolve(
     {
         *m = multisampled;
     }
+    let mut entries = vec![
+        Res::Frame.layout_entry(cs, HOST_FORMAT),
+        source,
+        Res::HostParams.layout_entry(cs, HOST_FORMAT),
+        Res::HostOut.layout_entry(cs, HOST_FORMAT),
+    ];
+    if multisampled {
+        entries.push(Res::HostSeedOut.layout_entry(cs, HOST_FORMAT));
+    }
     let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("wirepass host depth"),
-        entries: &[
-            Res::Frame.layout_entry(cs, HOST_FORMAT),
-            source,
-            Res::HostParams.layout_entry(cs, HOST_FORMAT),
-            Res::HostOut.layout_entry(cs, HOST_FORMAT),
-        ],
+        entries: &entries,
     });
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some("wirepass host depth"),

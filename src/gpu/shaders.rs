@@ -151,6 +151,12 @@ pub fn host_depth_source(multisampled: bool) -> String {
     assemble(&[HOST_DEPTH], flags)
 }
 
+/// The composite's module: testing the host's depth per sample (`tested`) or not.
+pub fn composite_source(tested: bool) -> String {
+    let flags: &[&str] = if tested { &["TESTED"] } else { &[] };
+    assemble(&[COMPOSITE], flags)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

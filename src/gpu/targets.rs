@@ -109,6 +109,8 @@ pub(crate) struct Targets {
     pub diagnostic: Option<(wgpu::Texture, wgpu::Texture)>,
     /// The host's depth, where the frame has one.
     pub host: Option<wgpu::Texture>,
+    /// The seed depth of a multisampled host's depth (host_depth.wgsl).
+    pub host_seed: Option<wgpu::Texture>,
 }
 
 /// What a set of targets must hold.
@@ -120,6 +122,7 @@ pub(crate) struct TargetSpec {
     pub result: bool,
     pub diagnostic: bool,
     pub host: bool,
+    pub host_seed: bool,
 }
 
 impl Targets {
@@ -131,6 +134,7 @@ impl Targets {
             result: self.result.is_some(),
             diagnostic: self.diagnostic.is_some(),
             host: self.host.is_some(),
+            host_seed: self.host_seed.is_some(),
         }
     }
 
@@ -255,6 +259,14 @@ impl Targets {
                     U::STORAGE_BINDING | U::TEXTURE_BINDING,
                 )
             }),
+            host_seed: spec.host_seed.then(|| {
+                texture(
+                    "wirepass host seed depth",
+                    spec.size,
+                    HOST_FORMAT,
+                    U::STORAGE_BINDING | U::TEXTURE_BINDING,
+                )
+            }),
         })
     }
 
@@ -272,7 +284,7 @@ impl Targets {
         if let Some((d, i)) = &self.diagnostic {
             n += tex(d) + tex(i);
         }
-        if let Some(h) = &self.host {
+        for h in self.host.iter().chain(&self.host_seed) {
             n += tex(h);
         }
         n

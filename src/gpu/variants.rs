@@ -118,7 +118,13 @@ impl Variant {
 pub fn shader_modules() -> Vec<(String, String)> {
     use super::shaders::*;
     use wgpu::TextureFormat as F;
-    let mut out = vec![("composite".to_string(), COMPOSITE.to_string())];
+    let mut out = vec![];
+    for tested in [false, true] {
+        out.push((
+            format!("composite tested={tested}"),
+            composite_source(tested),
+        ));
+    }
     for multisampled in [false, true] {
         out.push((
             format!("host depth multisampled={multisampled}"),

@@ -73,11 +73,14 @@ pub fn draw_raycast_over(shot: &Shot<'_>, host: Option<&HostOccluders<'_>>) -> R
         .collect();
     let styles = ObjectStyle::of(world, shot.style);
     let shading = Shading::new(shot);
-    let host = match host {
-        Some(h) => Some(h.depth_map(shot)?),
-        None => None,
+    // The host's depth for the line rules, and the depth that decides which pixels show it.
+    let (host_map, host) = match host {
+        Some(h) => {
+            let (depth, seed): (Vec<f64>, Vec<f64>) = h.depth_map(shot)?.into_iter().unzip();
+            (Some(HostMap::new(&caster, &rays, depth, &seed)), Some(seed))
+        }
+        None => (None, None),
     };
-    let host_map = host.clone().map(|h| HostMap::new(&caster, &rays, h));
     let patches: Vec<Patches> = world
         .meshes
         .iter()

@@ -411,11 +411,13 @@ impl<'a> HostOccluders<'a> {
         }
     }
 
-    /// Per pixel of `shot`, the host's reverse depth (moved back by the margin), or −1 where
-    /// the host has no geometry. Mirrors host_depth.wgsl: the farthest sample of the host's
+    /// Per pixel of `shot`, the host's reverse depth (moved back by the margin) and its seed
+    /// depth, which decides whether the pixel shows the host: that depth moved back further
+    /// by the spread of the pixel's samples (the same for one sample); −1 where the host has
+    /// no geometry. Mirrors host_depth.wgsl: the farthest and nearest samples of the host's
     /// convention, mapped to the shot's reverse depth (through the pixel's centre where the
     /// host's matrices differ from the shot's).
-    pub(crate) fn depth_map(&self, shot: &Shot<'_>) -> Result<Vec<f64>> {
+    pub(crate) fn depth_map(&self, shot: &Shot<'_>) -> Result<Vec<(f64, f64)>> {
         let caster = RayCaster::new(self.world);
         let rays = Rays::new(&shot.view, shot.size, self.world)?;
         let host = self.view.unwrap_or(shot.view);
@@ -434,35 +436,44 @@ impl<'a> HostOccluders<'a> {
                 let (caster, rays) = (&caster, &rays);
                 (0..width).map(move |x| {
                     let corner = DVec2::new(f64::from(x), f64::from(y));
-                    let mut farthest: Option<f64> = None;
+                    let mut range: Option<(f64, f64)> = None;
                     for &s in &self.samples {
                         let (from, to) = rays.segment(corner + s);
                         let Some(hit) = caster.cast(from, to) else {
-                            return -1.0;
+                            return (-1.0, -1.0);
                         };
                         let c = host_clip * hit.point.extend(1.0);
                         let d = self.stored(c.z / c.w);
-                        farthest = Some(match farthest {
-                            None => d,
-                            Some(f) if reversed => f.min(d),
-                            Some(f) => f.max(d),
+                        range = Some(match range {
+                            None => (d, d),
+                            Some((far, near)) if reversed => (far.min(d), near.max(d)),
+                            Some((far, near)) => (far.max(d), near.min(d)),
                         });
                     }
-                    let Some(d) = farthest else { return -1.0 };
-                    let reverse = if same {
-                        if reversed {
-                            d
-                        } else {
-                            1.0 - d
-                        }
-                    } else {
-                        let pixel = corner + 0.5;
-                        let ndc =
-                            DVec2::new(pixel.x / size.x * 2.0 - 1.0, 1.0 - pixel.y / size.y * 2.0);
-                        let p = unproject * DVec4::new(ndc.x, ndc.y, d, 1.0);
-                        scene.depth.dot(p) / scene.clip.row(3).dot(p)
+                    let Some((far, near)) = range else {
+                        return (-1.0, -1.0);
                     };
-                    (reverse - edge_math::host_margin(reverse, quantum)).clamp(0.0, 1.0)
+                    let pixel = corner + 0.5;
+                    let to_reverse = |d: f64| {
+                        if same {
+                            if reversed {
+                                d
+                            } else {
+                                1.0 - d
+                            }
+                        } else {
+                            let ndc = DVec2::new(
+                                pixel.x / size.x * 2.0 - 1.0,
+                                1.0 - pixel.y / size.y * 2.0,
+                            );
+                            let p = unproject * DVec4::new(ndc.x, ndc.y, d, 1.0);
+                            scene.depth.dot(p) / scene.clip.row(3).dot(p)
+                        }
+                    };
+                    let reverse = to_reverse(far);
+                    let line = (reverse - edge_math::host_margin(reverse, quantum)).clamp(0.0, 1.0);
+                    let spread = (to_reverse(near) - reverse).max(0.0);
+                    (line, (line - spread).max(0.0))
                 })
             })
             .collect())
@@ -470,8 +481,8 @@ impl<'a> HostOccluders<'a> {
 }
 
 /// The host's depth as the outline rules read it: per pixel its reverse depth (−1 where it
-/// has no geometry) and whether the pixel shows the host (its surface at the centre nearer
-/// than every object's, as [`Truth::sample`] decides).
+/// has no geometry) and whether the pixel shows the host (its seeded depth nearer than every
+/// object's surface at the centre, as [`Truth::sample`] decides).
 pub(crate) struct HostMap {
     depth: Vec<f64>,
     shows_host: Vec<bool>,
@@ -480,9 +491,15 @@ pub(crate) struct HostMap {
 }
 
 impl HostMap {
-    pub(crate) fn new(caster: &RayCaster<'_>, rays: &Rays, depth: Vec<f64>) -> HostMap {
+    /// `seed` is the seed depth of [`HostOccluders::depth_map`].
+    pub(crate) fn new(
+        caster: &RayCaster<'_>,
+        rays: &Rays,
+        depth: Vec<f64>,
+        seed: &[f64],
+    ) -> HostMap {
         let width = rays.size().x as usize;
-        let shows_host = depth
+        let shows_host = seed
             .par_iter()
             .enumerate()
             .map(|(k, &h)| {
