@@ -62,6 +62,8 @@ struct Instance {
     normal_y: vec4<f32>,
     normal_z: vec4<f32>,
     wire_color: vec4<f32>,
+    // Linear RGBA of the shaded surface.
+    fill_color: vec4<f32>,
     line_width: f32,
     // INSTANCE_EDGES, INSTANCE_OUTLINES.
     flags: u32,
@@ -381,10 +383,10 @@ fn surface_color(f: Frame, inst: Instance, p: vec3<f32>, normal: vec3<f32>, face
     }
     if !(dot(n, n) > 0.0) {
         // Seen edge-on or degenerate: light it as if it faced the viewer.
-        return shade(f.fill_color.rgb, normalize(f.light_dir.xyz), 1.0, f.light_dir.xyz, f.ambient);
+        return shade(inst.fill_color.rgb, normalize(f.light_dir.xyz), 1.0, f.light_dir.xyz, f.ambient);
     }
     let world = vec3<f32>(dot(inst.normal_x.xyz, n), dot(inst.normal_y.xyz, n), dot(inst.normal_z.xyz, n));
-    return shade(f.fill_color.rgb, normalize(world), dot(n, to_eye), f.light_dir.xyz, f.ambient);
+    return shade(inst.fill_color.rgb, normalize(world), dot(n, to_eye), f.light_dir.xyz, f.ambient);
 }
 
 fn linear_to_srgb(c: vec3<f32>) -> vec3<f32> {

@@ -42,6 +42,7 @@ struct Instance {
     vec4 normal_y;
     vec4 normal_z;
     vec4 wire_color;
+    vec4 fill_color;
     float line_width;
     uint flags;
     uint vertex_base;
@@ -207,10 +208,10 @@ vec3 surface_color(Instance inst, vec3 p, vec3 normal, vec3 face_normal) {
         n = face_normal;
     }
     if (!(dot(n, n) > 0.0)) {
-        return shade(frame.fill_color.rgb, normalize(frame.light_dir.xyz), 1.0, frame.light_dir.xyz, frame.ambient);
+        return shade(inst.fill_color.rgb, normalize(frame.light_dir.xyz), 1.0, frame.light_dir.xyz, frame.ambient);
     }
     vec3 world = vec3(dot(inst.normal_x.xyz, n), dot(inst.normal_y.xyz, n), dot(inst.normal_z.xyz, n));
-    return shade(frame.fill_color.rgb, normalize(world), dot(n, to_eye), frame.light_dir.xyz, frame.ambient);
+    return shade(inst.fill_color.rgb, normalize(world), dot(n, to_eye), frame.light_dir.xyz, frame.ambient);
 }
 
 float line_intensity(float d, float width) {

@@ -19,6 +19,9 @@ pub const MAX_INSTANCES: u32 = 1 << 20;
 pub struct InstanceStyle {
     /// Colour of this instance's lines (its edges and its outline).
     pub wire_color: Option<Color>,
+    /// Colour of this instance's shaded surface, before lighting (its alpha is unused:
+    /// surfaces are opaque).
+    pub fill_color: Option<Color>,
     /// Width of this instance's lines, in pixels.
     pub line_width: Option<f32>,
     /// `Some(false)` draws none of this instance's edges; it still occludes, and still has
@@ -77,6 +80,11 @@ impl InstanceStyle {
         if let Some(c) = self.wire_color {
             if c.0.iter().any(|v| !v.is_finite()) {
                 return bad(format!("wire colour {:?} is not finite", c.0));
+            }
+        }
+        if let Some(c) = self.fill_color {
+            if c.0.iter().any(|v| !v.is_finite()) {
+                return bad(format!("fill colour {:?} is not finite", c.0));
             }
         }
         Ok(())

@@ -57,9 +57,11 @@ impl Color {
 pub struct Style {
     /// Line width in pixels, constant at any distance and resolution.
     pub line_width: f32,
-    /// Colour of the lines; its alpha scales the line's opacity.
+    /// Colour of the lines; its alpha scales the line's opacity
+    /// ([`InstanceStyle::wire_color`](crate::InstanceStyle::wire_color) overrides it).
     pub wire_color: Color,
-    /// Base colour of the shaded surface.
+    /// Base colour of the shaded surface
+    /// ([`InstanceStyle::fill_color`](crate::InstanceStyle::fill_color) overrides it).
     pub fill_color: Color,
     /// Colour where no triangle is visible.
     pub background: Color,

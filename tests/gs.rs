@@ -139,8 +139,8 @@ fn gs_draws_what_forward_draws_on_the_shared_meshes() {
 }
 
 /// More instances than one draw's uniform block holds (256), mirrored ones among them, of
-/// two meshes, with per-instance line colours and widths and one without edges: the draws
-/// are split, and every instance keeps its own record.
+/// two meshes, with per-instance line and fill colours and widths and one without edges: the
+/// draws are split, and every instance keeps its own record.
 #[test]
 fn gs_draws_many_instances_as_forward_does() {
     let sphere = wirepass::mesh::sphere(200).unwrap();
@@ -162,6 +162,7 @@ fn gs_draws_many_instances_as_forward_does() {
             transform,
             style: InstanceStyle {
                 wire_color: (k % 5 == 0).then(|| wirepass::Color::from_hex("#c81e1e").unwrap()),
+                fill_color: (k % 4 == 1).then(|| wirepass::Color::from_hex("#d0a040").unwrap()),
                 line_width: (k % 7 == 0).then_some(3.0),
                 edges: (k == 42).then_some(false),
                 outlines: None,

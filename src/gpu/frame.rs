@@ -45,6 +45,7 @@ pub(crate) struct InstanceRecord {
     fade_row: [f32; 4],
     normal: [[f32; 4]; 3],
     wire_color: [f32; 4],
+    fill_color: [f32; 4],
     line_width: f32,
     flags: u32,
     vertex_base: u32,
@@ -62,13 +63,13 @@ const INSTANCE_OUTLINES: u32 = 2;
 
 /// Instance records a uniform buffer holds (`scene.wgsl`, `UNIFORM_INSTANCES`): frames with
 /// up to this many bind them as uniforms, which software rasterizers read many times faster
-/// than storage buffers; 256 records are 52 KiB, within `Limits::default()`'s 64 KiB.
+/// than storage buffers; 256 records are 56 KiB, within `Limits::default()`'s 64 KiB.
 pub(crate) const UNIFORM_INSTANCE_CAPACITY: u32 = 256;
 
 /// Byte offset of `InstanceRecord::index`, read as an instance-rate vertex attribute.
-pub(crate) const INSTANCE_INDEX_OFFSET: u64 = 204;
+pub(crate) const INSTANCE_INDEX_OFFSET: u64 = 220;
 /// Byte offsets of `vertex_base` and `triangle_base`.
-pub(crate) const INSTANCE_BASES_OFFSET: u64 = 184;
+pub(crate) const INSTANCE_BASES_OFFSET: u64 = 200;
 /// Size of an `InstanceRecord`.
 pub(crate) const INSTANCE_BYTES: u64 = std::mem::size_of::<InstanceRecord>() as u64;
 
@@ -226,7 +227,10 @@ impl FrameRecords {
                 instance.transform,
                 mesh,
                 (
-                    s.wire_color.unwrap_or(style.wire_color).0,
+                    [
+                        s.wire_color.unwrap_or(style.wire_color).0,
+                        s.fill_color.unwrap_or(style.fill_color).0,
+                    ],
                     s.line_width.unwrap_or(style.line_width),
                     flags,
                 ),
@@ -407,7 +411,7 @@ fn instance_record(
     (eye, fade_row): (DVec4, DVec4),
     transform: DMat4,
     mesh: &MeshRecord,
-    (wire_color, line_width, flags): ([f32; 4], f32, u32),
+    ([wire_color, fill_color], line_width, flags): ([[f32; 4]; 2], f32, u32),
     (slot, cluster_first): (u32, u32),
 ) -> InstanceRecord {
     let model = transform * mesh.local_to_mesh();
@@ -437,6 +441,7 @@ fn instance_record(
         fade_row: (model.transpose() * fade_row).as_vec4().to_array(),
         normal: [row(normal, 0), row(normal, 1), row(normal, 2)],
         wire_color,
+        fill_color,
         line_width,
         flags,
         vertex_base: mesh.vertex_base,
@@ -461,7 +466,7 @@ mod tests {
 
     #[test]
     fn records_match_their_wgsl_layout() {
-        assert_eq!(std::mem::size_of::<InstanceRecord>(), 208);
+        assert_eq!(std::mem::size_of::<InstanceRecord>(), 224);
         assert_eq!(std::mem::size_of::<FrameUniforms>(), 144);
         let r = InstanceRecord::zeroed_for_test();
         let base = &r as *const _ as usize;
@@ -537,7 +542,7 @@ mod tests {
             (view.eye(), view.view_depth_row()),
             transform,
             &mesh,
-            ([0.0; 4], 1.0, 0),
+            ([[0.0; 4]; 2], 1.0, 0),
             (0, 0),
         );
         // A stored point q is the mesh point origin + scale q.

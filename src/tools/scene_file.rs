@@ -6,7 +6,8 @@
 //!   "objects": [
 //!     { "mesh": "bunny.obj", "transform": { "translate": [0, 0, 0], "rotate_deg": [0, 90, 0], "scale": 2 } },
 //!     { "mesh": "sphere:20000", "transform": [1,0,0,0, 0,1,0,0, 0,0,1,0, 3,0,0,1],
-//!       "edges": "feature:30", "outlines": false, "wire_color": "#c03020", "line_width": 3 }
+//!       "edges": "feature:30", "outlines": false, "wire_color": "#c03020", "line_width": 3,
+//!       "fill_color": "#d0c0a0" }
 //!   ],
 //!   "camera": { "eye": [4, 3, 6], "target": [0, 0, 0], "up": [0, 1, 0], "fov": 40, "near": 0.1, "far": 100 }
 //! }
@@ -22,8 +23,8 @@
 //!   false). Edge selection (feature angles, adjacency, welding) is computed per mesh in its
 //!   own coordinates. Default: the command line's `--edges`, else the mesh file's own edges
 //!   where it has them (glTF), else `polygon`.
-//! - `outlines`, `wire_color` (`#rrggbb[aa]`, sRGB), `line_width` (pixels): per-object
-//!   overrides of the command line's style.
+//! - `outlines`, `wire_color` and `fill_color` (`#rrggbb[aa]`, sRGB; the fill's alpha is
+//!   unused), `line_width` (pixels): per-object overrides of the command line's style.
 //! - `camera`: `{"eye", "target", "up", "fov", "near", "far"}` (a perspective look-at;
 //!   `far` may be `null` for an infinite far plane), or `{"view": [16], "projection": [16],
 //!   "depth": "standard"|"reversed"}` (column-major matrices as a renderer has them), or
@@ -141,12 +142,14 @@ pub fn load(
                 "edges",
                 "outlines",
                 "wire_color",
+                "fill_color",
                 "line_width",
             ]
             .contains(&key.as_str())
             {
                 return Err(fail(format!(
-                    "{}: unknown field (mesh, transform, edges, outlines, wire_color, line_width)",
+                    "{}: unknown field (mesh, transform, edges, outlines, wire_color, \
+                     fill_color, line_width)",
                     field(key)
                 )));
             }
@@ -200,14 +203,19 @@ pub fn load(
                     .ok_or_else(|| fail(format!("{}: not true or false", field("outlines"))))?,
             );
         }
-        if let Some(v) = o.get("wire_color") {
+        let color = |name: &str| -> Result<Option<Color>> {
+            let Some(v) = o.get(name) else {
+                return Ok(None);
+            };
             let s = v
                 .as_str()
-                .ok_or_else(|| fail(format!("{}: not a string", field("wire_color"))))?;
-            style.wire_color = Some(
-                Color::from_hex(s).map_err(|e| fail(format!("{}: {e}", field("wire_color"))))?,
-            );
-        }
+                .ok_or_else(|| fail(format!("{}: not a string", field(name))))?;
+            Color::from_hex(s)
+                .map(Some)
+                .map_err(|e| fail(format!("{}: {e}", field(name))))
+        };
+        style.wire_color = color("wire_color")?;
+        style.fill_color = color("fill_color")?;
         if let Some(v) = o.get("line_width") {
             let w = v
                 .as_f64()
@@ -432,7 +440,7 @@ mod tests {
             r##"{"objects": [
                 {"mesh": "sphere:200"},
                 {"mesh": "sphere:200", "transform": {"translate": [3, 0, 0]}, "edges": "none",
-                 "wire_color": "#ff0000", "line_width": 3},
+                 "wire_color": "#ff0000", "line_width": 3, "fill_color": "#00ff00"},
                 {"mesh": "sphere:200", "edges": "all", "outlines": false}
             ],
             "camera": {"eye": [0, 0, 5], "orthographic": {"height": 4, "near": 0.1, "far": 20}}}"##,
@@ -442,6 +450,11 @@ mod tests {
         assert_eq!(world.objects.len(), 3);
         assert_eq!(world.objects[1].style.edges, Some(false));
         assert_eq!(world.objects[1].style.line_width, Some(3.0));
+        assert_eq!(
+            world.objects[1].style.fill_color,
+            Some(Color([0.0, 1.0, 0.0, 1.0]))
+        );
+        assert_eq!(world.objects[0].style.fill_color, None);
         assert_eq!(world.objects[2].style.outlines, Some(false));
         assert!(camera.unwrap().view(1.5).is_orthographic());
     }
@@ -472,6 +485,10 @@ mod tests {
             (
                 r#"{"objects": [{"mesh": "sphere:100", "line_width": 1000}]}"#,
                 "line width 1000",
+            ),
+            (
+                r#"{"objects": [{"mesh": "sphere:100", "fill_color": "green"}]}"#,
+                "objects[0].fill_color",
             ),
             (
                 r#"{"objects": [{"mesh": "missing.obj"}]}"#,

@@ -182,7 +182,6 @@ struct Shading {
     eye: DVec4,
     fade_row: DVec4,
     light: DVec3,
-    fill: [f64; 3],
     background: Color,
     ambient: f64,
     fade: [f64; 2],
@@ -191,12 +190,10 @@ struct Shading {
 impl Shading {
     fn new(shot: &Shot<'_>) -> Self {
         let s = shot.style;
-        let rgb = |c: Color| [0, 1, 2].map(|i| f64::from(c.0[i]));
         Self {
             eye: shot.view.eye(),
             fade_row: shot.view.view_depth_row(),
             light: light_world_dir(&shot.view, s),
-            fill: rgb(s.fill_color),
             background: s.background,
             ambient: f64::from(s.ambient),
             fade: s.fade_range().map(f64::from),
@@ -334,11 +331,11 @@ fn surface_color(
         n = (p[1] - p[0]).cross(p[2] - p[0]);
     }
     if !(n.dot(n) > 0.0) {
-        return style::shade(sh.fill, sh.light, 1.0, sh.light, sh.ambient);
+        return style::shade(st.fill, sh.light, 1.0, sh.light, sh.ambient);
     }
     let normal = (st.normal * n).normalize_or_zero();
     let facing = normal.dot(edge_math::towards_eye(point, sh.eye));
-    style::shade(sh.fill, normal, facing, sh.light, sh.ambient)
+    style::shade(st.fill, normal, facing, sh.light, sh.ambient)
 }
 
 #[cfg(test)]

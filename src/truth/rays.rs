@@ -287,6 +287,8 @@ impl Rays {
 /// Each object's look, as the GPU's instance records carry it.
 pub(crate) struct ObjectStyle {
     pub wire: [f64; 4],
+    /// The surface's colour (linear RGB).
+    pub fill: [f64; 3],
     pub width: f64,
     pub edges: bool,
     pub outlines: bool,
@@ -306,6 +308,10 @@ impl ObjectStyle {
                     .unwrap_or(style.wire_color)
                     .0
                     .map(f64::from),
+                fill: {
+                    let c = o.style.fill_color.unwrap_or(style.fill_color).0;
+                    [0, 1, 2].map(|i| f64::from(c[i]))
+                },
                 width: f64::from(o.style.line_width.unwrap_or(style.line_width)),
                 edges: o.style.edges.unwrap_or(true),
                 outlines: o.style.outlines.unwrap_or(style.silhouettes),
