@@ -419,13 +419,16 @@ fn encode_srgb(linear: f32) -> u8 {
     (s * 255.0).round() as u8
 }
 
-/// The lines composited into the host's own render pass, read back as sRGB bytes.
-fn composited(formats: HostFormats, content: Composite) -> Vec<u8> {
+/// The host's frame, drawn through `host_view`, with `wp`'s instances seen through
+/// `scene_view` composited into the host's own render pass as `content`; submitted.
+fn composite_over_host(
+    formats: HostFormats,
+    (host_view, scene_view): (wirepass::View, wirepass::View),
+    wp: &Wirepass,
+    content: Composite,
+) -> HostTargets {
     let ctx = device();
-    let f = fixture();
-    let view = f.scene.view(ASPECT, DepthRange::Standard);
-    let targets = draw_host(formats, &view, SIZE);
-    let wp = Wirepass::new();
+    let targets = draw_host(formats, &host_view, SIZE);
     let mut pass = DeferredPass::new(
         &ctx.device,
         PassOptions {
@@ -441,9 +444,9 @@ fn composited(formats: HostFormats, content: Composite) -> Vec<u8> {
     .unwrap();
     let canvas = Canvas::new(SIZE).with_host_depth(HostDepth {
         texture: &targets.depth,
-        matrices: view,
+        matrices: host_view,
     });
-    let frame = wp.prepare(&mut pass, view, canvas).unwrap();
+    let frame = wp.prepare(&mut pass, scene_view, canvas).unwrap();
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
     pass.encode(
         &ctx.device,
@@ -456,8 +459,15 @@ fn composited(formats: HostFormats, content: Composite) -> Vec<u8> {
     pass.render(&mut targets.overlay_pass(&mut encoder), &frame)
         .unwrap();
     ctx.queue.submit([encoder.finish()]);
+    targets
+}
+
+/// The lines composited into the host's own render pass, read back as sRGB bytes.
+fn composited(formats: HostFormats, content: Composite) -> Vec<u8> {
+    let view = fixture().scene.view(ASPECT, DepthRange::Standard);
+    let targets = composite_over_host(formats, (view, view), &Wirepass::new(), content);
     let rgba = read_srgb8(targets.image());
-    ctx.finish().unwrap();
+    device().finish().unwrap();
     rgba
 }
 
@@ -752,42 +762,13 @@ fn shaded_surfaces(
     scene_view: wirepass::View,
 ) -> Vec<[f32; 4]> {
     let ctx = device();
-    let targets = draw_host(formats, &host_view, SIZE);
     let mut wp = Wirepass::new();
     for i in &mut wp.instances {
         i.style.edges = Some(false);
         i.style.outlines = Some(false);
     }
-    let mut pass = DeferredPass::new(
-        &ctx.device,
-        PassOptions {
-            render_target: Some(RenderTarget {
-                format: formats.color,
-                sample_count: formats.samples,
-                depth_stencil: Some(formats.depth),
-                content: Composite::Shaded,
-            }),
-            ..Default::default()
-        },
-    )
-    .unwrap();
-    let canvas = Canvas::new(SIZE).with_host_depth(HostDepth {
-        texture: &targets.depth,
-        matrices: host_view,
-    });
-    let frame = wp.prepare(&mut pass, scene_view, canvas).unwrap();
-    let mut encoder = ctx.device.create_command_encoder(&Default::default());
-    pass.encode(
-        &ctx.device,
-        &mut encoder,
-        &wp.store,
-        &frame,
-        OutputTarget::RenderPass,
-    )
-    .unwrap();
-    pass.render(&mut targets.overlay_pass(&mut encoder), &frame)
-        .unwrap();
-    ctx.queue.submit([encoder.finish()]);
+    let views = (host_view, scene_view);
+    let targets = composite_over_host(formats, views, &wp, Composite::Shaded);
     let bytes = read_texture(
         &ctx.device,
         &ctx.queue,
