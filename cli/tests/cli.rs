@@ -127,20 +127,22 @@ fn bench_json(args: &[&str], out: &std::path::Path) -> serde_json::Value {
     serde_json::from_slice(&std::fs::read(out.join("bench.json")).unwrap()).unwrap()
 }
 
+/// A bench run small enough for a test: a 2 k-triangle sphere, 64×48, two frames.
+const TINY_BENCH: [&str; 7] = [
+    "sphere:2000",
+    "--size",
+    "64x48",
+    "--frames",
+    "2",
+    "--warmup",
+    "0",
+];
+
 #[test]
 fn bench_times_only_the_methods_asked_for() {
     let out = temp("bench-methods");
-    let args = [
-        "sphere:2000",
-        "--size",
-        "64x48",
-        "--frames",
-        "2",
-        "--warmup",
-        "0",
-    ];
     let json = bench_json(
-        &[&args[..], &["--methods", "floor,deferred"]].concat(),
+        &[&TINY_BENCH[..], &["--methods", "floor,deferred"]].concat(),
         &out,
     );
     let methods: Vec<_> = json["runs"]
@@ -434,18 +436,9 @@ fn gs_is_skipped_with_its_reason_where_opengl_is_missing() {
 #[test]
 fn bench_times_outlines_on_and_off_in_one_run() {
     let out = temp("bench-outlines");
-    let args = [
-        "sphere:2000",
-        "--size",
-        "64x48",
-        "--frames",
-        "2",
-        "--warmup",
-        "0",
-    ];
     let json = bench_json(
         &[
-            &args[..],
+            &TINY_BENCH[..],
             &["--silhouettes", "on,off", "--methods", "deferred,gs"],
         ]
         .concat(),
