@@ -40,8 +40,14 @@ struct Frame {
     clusters: u32,
     // Host depth: 1 when the id target was seeded from the host's depth.
     host_depth: u32,
-    _pad0: u32,
-    _pad1: u32,
+    // Hidden lines (HIDDEN): 1 when those the host's depth hides are drawn too.
+    hidden_behind_host: u32,
+    // Opacity of the shaded surface over the background (`see_through`).
+    fill_opacity: f32,
+    // Hidden lines (HIDDEN): linear RGBA colour; width, dash and period of the pattern
+    // (period 0 for solid, `dash_nearest`) in pixels.
+    hidden_color: vec4<f32>,
+    hidden_line: vec4<f32>,
 }
 
 // Per instance (src/gpu/frame.rs, InstanceRecord). "Local" coordinates are the mesh
@@ -265,6 +271,41 @@ fn line_reach(width: f32) -> f32 {
 // 1 everywhere when fade.y <= fade.x (no fade).
 fn depth_fade(depth: f32, fade: vec2<f32>) -> f32 {
     return select(1.0, clamp((fade.y - depth) / (fade.y - fade.x), 0.0, 1.0), fade.y > fade.x);
+}
+
+// The shaded surface `surface` over `under` (premultiplied, linear) at opacity k (the
+// frame's fill opacity): `surface` itself, bit for bit, where the surface is opaque.
+fn see_through(surface: vec3<f32>, under: vec4<f32>, k: f32) -> vec4<f32> {
+    if k < 1.0 {
+        return vec4<f32>(surface * k + under.rgb * (1.0 - k), k + under.a * (1.0 - k));
+    }
+    return vec4<f32>(surface, 1.0);
+}
+
+// Twin of `style::dash_nearest`: of the points of the dashes [j period, j period + dash]
+// (every integer j; period 0 for a solid line) that lie in [lo, hi], the one nearest s
+// (positions along a line, pixels); NO_EDGE where the interval holds none.
+fn dash_nearest(s: f32, lo: f32, hi: f32, dash: f32, period: f32) -> f32 {
+    if !(lo <= hi) {
+        return NO_EDGE;
+    }
+    let c = clamp(s, lo, hi);
+    if !(period > 0.0) {
+        return c;
+    }
+    let start = floor(c / period) * period;
+    if c - start <= dash {
+        return c;
+    }
+    // c lies in the gap between a dash's end and the next one's start.
+    let end = start + dash;
+    let next = start + period;
+    let has_end = end >= lo;
+    let has_next = next <= hi;
+    if has_end && (!has_next || s - end <= next - s) {
+        return end;
+    }
+    return select(NO_EDGE, next, has_next);
 }
 
 // Which line colours a pixel most: lines are ranked by their intensity in 1/4095 steps, and

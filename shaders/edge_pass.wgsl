@@ -30,7 +30,8 @@
 //
 // Flags: OUTLINES (read what the outline pass left), PATCHES (some instance draws a mesh with
 // undrawn edges: a pixel near one searches its patch, `patch_distance`), COLORS (instances differ in line
-// colour: the outline pass also left which instance's line a pixel holds), HOST (the host's
+// colour: the outline pass also left which instance's line a pixel holds), HIDDEN (the outline
+// pass left hidden lines, drawn under the visible ones: `hidden_at`), HOST (the host's
 // depth seeded the targets: a triangle must also be nearer than it), and the output
 // mode: MODE_SHADE, MODE_OVERLAY, MODE_RESULT (with SHADED: surface and lines, else lines
 // only), MODE_DIAGNOSTIC.
@@ -114,6 +115,15 @@ fn outline_at(xy: vec2<u32>) -> vec2<u32> {
 #endif
 #endif
     return vec2<u32>(key, owner);
+}
+
+// The key of the hidden line the outline pass left in target pixel `xy` (0 for none).
+fn hidden_at(xy: vec2<u32>) -> u32 {
+#if HIDDEN
+    return acc[hidden_lines() + xy.y * u32(frame.target_size.x) + xy.x];
+#else
+    return 0u;
+#endif
 }
 
 // A pixel whose centre no triangle covers (`inst` is BACKGROUND_ID or HOST_ID): only the
@@ -447,14 +457,25 @@ fn surface_pixel(xy: vec2<u32>, s: Sample, own: f32) -> Pixel {
 }
 
 // Writes pixel `p` of target pixel `xy` into the output.
+// The visible line goes over the hidden line, which goes over what is below.
 fn store_pixel(xy: vec2<u32>, p: Pixel) {
     let out = xy - vec2<u32>(frame.output_offset);
     let i = p.line * p.wire.a;
+    let hidden_key = hidden_at(xy);
+#if HIDDEN
+    let h = key_intensity(hidden_key) * frame.hidden_color.a;
+    let hidden = frame.hidden_color.rgb;
+#endif
 #if MODE_SHADE
     var base = frame.background;
     if p.inst < HOST_ID {
-        base = vec4<f32>(p.surface, 1.0);
+        // The background's colour, premultiplied, under a see-through surface.
+        base = see_through(p.surface, vec4<f32>(base.rgb * base.a, base.a), frame.fill_opacity);
+        base = vec4<f32>(base.rgb / max(base.a, 1e-30), base.a);
     }
+#if HIDDEN
+    base = vec4<f32>(mix(base.rgb, hidden, h), max(base.a, h));
+#endif
     textureStore(out_color, out, encode_output(vec4<f32>(mix(base.rgb, p.wire.rgb, i), max(base.a, i))));
 #endif
 #if MODE_OVERLAY
@@ -462,19 +483,39 @@ fn store_pixel(xy: vec2<u32>, p: Pixel) {
 #if HOST_ENCODED
     host = vec4<f32>(srgb_to_linear(host.rgb), host.a);
 #endif
+#if HIDDEN
+    host = vec4<f32>(mix(host.rgb, hidden, h), max(host.a, h));
+#endif
     textureStore(out_color, out, encode_output(vec4<f32>(mix(host.rgb, p.wire.rgb, i), max(host.a, i))));
 #endif
 #if MODE_RESULT
     var color = vec4<f32>(p.wire.rgb * i, i);
+#if HIDDEN
+    color += vec4<f32>(hidden * h, h) * (1.0 - i);
+#endif
 #if SHADED
     if p.inst < HOST_ID {
-        color = vec4<f32>(mix(p.surface, p.wire.rgb, i), 1.0);
+        var surface = p.surface;
+#if HIDDEN
+        surface = mix(surface, hidden, h);
+#endif
+        color = vec4<f32>(mix(surface, p.wire.rgb, i), 1.0);
+        if frame.fill_opacity < 1.0 {
+            // Premultiplied: the surface at its opacity, the hidden line over it, the line
+            // over both; the host's image shows through what is left.
+            var under = see_through(p.surface, vec4<f32>(0.0), frame.fill_opacity);
+#if HIDDEN
+            under = under * (1.0 - h) + vec4<f32>(hidden * h, h);
+#endif
+            color = under * (1.0 - i) + vec4<f32>(p.wire.rgb * i, i);
+        }
     }
 #endif
     textureStore(out_color, out, color);
 #endif
 #if MODE_DIAGNOSTIC
-    textureStore(out_diagnostic, out, vec4<f32>(p.distance, p.depth, 0.0, 0.0));
+    // b: the distance to the hidden line that colours the pixel (NO_EDGE for none).
+    textureStore(out_diagnostic, out, vec4<f32>(p.distance, p.depth, key_distance(hidden_key), 0.0));
     textureStore(out_ids, out, vec4<u32>(p.inst, p.tri, 0u, 0u));
 #endif
 }

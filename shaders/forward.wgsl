@@ -137,6 +137,6 @@ fn fs_maps(in: Varyings) -> MapsOut {
     if d >= 0.5 * MASKED {
         d = NO_EDGE;
     }
-    out.diag = vec4<u32>(bitcast<u32>(d), bitcast<u32>(in.clip.z), 0u, 0u);
+    out.diag = vec4<u32>(bitcast<u32>(d), bitcast<u32>(in.clip.z), bitcast<u32>(NO_EDGE), 0u);
     return out;
 }

@@ -239,7 +239,7 @@ void main() {
     if (d >= 0.5 * MASKED) {
         d = NO_EDGE;
     }
-    diag = uvec4(floatBitsToUint(d), floatBitsToUint(gl_FragCoord.z), 0u, 0u);
+    diag = uvec4(floatBitsToUint(d), floatBitsToUint(gl_FragCoord.z), floatBitsToUint(3.0e38), 0u);
 #endif
 }
 

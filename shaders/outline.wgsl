@@ -22,8 +22,14 @@
 // src/mesh/patches.rs) are drawn here the same way, as the only lines their pixels get beyond
 // their own triangle's edges.
 //
+// Hidden lines (HIDDEN): every drawn edge in view (the selected edges and the outlines) is
+// listed too, and the pixels within reach of the hidden runs of each (where the same test
+// finds a surface in front) get the key of the nearest point of a dash of the hidden-line
+// pattern (`dash_nearest`) in their own word (`hidden_lines`). The pattern's phase runs
+// along the edge's projection from its end that comes first in (x, y, z) order.
+//
 // Flags: COLORS (instances differ in line colour: each pixel also keeps the greatest
-// (intensity level, instance) pair, so the edge pass knows whose line it holds).
+// (intensity level, instance) pair, so the edge pass knows whose line it holds), HIDDEN.
 
 @group(0) @binding(9) var<storage, read> clusters: array<Cluster>;
 // The outline buffer (`outline_tile_marks` in scene.wgsl): the lines, and the output tiles
@@ -100,7 +106,13 @@ fn outline_cull(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     let cluster = clusters[instances[slot(inst)].cluster_base + c];
     let outlines = (flags & INSTANCE_OUTLINES) != 0u && cluster_may_fold(cluster, instances[slot(inst)].eye);
     let splats = (flags & INSTANCE_EDGES) != 0u && cluster_splats(cluster);
-    if !outlines && !splats {
+#if HIDDEN
+    // Every drawn edge in view has a hidden part to find.
+    let hidden = (flags & INSTANCE_EDGES) != 0u && cluster_in_view(instances[slot(inst)].clip, cluster);
+#else
+    let hidden = false;
+#endif
+    if !outlines && !splats && !hidden {
         return;
     }
     let k = atomicAdd(&cull_rw.count, 1u);
@@ -108,6 +120,26 @@ fn outline_cull(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     let size = list_size(k, 1u);
     atomicMax(&cull_rw.x, size.x);
     atomicMax(&cull_rw.y, size.y);
+}
+
+// Whether a cluster's bounding sphere reaches the view volume (local -> clip rows x, y,
+// near, w: `clip`), widened by the targets' guard band.
+fn cluster_in_view(clip: mat4x4<f32>, c: Cluster) -> bool {
+    let m = 1.0 + 2.0 * frame.output_offset / frame.image_size;
+    var planes = array<vec4<f32>, 5>(
+        vec4<f32>(1.0, 0.0, 0.0, m.x),
+        vec4<f32>(-1.0, 0.0, 0.0, m.x),
+        vec4<f32>(0.0, 1.0, 0.0, m.y),
+        vec4<f32>(0.0, -1.0, 0.0, m.y),
+        vec4<f32>(0.0, 0.0, 1.0, 0.0),
+    );
+    var inside = true;
+    for (var k = 0u; k < 5u; k++) {
+        // The plane's function of a local point, dot(plane, clip * (p, 1)).
+        let r = planes[k] * clip;
+        inside = inside && dot(r.xyz, c.center) + r.w >= -c.radius * length(r.xyz);
+    }
+    return inside;
 }
 
 // Triangles per cluster, and invocations per workgroup of both entry points.
@@ -137,14 +169,15 @@ fn outline_pieces_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_i
         let at = list + 4u + PIECE_WORDS * k;
         let inst = atomicLoad(&acc_rw[at]);
         let t = atomicLoad(&acc_rw[at + 1u]);
-        let i = atomicLoad(&acc_rw[at + 2u]);
+        let word = atomicLoad(&acc_rw[at + 2u]);
+        let i = word & 3u;
         let piece = atomicLoad(&acc_rw[at + 3u]) & 0xffffu;
         let base = instances[slot(inst)].triangle_base;
         let v = corners(base + t) + instances[slot(inst)].vertex_base;
         let a = vertex_at(v[i]).xyz;
         let b = vertex_at(v[(i + 1u) % 3u]).xyz;
-        let c = clip_outline(inst, t, neighbour(base + t, i), a, b);
-        draw_piece(c.seg, f32(piece) / f32(c.pieces), f32(piece + 1u) / f32(c.pieces), c.length_px);
+        let c = clip_outline(inst, t, neighbour(base + t, i), a, b, comes_first(a, b));
+        draw_piece(c.seg, f32(piece) / f32(c.pieces), f32(piece + 1u) / f32(c.pieces), c.length_px, word >> 2u);
     }
 }
 
@@ -164,6 +197,12 @@ fn outline_triangle(inst: u32, t: u32) {
     let allowed = select(0u, (bits >> 8u) & 7u, outlines);
     // Drawn edges of a large patch, drawn here like outlines (mesh_store::EdgeData).
     let splat = select(0u, (bits >> 12u) & 7u, (flags & INSTANCE_EDGES) != 0u);
+#if HIDDEN
+    // Drawn edges: their hidden parts, wherever they are.
+    let drawn = select(0u, bits & 7u, (flags & INSTANCE_EDGES) != 0u);
+#else
+    let drawn = 0u;
+#endif
     // Decoded as adjacency::fold_bound: 0 flat, 2^(q - 14) with a margin, 15 never skip.
     let q = (bits >> 4u) & 15u;
     var fold_bound = exp2(f32(q) - 14.0) * 1.01 + 1e-6;
@@ -180,11 +219,11 @@ fn outline_triangle(inst: u32, t: u32) {
     // Seen along one direction (w = 0): the angle to edge-on is the same from every vertex.
     let along = !(abs(dot(eye.xyz, normal)) > fold_bound * length(eye.xyz) * length(normal));
     let may_fold = select(along, !(height > fold_bound * farthest * length(normal)), eye.w != 0.0);
-    if !(may_fold && outlines) && !boundary && splat == 0u {
+    if !(may_fold && outlines) && !boundary && splat == 0u && drawn == 0u {
         return;
     }
     for (var i = 0u; i < 3u; i++) {
-        if ((allowed | splat) & (1u << i)) == 0u {
+        if ((allowed | splat | drawn) & (1u << i)) == 0u {
             continue;
         }
         let word = neighbour_word(base + t, i);
@@ -199,11 +238,29 @@ fn outline_triangle(inst: u32, t: u32) {
             let d = (q.q0.xyz + q.q1.xyz + q.q2.xyz) / 3.0;
             outline = is_silhouette(a, b, p[(i + 2u) % 3u], d, eye);
         }
-        if outline {
-            list_outline(inst, t, i, n, a, b);
+        var mode = select(0u, DRAW_VISIBLE, outline);
+#if HIDDEN
+        // A shared drawn edge is drawn by the lower id only.
+        let hidden = outline || ((drawn & (1u << i)) != 0u && (n == BACKGROUND_ID || t < n));
+        mode |= select(0u, DRAW_HIDDEN, hidden);
+#endif
+        if mode != 0u {
+            list_outline(inst, t, i, n, a, b, comes_first(a, b), mode);
         }
     }
 }
+
+// Whether a comes before b in (x, y, z) order: the end of an edge that anchors its line
+// pattern, the same whichever triangle draws the edge and whatever the vertices' numbers
+// (twin of `comes_first` in src/truth/outline.rs).
+fn comes_first(a: vec3<f32>, b: vec3<f32>) -> bool {
+    return a.x < b.x || (a.x == b.x && (a.y < b.y || (a.y == b.y && a.z < b.z)));
+}
+
+// What a listed edge draws: its visible runs (into the lines), its hidden runs (HIDDEN, into
+// the hidden lines).
+const DRAW_VISIBLE: u32 = 1u;
+const DRAW_HIDDEN: u32 = 2u;
 
 // Narrows [range.x, range.y] to the parameters u where lo <= p0 + u d <= hi.
 fn keep_between(range: vec2<f32>, p0: f32, d: f32, lo: f32, hi: f32) -> vec2<f32> {
@@ -251,30 +308,43 @@ struct Segment {
     inst: u32,
     t: u32,
     n: u32,
+    // Position of `start` along the line pattern (pixels from the pattern's anchor), and
+    // +1 or -1 as the pattern runs towards `end` or away from it.
+    phase: f32,
+    phase_dir: f32,
 }
 
 fn seg_at(s: Segment, k: f32) -> Projected {
     return lerp_projected(s.start, s.end, k);
 }
 
-fn seg_visible(s: Segment, k: f32) -> bool {
+// The class of the segment's point at k: 0 visible, 1 hidden (by a surface of the scene, or
+// by the host's where hidden lines are drawn behind it), 2 neither drawn (behind the host).
+// Without HIDDEN only visible or not: 0 or 1.
+fn seg_class(s: Segment, k: f32) -> u32 {
     let q = seg_at(s, k);
     let w = 1.0 / q.inv_w;
-    return visible_at(q.xy, q.near_w * w, w, q.reverse, s.inst, s.t, s.n);
+    let c = class_at(q.xy, q.near_w * w, w, q.reverse, s.inst, s.t, s.n);
+#if HIDDEN
+    return select(c, 1u, c == 2u && frame.hidden_behind_host != 0u);
+#else
+    return min(c, 1u);
+#endif
 }
 
 // Edge a -> b of triangle t of `inst` (with neighbour n) on screen: its segment in front of
 // the near plane, not beyond the far one, and inside the image and its guard band (not the
 // targets: a tile then samples and bisects the same points as the whole image, and computes
 // exactly what the whole image does), its length, and the pieces it is drawn in (0 when
-// nothing is left of it).
+// nothing is left of it). The line pattern is anchored at a (`a_first`) or b, or where the
+// near or far plane cuts the edge short of that end.
 struct Clipped {
     seg: Segment,
     length_px: f32,
     pieces: u32,
 }
 
-fn clip_outline(inst: u32, t: u32, n: u32, a: vec3<f32>, b: vec3<f32>) -> Clipped {
+fn clip_outline(inst: u32, t: u32, n: u32, a: vec3<f32>, b: vec3<f32>, a_first: bool) -> Clipped {
     var c: Clipped;
     c.pieces = 0u;
     let clip = instances[slot(inst)].clip;
@@ -308,17 +378,23 @@ fn clip_outline(inst: u32, t: u32, n: u32, a: vec3<f32>, b: vec3<f32>) -> Clippe
     c.seg.inst = inst;
     c.seg.t = t;
     c.seg.n = n;
+    let full = length(d);
+    c.seg.phase = select((1.0 - u.x) * full, u.x * full, a_first);
+    c.seg.phase_dir = select(-1.0, 1.0, a_first);
     c.length_px = length(c.seg.end.xy - c.seg.start.xy);
     c.pieces = max(u32(ceil(c.length_px / PIECE_PX)), 1u);
     return c;
 }
 
 // Lists the pieces of edge i (a -> b) of triangle t of `inst`, with neighbour n, that lie
-// within reach of the targets (of a tile) for outline_pieces_main. Where the list is full
-// the piece is drawn here.
-fn list_outline(inst: u32, t: u32, i: u32, n: u32, a: vec3<f32>, b: vec3<f32>) {
-    let c = clip_outline(inst, t, n, a, b);
-    let reach = line_reach(instances[slot(inst)].line_width);
+// within reach of the targets (of a tile) for outline_pieces_main, to draw as `mode` says
+// (DRAW_VISIBLE, DRAW_HIDDEN). Where the list is full the piece is drawn here.
+fn list_outline(inst: u32, t: u32, i: u32, n: u32, a: vec3<f32>, b: vec3<f32>, a_first: bool, mode: u32) {
+    let c = clip_outline(inst, t, n, a, b, a_first);
+    var reach = select(0.0, line_reach(instances[slot(inst)].line_width), (mode & DRAW_VISIBLE) != 0u);
+#if HIDDEN
+    reach = max(reach, select(0.0, line_reach(frame.hidden_line.x), (mode & DRAW_HIDDEN) != 0u));
+#endif
     let first = frame.target_origin - reach;
     let last = frame.target_origin + frame.target_size + reach;
     let list = piece_list();
@@ -341,31 +417,35 @@ fn list_outline(inst: u32, t: u32, i: u32, n: u32, a: vec3<f32>, b: vec3<f32>) {
             let at = list + 4u + PIECE_WORDS * k;
             atomicStore(&acc_rw[at], inst);
             atomicStore(&acc_rw[at + 1u], t);
-            atomicStore(&acc_rw[at + 2u], i);
+            atomicStore(&acc_rw[at + 2u], i | (mode << 2u));
             atomicStore(&acc_rw[at + 3u], piece | (c.pieces << 16u));
             let size = list_size(k, 64u);
             atomicMax(&acc_rw[list], size.x);
             atomicMax(&acc_rw[list + 1u], size.y);
         } else {
-            draw_piece(c.seg, k0, k1, c.length_px);
+            draw_piece(c.seg, k0, k1, c.length_px, mode);
         }
     }
 }
 
-// Finds the visible runs of the segment between parameters k0 and k1, then writes the
-// key of the nearest of them into every pixel within reach.
-fn draw_piece(seg: Segment, k0: f32, k1: f32, length_px: f32) {
+// Finds the visible (and, with DRAW_HIDDEN in `mode`, the hidden) runs of the segment
+// between parameters k0 and k1, then writes the key of the nearest of them into every pixel
+// within reach.
+fn draw_piece(seg: Segment, k0: f32, k1: f32, length_px: f32, mode: u32) {
     var runs: array<vec2<f32>, MAX_RUNS>;
     var count = 0u;
+    var hidden_runs: array<vec2<f32>, MAX_RUNS>;
+    var hidden_count = 0u;
     let steps = max(u32(ceil(length_px * (k1 - k0) * RUN_SAMPLES_PER_PX)), 1u);
-    // One loop and one call of seg_visible: sample k0 and then each step; where visibility
+    // One loop and one call of seg_class: sample k0 and then each step; where the class
     // changes between two steps, the next RUN_BISECTIONS iterations bisect that interval.
     // (A shader holding one copy of the visibility test instead of three compiles smaller,
     // and lavapipe runs every copy for every lane.)
     var j = 0u;
     var bisections = 0u;
     var last_k = k0;
-    var last_visible = false;
+    var last_class = 0u;
+    var step_class = 0u;
     var start = k0;
     var lo = k0;
     var hi = k0;
@@ -375,9 +455,10 @@ fn draw_piece(seg: Segment, k0: f32, k1: f32, length_px: f32) {
         if bisections > 0u {
             k = 0.5 * (lo + hi);
         }
-        let now = seg_visible(seg, k);
+        let now = seg_class(seg, k);
+        var ended = false;
         if bisections > 0u {
-            if now == last_visible {
+            if now == last_class {
                 lo = k;
             } else {
                 hi = k;
@@ -385,53 +466,87 @@ fn draw_piece(seg: Segment, k0: f32, k1: f32, length_px: f32) {
             bisections -= 1u;
             if bisections == 0u {
                 // The change between last_k and step_k lies between lo and hi.
-                if !last_visible {
-                    start = hi;
-                } else if count < MAX_RUNS {
-                    runs[count] = vec2<f32>(start, lo);
-                    count++;
-                } else {
-                    runs[MAX_RUNS - 1u].y = lo;
-                }
-                last_visible = !last_visible;
-                last_k = step_k;
+                ended = true;
                 j++;
             }
         } else if j == 0u {
-            last_visible = now;
+            last_class = now;
             j = 1u;
-        } else if now != last_visible {
+        } else if now != last_class {
             lo = last_k;
             hi = k;
             step_k = k;
+            step_class = now;
             bisections = RUN_BISECTIONS;
         } else {
             last_k = k;
             j++;
         }
+        if ended {
+            // The run of last_class from start ends at lo.
+            push_run(&runs, &count, &hidden_runs, &hidden_count, last_class, vec2<f32>(start, lo));
+            start = hi;
+            last_class = step_class;
+            last_k = step_k;
+        }
         if bisections == 0u && j > steps {
+            push_run(&runs, &count, &hidden_runs, &hidden_count, last_class, vec2<f32>(start, k1));
             break;
         }
     }
-    if last_visible {
-        if count < MAX_RUNS {
-            runs[count] = vec2<f32>(start, k1);
-            count++;
+    if (mode & DRAW_VISIBLE) != 0u && count > 0u {
+        splat_runs(seg, k0, k1, &runs, count, false);
+    }
+#if HIDDEN
+    if (mode & DRAW_HIDDEN) != 0u && hidden_count > 0u {
+        splat_runs(seg, k0, k1, &hidden_runs, hidden_count, true);
+    }
+#endif
+}
+
+// Appends a run of class `kind` (seg_class) to the visible or the hidden runs; past MAX_RUNS
+// the last one absorbs it.
+fn push_run(runs: ptr<function, array<vec2<f32>, MAX_RUNS>>, count: ptr<function, u32>, hidden_runs: ptr<function, array<vec2<f32>, MAX_RUNS>>, hidden_count: ptr<function, u32>, kind: u32, run: vec2<f32>) {
+    if kind == 0u {
+        if *count < MAX_RUNS {
+            (*runs)[*count] = run;
+            *count += 1u;
         } else {
-            runs[MAX_RUNS - 1u].y = k1;
+            (*runs)[MAX_RUNS - 1u].y = run.y;
+        }
+    } else if kind == 1u {
+        if *hidden_count < MAX_RUNS {
+            (*hidden_runs)[*hidden_count] = run;
+            *hidden_count += 1u;
+        } else {
+            (*hidden_runs)[MAX_RUNS - 1u].y = run.y;
         }
     }
-    if count == 0u {
-        return;
-    }
+}
 
-    let width = instances[slot(seg.inst)].line_width;
+// Writes into every pixel within reach of the segment's `runs` (parameters, between k0 and
+// k1) the key of their nearest point: of a visible line, or (`hidden`) of a dash of the
+// hidden-line pattern, in the hidden lines' word.
+fn splat_runs(seg: Segment, k0: f32, k1: f32, runs: ptr<function, array<vec2<f32>, MAX_RUNS>>, count: u32, hidden: bool) {
+    var width = instances[slot(seg.inst)].line_width;
+    var pattern = vec2<f32>(0.0);
+    var behind_host = false;
+#if HIDDEN
+    if hidden {
+        width = frame.hidden_line.x;
+        pattern = frame.hidden_line.yz;
+        behind_host = frame.hidden_behind_host != 0u;
+    }
+#endif
     let reach = line_reach(width);
     let along = seg.end.xy - seg.start.xy;
     let q0 = seg.start.xy + k0 * along;
     let q1 = seg.start.xy + k1 * along;
     let span = q1 - q0;
     let len2 = dot(along, along);
+    // Pattern positions: phase + phase_dir * k * seg_length.
+    let seg_length = sqrt(len2);
+    let scale = seg.phase_dir * seg_length;
     // Walk the pixels along the piece's major axis; across it, the band within reach of the
     // line is at most reach × √2 wide on either side (slope <= 1), plus a pixel for rounding.
     // Pixels are addressed in target coordinates.
@@ -459,7 +574,7 @@ fn draw_piece(seg: Segment, k0: f32, k1: f32, length_px: f32) {
                 xy = vec2<i32>(o, m);
             }
             let pixel = vec2<f32>(xy) + origin + 0.5;
-            // Nearest point of the nearest visible run.
+            // Nearest point of the nearest run (of a dash in it, for a pattern).
             var k = 0.0;
             if len2 > 0.0 {
                 k = dot(pixel - seg.start.xy, along) / len2;
@@ -467,7 +582,17 @@ fn draw_piece(seg: Segment, k0: f32, k1: f32, length_px: f32) {
             var best = NO_EDGE;
             var best_k = 0.0;
             for (var r = 0u; r < count; r++) {
-                let kr = clamp(k, runs[r].x, runs[r].y);
+                let run = (*runs)[r];
+                var kr = clamp(k, run.x, run.y);
+                if pattern.y > 0.0 && scale != 0.0 {
+                    let sa = seg.phase + scale * run.x;
+                    let sb = seg.phase + scale * run.y;
+                    let sr = dash_nearest(seg.phase + scale * k, min(sa, sb), max(sa, sb), pattern.x, pattern.y);
+                    if sr == NO_EDGE {
+                        continue;
+                    }
+                    kr = clamp((sr - seg.phase) / scale, run.x, run.y);
+                }
                 let dr = distance(pixel, seg.start.xy + kr * along);
                 if dr < best {
                     best = dr;
@@ -480,13 +605,19 @@ fn draw_piece(seg: Segment, k0: f32, k1: f32, length_px: f32) {
             let q = seg_at(seg, best_k);
 #if HOST
             // The pixel shows the host, and its surface is in front of the line's point.
-            if host_hides_line(xy, q.reverse, best) {
+            if !behind_host && host_hides_line(xy, q.reverse, best) {
                 continue;
             }
 #endif
             let fade = depth_fade(q.fade_w / q.inv_w, frame.fade);
             let key = line_key(line_intensity(best, width) * fade, best);
             let index = u32(xy.y) * u32(frame.target_size.x) + u32(xy.x);
+#if HIDDEN
+            if hidden {
+                atomicMax(&acc_rw[hidden_lines() + index], key);
+                continue;
+            }
+#endif
 #if COLORS
             atomicMax(&acc_rw[2u * index], key);
             atomicMax(&acc_rw[2u * index + 1u], (key & 0xfff00000u) | seg.inst);
@@ -528,8 +659,8 @@ fn mark_outline_tiles(first_m: i32, last_m: i32, first_o: i32, last_o: i32, majo
 }
 
 // Whether the edge's point at screen point x (near row `near`, w `w`, reverse depth `reverse`)
-// is visible: unless the host hides it (host_hides_point), or a triangle other than t and n of
-// `inst` covers x nearer than the point. The candidates are the triangles the
+// is visible (0), hidden by a triangle other than t and n of `inst` that covers x nearer
+// than the point (1), or by the host (2, host_hides_point). The candidates are the triangles the
 // rasterizer gave the 3×3 pixel centres around x (a sliver of surface in front of the edge
 // may own no centre next to x, but one a pixel further on), and those a walk across edges
 // from them reaches when they do not cover x themselves (x may lie in a small triangle that
@@ -537,10 +668,10 @@ fn mark_outline_tiles(first_m: i32, last_m: i32, first_o: i32, last_o: i32, majo
 // on this side of the fold's edge, and a walk towards x, a point of a silhouette, would
 // only bounce between the edge's two triangles or wander over the far side for all its
 // steps, the slowest lane holding up its batch.
-fn visible_at(x: vec2<f32>, near: f32, w: f32, reverse: f32, inst: u32, t: u32, n: u32) -> bool {
+fn class_at(x: vec2<f32>, near: f32, w: f32, reverse: f32, inst: u32, t: u32, n: u32) -> u32 {
     let centre = vec2<i32>(floor(x - frame.target_origin));
     if host_hides_point(x - frame.target_origin, reverse) {
-        return false;
+        return 2u;
     }
     var last = vec2<u32>(BACKGROUND_ID, 0u);
     for (var k = 0; k < 9; k++) {
@@ -551,8 +682,8 @@ fn visible_at(x: vec2<f32>, near: f32, w: f32, reverse: f32, inst: u32, t: u32, 
         last = id;
         let s = locate(id.x, id.y, x, WALK_STEPS, true);
         if s.covers && !(s.inst == inst && (s.tri == t || s.tri == n)) && nearer(s.near, near, w) {
-            return false;
+            return 1u;
         }
     }
-    return true;
+    return 0u;
 }

@@ -28,7 +28,7 @@ fn fs_fill(in: Varyings) -> @location(0) vec4<f32> {
 
 @fragment
 fn fs_fill_maps(in: Varyings) -> FillMaps {
-    let diag = vec4<u32>(bitcast<u32>(NO_EDGE), bitcast<u32>(in.clip.z), 0u, 0u);
+    let diag = vec4<u32>(bitcast<u32>(NO_EDGE), bitcast<u32>(in.clip.z), bitcast<u32>(NO_EDGE), 0u);
     return FillMaps(encode_output(fill_color(in)), vec2<u32>(in.slot, in.tri), diag);
 }
 

@@ -104,7 +104,7 @@ pub use gpu::{
 };
 pub use mesh::{EdgeSelection, Mesh};
 pub use scene::{Instance, InstanceStyle, Scene};
-pub use style::{Color, Style};
+pub use style::{Color, HiddenLines, LinePattern, Style};
 
 /// The wgpu this crate is built against: use it (`wirepass::wgpu`) so the host's types match.
 pub use wgpu;

@@ -63,6 +63,10 @@ pub struct Style {
     /// Base colour of the shaded surface
     /// ([`InstanceStyle::fill_color`](crate::InstanceStyle::fill_color) overrides it).
     pub fill_color: Color,
+    /// Opacity of the shaded surface over the background, 0..1: below 1 the visible surface
+    /// is faded over the background (the "hidden lines visible" views of CAD programs, with
+    /// [`hidden`](Self::hidden) lines showing through it); 1 draws it opaque.
+    pub fill_opacity: f32,
     /// Colour where no triangle is visible.
     pub background: Color,
     /// Share of ambient light, 0..1; the rest comes from the key light.
@@ -77,6 +81,194 @@ pub struct Style {
     pub silhouettes: bool,
     /// Fade lines with their distance from the eye; `None` draws every line at full strength.
     pub depth_fade: Option<DepthFade>,
+    /// Draw the parts of the drawn lines (the selected edges and the outlines) that surfaces
+    /// hide, in a style of their own; `None` draws only what is visible. Only the deferred
+    /// pass and the ground truth draw them. See [`HiddenLines`].
+    pub hidden: Option<HiddenLines>,
+}
+
+/// How the hidden parts of the drawn lines look: the "hidden lines" of technical drawings.
+///
+/// A point of a drawn line is hidden where a surface of the scene lies in front of it (the
+/// test that ends a visible outline); the hidden and visible parts of one edge meet exactly
+/// there. Hidden lines are drawn under the surfaces' visible lines, and over the surfaces
+/// that hide them.
+///
+/// ```
+/// use wirepass::{Color, HiddenLines, LinePattern, Style};
+/// let style = Style {
+///     hidden: Some(HiddenLines {
+///         pattern: LinePattern::Dashed { dash: 6.0, gap: 4.0 },
+///         ..HiddenLines::default()
+///     }),
+///     ..Style::default()
+/// };
+/// assert!(style.validate().is_ok());
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HiddenLines {
+    /// Solid, dashed or dotted, in pixels along the projected edge.
+    pub pattern: LinePattern,
+    /// Colour of the hidden lines; its alpha scales their opacity.
+    pub color: Color,
+    /// Width in pixels, with the same profile as the visible lines.
+    pub width: f32,
+    /// Also draw, as hidden, the parts the host's depth hides (a frame prepared with the
+    /// host's depth); otherwise those are not drawn at all.
+    pub behind_host: bool,
+}
+
+impl Default for HiddenLines {
+    fn default() -> Self {
+        HiddenLines {
+            pattern: LinePattern::Dashed {
+                dash: 6.0,
+                gap: 4.0,
+            },
+            color: Color([0.2, 0.22, 0.25, 0.8]),
+            width: 1.0,
+            behind_host: false,
+        }
+    }
+}
+
+/// A line pattern along an edge's projection, in pixels.
+///
+/// Patterns are anchored to the geometry, not to the screen: the pattern's phase starts at
+/// the edge's end that comes first in (x, y, z) order of the mesh's coordinates (where that
+/// end lies behind the near plane, at the plane) and runs along its projection, so it does
+/// not crawl over the image as the camera moves.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LinePattern {
+    /// The whole line.
+    Solid,
+    /// Dashes `dash` pixels long (their round ends add half the width at each end),
+    /// `gap` pixels apart.
+    Dashed {
+        /// Length of a dash's core, pixels.
+        dash: f32,
+        /// Length of the gap between two dashes' cores, pixels.
+        gap: f32,
+    },
+    /// Dots (round, as wide as the line), one every `spacing` pixels.
+    Dotted {
+        /// Distance between two dots' centres, pixels.
+        spacing: f32,
+    },
+}
+
+impl LinePattern {
+    /// Parses `off` (no hidden lines: `None`), `solid`, `dashed[:DASH,GAP]` (default 6,4) or
+    /// `dotted[:SPACING]` (default 4), lengths in pixels, as the CLI and scene files take a
+    /// hidden-line style.
+    pub fn parse(s: &str) -> Result<Option<LinePattern>> {
+        let bad = || {
+            Error::InvalidSetting(format!(
+                "hidden-line style {s:?} is not off, solid, dashed[:DASH,GAP] or dotted[:SPACING]"
+            ))
+        };
+        let (name, lengths) = match s.split_once(':') {
+            Some((n, l)) => (n, Some(l)),
+            None => (s, None),
+        };
+        let numbers = |l: &str| -> Result<Vec<f32>> {
+            l.split(',')
+                .map(|t| t.trim().parse::<f32>().map_err(|_| bad()))
+                .collect()
+        };
+        let pattern = match (name, lengths) {
+            ("off", None) => return Ok(None),
+            ("solid", None) => LinePattern::Solid,
+            ("dashed", None) => LinePattern::Dashed {
+                dash: 6.0,
+                gap: 4.0,
+            },
+            ("dashed", Some(l)) => match numbers(l)?[..] {
+                [dash, gap] => LinePattern::Dashed { dash, gap },
+                _ => return Err(bad()),
+            },
+            ("dotted", None) => LinePattern::Dotted { spacing: 4.0 },
+            ("dotted", Some(l)) => match numbers(l)?[..] {
+                [spacing] => LinePattern::Dotted { spacing },
+                _ => return Err(bad()),
+            },
+            _ => return Err(bad()),
+        };
+        Ok(Some(pattern))
+    }
+
+    /// The pattern as the shaders take it: (dash, period) in pixels; period 0 for solid.
+    pub fn dash_period(self) -> [f32; 2] {
+        match self {
+            LinePattern::Solid => [0.0, 0.0],
+            LinePattern::Dashed { dash, gap } => [dash, dash + gap],
+            LinePattern::Dotted { spacing } => [0.0, spacing],
+        }
+    }
+}
+
+/// Longest dash, gap or dot spacing a pattern may ask for, in pixels.
+pub const MAX_PATTERN_LENGTH: f32 = 4096.0;
+
+impl HiddenLines {
+    /// Rejects settings that cannot produce a sensible image.
+    pub fn validate(&self) -> Result<()> {
+        if !(self.width > 0.0 && self.width <= MAX_LINE_WIDTH) {
+            return Err(Error::InvalidSetting(format!(
+                "hidden line width {} is not in (0, {MAX_LINE_WIDTH}] pixels",
+                self.width
+            )));
+        }
+        if self.color.0.iter().any(|v| !v.is_finite()) {
+            return Err(Error::InvalidSetting(format!(
+                "hidden line colour {:?} is not finite",
+                self.color.0
+            )));
+        }
+        let ok = |v: f32| (0.0..=MAX_PATTERN_LENGTH).contains(&v);
+        let fine = match self.pattern {
+            LinePattern::Solid => true,
+            LinePattern::Dashed { dash, gap } => ok(dash) && ok(gap) && dash > 0.0 && gap > 0.0,
+            LinePattern::Dotted { spacing } => ok(spacing) && spacing >= 1.0,
+        };
+        if !fine {
+            return Err(Error::InvalidSetting(format!(
+                "hidden line pattern {:?}: dashes and gaps must be in (0, {MAX_PATTERN_LENGTH}] \
+                 pixels, dot spacing in [1, {MAX_PATTERN_LENGTH}]",
+                self.pattern
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// Twin of `dash_nearest` in common.wgsl: of the points of the pattern's dashes (cores
+/// `[j·period, j·period + dash]` for every integer j; `period` 0 for a solid line) that lie
+/// in `[lo, hi]`, the one nearest `s` (positions along the line, pixels); `None` where the
+/// interval holds none.
+#[allow(clippy::neg_cmp_op_on_partial_ord)] // as in WGSL: NaN takes the rejecting branch
+pub fn dash_nearest(s: f64, lo: f64, hi: f64, dash: f64, period: f64) -> Option<f64> {
+    if !(lo <= hi) {
+        return None;
+    }
+    let c = s.clamp(lo, hi);
+    if !(period > 0.0) {
+        return Some(c);
+    }
+    let j = (c / period).floor();
+    let start = j * period;
+    if c - start <= dash {
+        return Some(c);
+    }
+    // c lies in the gap between dash j's end and dash j + 1's start.
+    let end = start + dash;
+    let next = start + period;
+    match (end >= lo, next <= hi) {
+        (true, true) => Some(if s - end <= next - s { end } else { next }),
+        (true, false) => Some(end),
+        (false, true) => Some(next),
+        (false, false) => None,
+    }
 }
 
 /// Lines fade linearly from full strength at view depth `start` to nothing at `end` (depth
@@ -103,11 +295,13 @@ impl Default for Style {
             line_width: DEFAULT_LINE_WIDTH,
             wire_color: Color([0.005, 0.01, 0.02, 1.0]),
             fill_color: Color([0.55, 0.62, 0.72, 1.0]),
+            fill_opacity: 1.0,
             background: Color([1.0, 1.0, 1.0, 1.0]),
             ambient: 0.3,
             light_view_dir: Vec3::new(-0.4, 0.6, 1.0),
             silhouettes: true,
             depth_fade: None,
+            hidden: None,
         }
     }
 }
@@ -128,11 +322,20 @@ impl Style {
                 )));
             }
         }
+        if !(0.0..=1.0).contains(&self.fill_opacity) {
+            return Err(Error::InvalidSetting(format!(
+                "fill opacity {} is not in 0..1",
+                self.fill_opacity
+            )));
+        }
         if !(0.0..=1.0).contains(&self.ambient) {
             return Err(Error::InvalidSetting(format!(
                 "ambient {} is not in 0..1",
                 self.ambient
             )));
+        }
+        if let Some(hidden) = &self.hidden {
+            hidden.validate()?;
         }
         if self.light_view_dir.try_normalize().is_none() {
             return Err(Error::InvalidSetting("light direction is zero".into()));
@@ -272,6 +475,99 @@ mod tests {
         assert_eq!(depth_fade(1.0, [2.0, 4.0]), 1.0);
         assert_eq!(depth_fade(3.0, [2.0, 4.0]), 0.5);
         assert_eq!(depth_fade(9.0, [2.0, 4.0]), 0.0);
+    }
+
+    #[test]
+    fn dash_nearest_is_the_nearest_dash_point() {
+        // Brute force over a fine grid of the interval.
+        let cases = [
+            (3.0, 0.0, 20.0, 2.0, 5.0),
+            (7.4, 6.0, 9.0, 2.0, 5.0),
+            (-4.0, 1.0, 3.0, 1.0, 4.0),
+            (30.0, 2.5, 12.5, 0.0, 2.5),
+            (5.0, 2.1, 2.9, 1.0, 5.0),
+            (1.0, -3.0, 3.0, 0.0, 0.0),
+        ];
+        for (s, lo, hi, dash, period) in cases {
+            let in_dash = |x: f64| {
+                period == 0.0 || {
+                    let r = x - (x / period).floor() * period;
+                    r <= dash + 1e-9 || r >= period - 1e-9
+                }
+            };
+            let brute = (0..=100_000)
+                .map(|k| lo + (hi - lo) * f64::from(k) / 100_000.0)
+                .filter(|&x| in_dash(x))
+                .min_by(|a, b| (a - s).abs().total_cmp(&(b - s).abs()));
+            let got = dash_nearest(s, lo, hi, dash, period);
+            match (got, brute) {
+                (Some(g), Some(b)) => assert!(
+                    (g - s).abs() <= (b - s).abs() + 1e-4,
+                    "{s} {lo} {hi}: {g} vs {b}"
+                ),
+                (None, None) => {}
+                _ => panic!("{s} {lo} {hi} {dash} {period}: {got:?} vs {brute:?}"),
+            }
+        }
+    }
+
+    #[test]
+    fn hidden_styles_parse_and_validate() {
+        assert_eq!(LinePattern::parse("off").unwrap(), None);
+        assert_eq!(
+            LinePattern::parse("solid").unwrap(),
+            Some(LinePattern::Solid)
+        );
+        assert_eq!(
+            LinePattern::parse("dashed:8,3").unwrap(),
+            Some(LinePattern::Dashed {
+                dash: 8.0,
+                gap: 3.0
+            })
+        );
+        assert_eq!(
+            LinePattern::parse("dotted").unwrap(),
+            Some(LinePattern::Dotted { spacing: 4.0 })
+        );
+        for bad in [
+            "",
+            "dash",
+            "dashed:1",
+            "dashed:a,b",
+            "dotted:1,2",
+            "solid:3",
+        ] {
+            assert!(LinePattern::parse(bad).is_err(), "{bad}");
+        }
+        let with = |pattern, width| Style {
+            hidden: Some(HiddenLines {
+                pattern,
+                width,
+                ..HiddenLines::default()
+            }),
+            ..Style::default()
+        };
+        assert!(with(LinePattern::Solid, 1.0).validate().is_ok());
+        assert!(with(LinePattern::Solid, 0.0).validate().is_err());
+        assert!(with(LinePattern::Solid, f32::NAN).validate().is_err());
+        for bad in [
+            LinePattern::Dashed {
+                dash: 0.0,
+                gap: 3.0,
+            },
+            LinePattern::Dashed {
+                dash: 3.0,
+                gap: -1.0,
+            },
+            LinePattern::Dashed {
+                dash: f32::INFINITY,
+                gap: 1.0,
+            },
+            LinePattern::Dotted { spacing: 0.5 },
+            LinePattern::Dotted { spacing: f32::NAN },
+        ] {
+            assert!(with(bad, 1.0).validate().is_err(), "{bad:?}");
+        }
     }
 
     #[test]

@@ -224,4 +224,10 @@ pub struct Rendering {
     /// are NaN); the two-pass method measures no distance and reports 0 where it drew a line
     /// fragment, `inf` elsewhere.
     pub edge_distance: Vec<f32>,
+    /// Pixels to the hidden line that colours the pixel most ([`Style::hidden`]: the
+    /// nearest point of a dash of a hidden part of a drawn line, within reach); `inf` where
+    /// there is none, and everywhere for methods that draw no hidden lines.
+    ///
+    /// [`Style::hidden`]: crate::Style::hidden
+    pub hidden_distance: Vec<f32>,
 }

@@ -798,3 +798,72 @@ fn wgsl_segment_distance_matches_rust() {
     )
     .is_finite());
 }
+
+const DASH_SHADER: &str = r#"
+@group(0) @binding(0) var<storage, read> cases: array<vec4<f32>>;
+@group(0) @binding(1) var<storage, read_write> results: array<vec4<f32>>;
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if 2u * i >= arrayLength(&cases) {
+        return;
+    }
+    let a = cases[2u * i];
+    let b = cases[2u * i + 1u];
+    results[i] = vec4<f32>(dash_nearest(a.x, a.y, a.z, b.x, b.y), 0.0, 0.0, 0.0);
+}
+"#;
+
+/// `dash_nearest` in WGSL against `style::dash_nearest`: random points and intervals along
+/// dashed, dotted and solid lines, and an empty interval.
+#[test]
+fn wgsl_dash_nearest_matches_rust() {
+    let mut next = uniform(0x2545_f491_4f6c_dd1d);
+    let mut cases: Vec<[f32; 5]> = Vec::new();
+    for k in 0..1200 {
+        let lo = (next() * 200.0) as f32;
+        let hi = lo + ((next() + 1.0) * 12.0) as f32;
+        let s = lo + ((next() * 1.5) * f64::from(hi - lo)) as f32;
+        let (dash, period) = match k % 3 {
+            0 => (((next() + 1.0) * 4.0) as f32, 0.0),
+            1 => (0.0, ((next() + 1.0) * 3.0 + 1.0) as f32),
+            _ => (0.0, 0.0),
+        };
+        let period = if k % 3 == 0 {
+            dash + ((next() + 1.0) * 3.0) as f32
+        } else {
+            period
+        };
+        cases.push([s, lo, hi, dash, period]);
+    }
+    cases.push([1.0, 5.0, 4.0, 1.0, 3.0]);
+    let input: Vec<Vec4> = cases
+        .iter()
+        .flat_map(|c| {
+            [
+                Vec4::new(c[0], c[1], c[2], 0.0),
+                Vec4::new(c[3], c[4], 0.0, 0.0),
+            ]
+        })
+        .collect();
+    let got = run_shader(DASH_SHADER, &input, cases.len());
+    let (mut none, mut worst) = (0, 0.0_f64);
+    for (k, (g, c)) in got.iter().zip(&cases).enumerate() {
+        let [s, lo, hi, dash, period] = c.map(f64::from);
+        match wirepass::style::dash_nearest(s, lo, hi, dash, period) {
+            None => {
+                none += 1;
+                assert!(g.x >= NO_EDGE_GPU, "case {k} {c:?}: {} for none", g.x);
+            }
+            // The point's distance from s, which is what a pixel's line distance takes.
+            Some(want) => {
+                let error = ((f64::from(g.x) - s).abs() - (want - s).abs()).abs();
+                worst = worst.max(error);
+                assert!(error <= 1e-4, "case {k} {c:?}: {} against {want}", g.x);
+            }
+        }
+    }
+    println!("{none} cases without a dash point; worst error {worst:.2e} px");
+    assert!(none > 10);
+}

@@ -32,7 +32,10 @@ pub(crate) struct FrameUniforms {
     triangle_split: u32,
     clusters: u32,
     host_depth: u32,
-    _pad: [u32; 2],
+    hidden_behind_host: u32,
+    fill_opacity: f32,
+    hidden_color: [f32; 4],
+    hidden_line: [f32; 4],
 }
 
 /// Mirror of WGSL `struct Instance`; field order and padding match it.
@@ -104,6 +107,7 @@ pub fn guard_band(scene: &Scene<'_>, style: &Style) -> u32 {
         .instances
         .iter()
         .filter_map(|i| i.style.line_width)
+        .chain(style.hidden.map(|h| h.width))
         .fold(style.line_width, f32::max);
     (crate::style::line_reach(f64::from(widest)).ceil() as u32).saturating_add(2)
 }
@@ -138,6 +142,8 @@ pub(crate) struct FrameData {
     /// Whether an instance draws the edges of a mesh with small patches (the edge pass then
     /// searches them).
     pub patches: bool,
+    /// Whether hidden lines are drawn (by the outline pass, with `outlines`).
+    pub hidden: bool,
     /// Whether instances differ in line colour (the outline pass then keeps, per pixel,
     /// which instance's line it holds).
     pub mixed_colors: bool,
@@ -161,6 +167,7 @@ pub(crate) struct FrameRecords {
     pub guard: u32,
     pub outlines: bool,
     pub patches: bool,
+    pub hidden: bool,
     pub mixed_colors: bool,
 }
 
@@ -210,6 +217,7 @@ impl FrameRecords {
         let mut clusters = 0u64;
         let mut outlines = false;
         let mut patches = false;
+        let mut lines = false;
         for (slot, &i) in order.iter().enumerate() {
             let instance = &scene.instances[i as usize];
             let mesh = store.record(instance.mesh)?;
@@ -219,6 +227,7 @@ impl FrameRecords {
             // The outline pass also draws the edges of large patches.
             outlines |= draws_outline || (draws_edges && mesh.lines.splat);
             patches |= draws_edges && mesh.lines.small_patches;
+            lines |= draws_outline || draws_edges;
             let flags = if draws_edges { INSTANCE_EDGES } else { 0 }
                 | if draws_outline { INSTANCE_OUTLINES } else { 0 };
             let record = instance_record(
@@ -258,6 +267,9 @@ impl FrameRecords {
         }
         let clusters = u32::try_from(clusters)
             .map_err(|_| Error::InvalidScene(format!("{clusters} clusters over all instances")))?;
+        // Hidden lines are drawn by the outline pass, from every drawn edge in view.
+        let hidden = style.hidden.filter(|_| lines);
+        outlines |= hidden.is_some();
         let mixed_colors = records
             .windows(2)
             .any(|w| w[0].wire_color != w[1].wire_color);
@@ -294,7 +306,13 @@ impl FrameRecords {
             triangle_split: buffers.split.triangles,
             clusters,
             host_depth: 0,
-            _pad: [0; 2],
+            hidden_behind_host: u32::from(hidden.is_some_and(|h| h.behind_host)),
+            fill_opacity: style.fill_opacity,
+            hidden_color: hidden.map_or([0.0; 4], |h| h.color.0),
+            hidden_line: hidden.map_or([0.0; 4], |h| {
+                let [dash, period] = h.pattern.dash_period();
+                [h.width, dash, period, 0.0]
+            }),
         };
         Ok(FrameRecords {
             uniforms,
@@ -306,6 +324,7 @@ impl FrameRecords {
             guard,
             outlines,
             patches,
+            hidden: hidden.is_some(),
             mixed_colors,
         })
     }
@@ -323,6 +342,7 @@ impl FrameData {
             guard,
             outlines,
             patches,
+            hidden,
             region,
             mixed_colors,
         } = built;
@@ -365,6 +385,7 @@ impl FrameData {
             guard,
             outlines,
             patches,
+            hidden,
             mixed_colors,
             uniform_instances,
         }
@@ -467,7 +488,7 @@ mod tests {
     #[test]
     fn records_match_their_wgsl_layout() {
         assert_eq!(std::mem::size_of::<InstanceRecord>(), 224);
-        assert_eq!(std::mem::size_of::<FrameUniforms>(), 144);
+        assert_eq!(std::mem::size_of::<FrameUniforms>(), 176);
         let r = InstanceRecord::zeroed_for_test();
         let base = &r as *const _ as usize;
         assert_eq!(

@@ -94,13 +94,15 @@ pub(crate) struct Targets {
     pub ids: wgpu::Texture,
     pub depth: wgpu::Texture,
     /// The outline buffer (`outline_tile_marks` in scene.wgsl): one u32 per target pixel,
-    /// or two where instances differ in line colour; a mark per output tile; the list of
+    /// or two where instances differ in line colour, and one more for hidden lines where
+    /// they are drawn; a mark per output tile; the list of
     /// the tiles the lines reach, from byte `acc_tiles`; the outline pass's piece list, from
     /// byte `acc_pieces`.
     pub acc: wgpu::Buffer,
     pub acc_tiles: u64,
     pub acc_pieces: u64,
     pub acc_colors: bool,
+    pub acc_hidden: bool,
     /// The refine list: header, then one packed pixel per entry.
     pub work: wgpu::Buffer,
     /// The edge pass's list of 8×8 output tiles with work for its tile dispatch.
@@ -119,6 +121,7 @@ pub(crate) struct TargetSpec {
     pub size: (u32, u32),
     pub output: (u32, u32),
     pub acc_colors: bool,
+    pub acc_hidden: bool,
     pub result: bool,
     pub diagnostic: bool,
     pub host: bool,
@@ -131,6 +134,7 @@ impl Targets {
             size: self.size,
             output: self.output,
             acc_colors: self.acc_colors,
+            acc_hidden: self.acc_hidden,
             result: self.result.is_some(),
             diagnostic: self.diagnostic.is_some(),
             host: self.host.is_some(),
@@ -155,7 +159,8 @@ impl Targets {
         // then room for a piece per PIXELS_PER_PIECE target pixels (at least MIN_PIECES),
         // less where the binding limit leaves less (the outline pass draws the pieces it has
         // no room for itself).
-        let acc_tiles = pixels * 4 * if spec.acc_colors { 2 } else { 1 } + 4 * tiles;
+        let words = 1 + u64::from(spec.acc_colors) + u64::from(spec.acc_hidden);
+        let acc_tiles = pixels * 4 * words + 4 * tiles;
         let acc_pieces = acc_tiles + LIST_HEADER + 4 * tiles;
         if acc_pieces + LIST_HEADER > binding {
             return Err(Error::OverLimit {
@@ -215,6 +220,7 @@ impl Targets {
             acc_tiles,
             acc_pieces,
             acc_colors: spec.acc_colors,
+            acc_hidden: spec.acc_hidden,
             // Read back by PreparedFrame::edge_work.
             work: buffer(
                 "wirepass refine list",

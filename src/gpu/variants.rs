@@ -58,6 +58,8 @@ pub(crate) struct Variant {
     pub patches: bool,
     /// Outline colours differ between instances; only with outlines.
     pub colors: bool,
+    /// Hidden lines are drawn (by the outline pass); only with outlines.
+    pub hidden: bool,
     pub host: bool,
     /// The instance records are bound as a uniform array.
     pub uniform_instances: bool,
@@ -66,12 +68,18 @@ pub(crate) struct Variant {
 }
 
 impl Variant {
-    /// Every variant a frame can select: `colors` needs `outlines`, `one_instance` needs
-    /// `uniform_instances`.
+    /// Every variant a frame can select: `colors` and `hidden` need `outlines`,
+    /// `one_instance` needs `uniform_instances`.
     pub(crate) fn all() -> Vec<Variant> {
         let mut all = Vec::new();
         for split in [false, true] {
-            for (outlines, colors) in [(false, false), (true, false), (true, true)] {
+            for (outlines, colors, hidden) in [
+                (false, false, false),
+                (true, false, false),
+                (true, true, false),
+                (true, false, true),
+                (true, true, true),
+            ] {
                 for patches in [false, true] {
                     for host in [false, true] {
                         for (uniform_instances, one_instance) in
@@ -82,6 +90,7 @@ impl Variant {
                                 outlines,
                                 patches,
                                 colors,
+                                hidden,
                                 host,
                                 uniform_instances,
                                 one_instance,
@@ -101,6 +110,7 @@ impl Variant {
             (self.outlines, "OUTLINES"),
             (self.patches, "PATCHES"),
             (self.colors, "COLORS"),
+            (self.hidden, "HIDDEN"),
             (self.host, "HOST"),
             (self.uniform_instances, "UNIFORM_INSTANCES"),
             (self.one_instance, "ONE_INSTANCE"),

@@ -8,7 +8,7 @@ use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
 use crate::tools::offline::{draw, Method};
 use crate::tools::regression;
-use crate::truth::accuracy::{distance_error, id_agreement, percentile};
+use crate::truth::accuracy::{distance_error, hidden_distance_error, id_agreement, percentile};
 use crate::truth::draw_raycast;
 use crate::world::{Rendering, Shot};
 use serde::Serialize;
@@ -40,6 +40,9 @@ pub struct Metrics {
     pub coverage_agreement: f64,
     /// Edge-distance error, see [`DistanceError`].
     pub distance_error_px: DistanceError,
+    /// Hidden-line distance error ([`Rendering::hidden_distance`]); no pixels where the
+    /// reference draws no hidden lines.
+    pub hidden_distance_error_px: DistanceError,
     /// FLIP difference of the final images.
     pub image_difference: ImageDifference,
 }
@@ -47,6 +50,7 @@ pub struct Metrics {
 /// Compares `frame` against `reference` (the ground truth); an error if their sizes differ.
 pub fn metrics(reference: &Rendering, frame: &Rendering) -> Result<Metrics> {
     let distance_error_px = distance_error(reference, frame)?;
+    let hidden_distance_error_px = hidden_distance_error(reference, frame)?;
     let (id_agreement, coverage_agreement) = id_agreement(reference, frame)?;
     let mut flip: Vec<f64> = flip_map(reference, frame)?
         .into_iter()
@@ -58,6 +62,7 @@ pub fn metrics(reference: &Rendering, frame: &Rendering) -> Result<Metrics> {
         id_agreement,
         coverage_agreement,
         distance_error_px,
+        hidden_distance_error_px,
         image_difference: ImageDifference {
             flip_mean,
             flip_p99: percentile(&flip, 0.99).unwrap_or(0.0),
@@ -440,6 +445,32 @@ pub fn table(report: &Report) -> String {
             ),
         });
     }
+    // The hidden lines' own distance errors, where the reference draws any.
+    let hidden: Vec<_> = report
+        .rows
+        .iter()
+        .filter_map(|(m, r)| match r {
+            MethodReport::Measured { metrics, .. } => Some((m, metrics.hidden_distance_error_px)),
+            MethodReport::Skipped { .. } => None,
+        })
+        .collect();
+    if hidden.iter().any(|(_, h)| h.pixels > 0) {
+        lines.push(String::new());
+        lines.push(format!(
+            "{:<10} {:>9} {:>9} {:>9} {:>9}",
+            "hidden", "h mean", "h p99", "h max", "pixels"
+        ));
+        for (m, h) in hidden {
+            lines.push(format!(
+                "{:<10} {:>9} {:>9} {:>9} {:>9}",
+                m.name(),
+                fmt(h.mean),
+                fmt(h.p99),
+                fmt(h.max),
+                h.pixels
+            ));
+        }
+    }
     lines.join("\n")
 }
 
@@ -455,6 +486,7 @@ mod tests {
             ids,
             depth: vec![0.5; n],
             edge_distance: d,
+            hidden_distance: vec![f32::INFINITY; n],
         }
     }
 

@@ -30,6 +30,7 @@ fn check_same_shape(reference: &Rendering, frame: &Rendering) -> Result<()> {
     let whole = |f: &Rendering| {
         f.ids.len() == n
             && f.edge_distance.len() == n
+            && f.hidden_distance.len() == n
             && f.depth.len() == n
             && f.rgba.len() == 4 * n
     };
@@ -68,17 +69,23 @@ pub fn id_agreement(reference: &Rendering, frame: &Rendering) -> Result<(f64, f6
 
 /// The [`DistanceError`] of `frame` against `reference`; an error if their sizes differ.
 pub fn distance_error(reference: &Rendering, frame: &Rendering) -> Result<DistanceError> {
-    let mut measured: Vec<f64> = distance_errors(reference, frame)?
-        .into_iter()
-        .flatten()
-        .collect();
+    Ok(summarise(distance_errors(reference, frame)?))
+}
+
+/// [`distance_error`] of the hidden lines ([`Rendering::hidden_distance`]).
+pub fn hidden_distance_error(reference: &Rendering, frame: &Rendering) -> Result<DistanceError> {
+    Ok(summarise(hidden_distance_errors(reference, frame)?))
+}
+
+fn summarise(errors: Vec<Option<f64>>) -> DistanceError {
+    let mut measured: Vec<f64> = errors.into_iter().flatten().collect();
     measured.sort_by(f64::total_cmp);
-    Ok(DistanceError {
+    DistanceError {
         mean: (!measured.is_empty()).then(|| measured.iter().sum::<f64>() / measured.len() as f64),
         p99: percentile(&measured, 0.99),
         max: measured.last().copied(),
         pixels: measured.len(),
-    })
+    }
 }
 
 /// Nearest-rank percentile of sorted values.
@@ -93,14 +100,31 @@ pub fn percentile(sorted: &[f64], q: f64) -> Option<f64> {
 /// Per pixel, `|d − d_true|` where it is measured (ids agree, background included, which
 /// outlines reach; true distance finite and under [`DISTANCE_RANGE_PX`]), `None` elsewhere.
 pub fn distance_errors(reference: &Rendering, frame: &Rendering) -> Result<Vec<Option<f64>>> {
+    errors_of(reference, frame, |f| &f.edge_distance)
+}
+
+/// [`distance_errors`] of the hidden lines ([`Rendering::hidden_distance`]).
+pub fn hidden_distance_errors(
+    reference: &Rendering,
+    frame: &Rendering,
+) -> Result<Vec<Option<f64>>> {
+    errors_of(reference, frame, |f| &f.hidden_distance)
+}
+
+fn errors_of(
+    reference: &Rendering,
+    frame: &Rendering,
+    map: impl Fn(&Rendering) -> &[f32],
+) -> Result<Vec<Option<f64>>> {
     check_same_shape(reference, frame)?;
+    let (truths, distances) = (map(reference), map(frame));
     Ok((0..reference.ids.len())
         .map(|i| {
             let id = reference.ids[i];
-            let truth = f64::from(reference.edge_distance[i]);
+            let truth = f64::from(truths[i]);
             let measured = frame.ids[i] == id && truth.is_finite() && truth < DISTANCE_RANGE_PX;
             measured.then(|| {
-                let d = f64::from(frame.edge_distance[i]);
+                let d = f64::from(distances[i]);
                 if d.is_finite() {
                     (d - truth).abs()
                 } else {

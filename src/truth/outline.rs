@@ -36,10 +36,13 @@ const SAMPLES_PER_PIXEL: f64 = 8.0;
 /// Bisection steps that place each change of visibility along an edge.
 const BISECTIONS: u32 = 30;
 
-/// Per pixel, the outline line that colours it most, if any is within reach.
+/// Per pixel, the outline line that colours it most, if any is within reach, and the hidden
+/// line ([`Style::hidden`](crate::Style::hidden)) likewise.
 pub struct OutlineMap {
     /// Pixels, row-major.
     pub line: Vec<Option<Line>>,
+    /// Pixels, row-major; all `None` without hidden lines.
+    pub hidden: Vec<Option<Line>>,
 }
 
 /// The outline edges of `mesh` seen from `eye` (homogeneous, in the mesh's coordinates), as
@@ -73,8 +76,8 @@ pub fn outline_edges(mesh: &crate::Mesh, eye: DVec4) -> Vec<(u32, u32)> {
         .collect()
 }
 
-/// A visible stretch of an outline edge on screen: pixel coordinates at both ends, and there
-/// 1/w and view depth / w (affine along the stretch).
+/// A stretch of an edge on screen, visible or a dash of a hidden part: pixel coordinates at
+/// both ends, and there 1/w, near/w and view depth / w (affine along the stretch).
 #[derive(Clone, Copy, Debug)]
 struct Stretch {
     from: DVec2,
@@ -86,30 +89,36 @@ struct Stretch {
     width: f64,
 }
 
-/// The outline map of `caster`'s world for `shot`, seen along `rays`.
+/// What a listed edge draws: its visible parts (an outline, or a drawn edge of a large
+/// patch), its hidden parts (a drawn edge or an outline, with hidden lines on).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+struct Draw {
+    visible: bool,
+    hidden: bool,
+}
+
+/// The outline map of `caster`'s world for `shot`, seen along `rays`; `masks` are each
+/// mesh's drawn edges.
 pub(crate) fn outline_map(
     caster: &RayCaster<'_>,
     rays: &Rays,
     shot: &Shot<'_>,
     styles: &[ObjectStyle],
-    patches: &[Patches],
+    (patches, masks): (&[Patches], &[Vec<u8>]),
     host: Option<&HostMap>,
 ) -> OutlineMap {
-    let (width, height) = shot.size;
-    let n = width as usize * height as usize;
-    let mut map = OutlineMap {
-        line: vec![None; n],
-    };
     let world = caster.world();
+    let hidden = shot.style.hidden;
     let view = Visibility {
         caster,
         rays,
         fade_row: shot.view.view_depth_row(),
         host,
+        behind_host: hidden.is_some_and(|h| h.behind_host),
     };
     let view = &view;
     let eye = shot.view.eye();
-    let stretches: Vec<Stretch> = world
+    let (visible, hidden_stretches): (Vec<Vec<Stretch>>, Vec<Vec<Stretch>>) = world
         .objects
         .iter()
         .enumerate()
@@ -119,37 +128,106 @@ pub(crate) fn outline_map(
             let local = edge_math::local_eye(object.transform, eye);
             let first = caster.first_ids()[o];
             let width = styles[o].width;
-            let mut edges = Vec::new();
+            let tris = mesh.triangles();
+            let neighbours = mesh.edge_neighbours();
+            let mut edges: Vec<((u32, u32), Draw)> = Vec::new();
+            let both = Draw {
+                visible: true,
+                hidden: hidden.is_some(),
+            };
             if styles[o].outlines {
-                edges = outline_edges(mesh, local);
+                edges.extend(outline_edges(mesh, local).into_iter().map(|e| (e, both)));
             }
             if styles[o].edges {
                 let splat = &patches[object.mesh].splat;
                 edges.extend(splat.iter().enumerate().flat_map(|(t, &bits)| {
                     (0..3u32)
                         .filter(move |i| bits & (1 << i) != 0)
-                        .map(move |i| (t as u32, i))
+                        .map(move |i| ((t as u32, i), both))
                 }));
-                edges.sort_unstable();
-                edges.dedup();
+                if hidden.is_some() {
+                    // Every drawn edge has hidden parts to find; a shared one is drawn by the
+                    // lower id only.
+                    let mask = &masks[object.mesh];
+                    edges.extend((0..tris.len() as u32).flat_map(|t| {
+                        (0..3u32)
+                            .filter(move |&i| {
+                                let n = neighbours[t as usize][i as usize];
+                                mask[t as usize] & (1 << i) != 0 && (n == NO_NEIGHBOUR || t < n)
+                            })
+                            .map(move |i| {
+                                let only = Draw {
+                                    visible: false,
+                                    hidden: true,
+                                };
+                                ((t, i), only)
+                            })
+                    }));
+                }
             }
-            edges
+            // One entry per edge, drawing all that any of its entries asks.
+            edges.sort_unstable();
+            let mut merged: Vec<((u32, u32), Draw)> = Vec::with_capacity(edges.len());
+            for (e, d) in edges {
+                match merged.last_mut() {
+                    Some((last, m)) if *last == e => {
+                        m.visible |= d.visible;
+                        m.hidden |= d.hidden;
+                    }
+                    _ => merged.push((e, d)),
+                }
+            }
+            merged
                 .into_par_iter()
-                .flat_map_iter(move |(t, i)| {
-                    let n = mesh.edge_neighbours()[t as usize][i as usize];
-                    view.visible_stretches(first, (t, i, n), (o as u32, width))
+                .map(move |((t, i), draw)| {
+                    let n = neighbours[t as usize][i as usize];
+                    let corners = tris[t as usize];
+                    let p = mesh.positions();
+                    let a_first = comes_first(
+                        p[corners[i as usize] as usize],
+                        p[corners[(i as usize + 1) % 3] as usize],
+                    );
+                    view.stretches(first, (t, i, n, a_first), (o as u32, width), draw, hidden)
                 })
                 .collect::<Vec<_>>()
         })
-        .collect();
-
+        .unzip();
     let fade = shot.style.fade_range().map(f64::from);
-    map.line
-        .par_chunks_mut(width as usize)
+    let visible: Vec<Stretch> = visible.into_iter().flatten().collect();
+    let line = splat(&visible, shot.size, fade, host);
+    let hidden = match hidden {
+        Some(h) => {
+            let stretches: Vec<Stretch> = hidden_stretches.into_iter().flatten().collect();
+            splat(&stretches, shot.size, fade, host.filter(|_| !h.behind_host))
+        }
+        None => vec![None; line.len()],
+    };
+    OutlineMap { line, hidden }
+}
+
+/// Whether `a` comes before `b` in (x, y, z) order (in the mesh's own coordinates): the end
+/// of an edge that anchors its line pattern, the same whichever triangle draws the edge and
+/// whatever its vertices' numbers. Twin of `comes_first` in outline.wgsl, which compares the
+/// store's rebased coordinates (the same order, but where rebasing rounds two coordinates
+/// together).
+fn comes_first(a: glam::Vec3, b: glam::Vec3) -> bool {
+    a.x < b.x || (a.x == b.x && (a.y < b.y || (a.y == b.y && a.z < b.z)))
+}
+
+/// Per pixel, the stretch whose line colours it most (the greatest key), skipping lines that
+/// `host` hides.
+fn splat(
+    stretches: &[Stretch],
+    (width, height): (u32, u32),
+    fade: [f64; 2],
+    host: Option<&HostMap>,
+) -> Vec<Option<Line>> {
+    let mut map: Vec<Option<Line>> = vec![None; width as usize * height as usize];
+    map.par_chunks_mut(width as usize)
         .enumerate()
         .for_each(|(y, row)| {
             let cy = y as f64 + 0.5;
-            for s in &stretches {
+            for s in stretches {
                 let reach = line_reach(s.width);
                 if (s.from.y.min(s.to.y) - reach) > cy || (s.from.y.max(s.to.y) + reach) < cy {
                     continue;
@@ -204,17 +282,35 @@ struct Visibility<'a> {
     fade_row: DVec4,
     /// The host's depth, if the host gave it.
     host: Option<&'a HostMap>,
+    /// Points the host hides count as hidden ([`HiddenLines::behind_host`]), not as neither.
+    ///
+    /// [`HiddenLines::behind_host`]: crate::HiddenLines::behind_host
+    behind_host: bool,
+}
+
+/// What a point of a line is: visible, hidden by a surface (or by the host, for hidden lines
+/// drawn behind it), or neither drawn (the host hides it).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Class {
+    Visible,
+    Hidden,
+    Neither,
 }
 
 impl Visibility<'_> {
-    /// The visible stretches of edge `i` of triangle `t` (neighbour `n`) of the object
-    /// whose first global id is `first`.
-    fn visible_stretches(
+    /// The visible stretches (where `draw.visible`) and the dashes of the hidden stretches
+    /// (where `draw.hidden`, in `hidden`'s pattern and width) of edge `i` of triangle `t`
+    /// (neighbour `n`; its pattern anchored at corner `i` when `a_first`, else at `i + 1`)
+    /// of the object whose first global id is `first`.
+    fn stretches(
         &self,
         first: u32,
-        (t, i, n): (u32, u32, u32),
+        (t, i, n, a_first): (u32, u32, u32, bool),
         (object, width): (u32, f64),
-    ) -> Vec<Stretch> {
+        draw: Draw,
+        hidden: Option<crate::HiddenLines>,
+    ) -> (Vec<Stretch>, Vec<Stretch>) {
+        let none = (Vec::new(), Vec::new());
         let corners = self.caster.corners(first + t);
         let (a, b) = (corners[i as usize], corners[(i as usize + 1) % 3]);
         let (ca, cb) = (self.rays.clip(a), self.rays.clip(b));
@@ -225,7 +321,7 @@ impl Visibility<'_> {
         keep_positive(&mut s, ca.z, cb.z);
         keep_positive(&mut s, depth.dot(ha), depth.dot(hb));
         if !(s.0 <= s.1) {
-            return Vec::new();
+            return none;
         }
         let fade = |h: DVec4| self.fade_row.dot(h);
         let at = |k: f64| {
@@ -236,66 +332,81 @@ impl Visibility<'_> {
         let (p0, p1) = (at(s.0), at(s.1));
         // Within reach of the image: an edge just outside it still draws its line inside.
         let size = self.rays.size();
-        let reach = line_reach(width);
+        let hidden_width = hidden.filter(|_| draw.hidden).map(|h| f64::from(h.width));
+        let reach = line_reach(width).max(hidden_width.map_or(0.0, line_reach));
         let d = p1.xy - p0.xy;
         let mut u = (0.0, 1.0);
         keep_between(&mut u, p0.xy.x, d.x, (-reach, size.x + reach));
         keep_between(&mut u, p0.xy.y, d.y, (-reach, size.y + reach));
         if !(u.0 <= u.1) {
-            return Vec::new();
+            return none;
         }
         let point = |k: f64| p0.lerp(&p1, k);
-        let visible = |k: f64| {
+        let class = |k: f64| {
             let q = point(k);
             let w = 1.0 / q.inv_w;
-            self.visible(q.xy, (q.near_w * w, w), first, (t, n))
+            self.class(q.xy, (q.near_w * w, w), first, (t, n))
         };
 
+        // Runs of one class, as (from, to, class) in parameters of p0 → p1.
         let length = d.length() * (u.1 - u.0);
         let steps = (length * SAMPLES_PER_PIXEL).ceil().clamp(1.0, 65536.0) as usize;
         let at = |j: usize| u.0 + (u.1 - u.0) * j as f64 / steps as f64;
-        let mut out = Vec::new();
-        let mut start = visible(u.0).then_some(u.0);
-        let mut last = (u.0, start.is_some());
+        let mut runs = Vec::new();
+        let mut start = u.0;
+        let mut last = (u.0, class(u.0));
         for j in 1..=steps {
             let k = at(j);
-            let now = visible(k);
+            let now = class(k);
             if now != last.1 {
                 // Bisect the change between last.0 and k.
                 let (mut lo, mut hi) = (last.0, k);
                 for _ in 0..BISECTIONS {
                     let mid = 0.5 * (lo + hi);
-                    if visible(mid) == last.1 {
+                    if class(mid) == last.1 {
                         lo = mid;
                     } else {
                         hi = mid;
                     }
                 }
-                if now {
-                    start = Some(hi);
-                } else if let Some(from) = start.take() {
-                    out.push((from, lo));
-                }
+                runs.push((start, lo, last.1));
+                start = hi;
             }
             last = (k, now);
         }
-        if let Some(from) = start {
-            out.push((from, u.1));
-        }
-        out.into_iter()
-            .map(|(k0, k1)| {
-                let (q0, q1) = (point(k0), point(k1));
-                Stretch {
-                    from: q0.xy,
-                    to: q1.xy,
-                    inv_w: [q0.inv_w, q1.inv_w],
-                    near_w: [q0.near_w, q1.near_w],
-                    depth_w: [q0.depth_w, q1.depth_w],
-                    object,
-                    width,
-                }
-            })
-            .collect()
+        runs.push((start, u.1, last.1));
+
+        let stretch = |(k0, k1): (f64, f64), width: f64| {
+            let (q0, q1) = (point(k0), point(k1));
+            Stretch {
+                from: q0.xy,
+                to: q1.xy,
+                inv_w: [q0.inv_w, q1.inv_w],
+                near_w: [q0.near_w, q1.near_w],
+                depth_w: [q0.depth_w, q1.depth_w],
+                object,
+                width,
+            }
+        };
+        let visible = runs
+            .iter()
+            .filter(|r| draw.visible && r.2 == Class::Visible)
+            .map(|&(k0, k1, _)| stretch((k0, k1), width))
+            .collect();
+        let Some(h) = hidden.filter(|_| draw.hidden) else {
+            return (visible, Vec::new());
+        };
+        // The pattern's position at parameter k: pixels along the projection from the
+        // anchored end (or where a clip plane cuts the edge short of it).
+        let full = d.length();
+        let [dash, period] = h.pattern.dash_period().map(f64::from);
+        let hidden = runs
+            .iter()
+            .filter(|r| r.2 == Class::Hidden)
+            .flat_map(|&(k0, k1, _)| dashes((k0, k1), full, a_first, (dash, period)))
+            .map(|run| stretch(run, f64::from(h.width)))
+            .collect();
+        (visible, hidden)
     }
 
     /// Where a clip-space point with view depth `depth` lands: pixel coordinates, and 1/w,
@@ -312,23 +423,64 @@ impl Visibility<'_> {
         }
     }
 
-    /// Whether the edge's point at screen point `x` (near row and w) is visible: unless the
-    /// host hides it ([`HostMap::hides_point`]), or a triangle other than `t` and `n` of the
-    /// object (first id `first`) covers `x` nearer than that point.
-    fn visible(&self, x: DVec2, (near, w): (f64, f64), first: u32, (t, n): (u32, u32)) -> bool {
+    /// What the edge's point at screen point `x` (near row and w) is: hidden by the host where
+    /// [`HostMap::hides_point`] says so, hidden by a triangle other than `t` and `n` of the
+    /// object (first id `first`) that covers `x` nearer than that point, else visible.
+    fn class(&self, x: DVec2, (near, w): (f64, f64), first: u32, (t, n): (u32, u32)) -> Class {
         if self.host.is_some_and(|h| h.hides_point(x, 1.0 - near / w)) {
-            return false;
+            return if self.behind_host {
+                Class::Hidden
+            } else {
+                Class::Neither
+            };
         }
         let (from, to) = self.rays.segment(x);
         match self.caster.cast(from, to) {
-            None => true,
+            None => Class::Visible,
             Some(hit) => {
                 let own = hit.id == first + t || (n != NO_NEIGHBOUR && hit.id == first + n);
                 let c = self.rays.clip(hit.point);
-                own || !edge_math::nearer(c.z, near, w)
+                if own || !edge_math::nearer(c.z, near, w) {
+                    Class::Visible
+                } else {
+                    Class::Hidden
+                }
             }
         }
     }
+}
+
+/// The dashes of the pattern (dash, period; period 0 for solid) within the run `(k0, k1)` of
+/// an edge's parameter, where the whole (clipped) edge is `full` pixels long on screen and
+/// the pattern runs from parameter 0 (`a_first`) or 1. Dashes are the cores
+/// `[j·period, j·period + dash]` of pattern position, for every integer j; a dot is a dash
+/// of no length.
+fn dashes(
+    (k0, k1): (f64, f64),
+    full: f64,
+    a_first: bool,
+    (dash, period): (f64, f64),
+) -> Vec<(f64, f64)> {
+    if !(period > 0.0) || !(full > 0.0) {
+        return vec![(k0, k1)];
+    }
+    let position = |k: f64| if a_first { k * full } else { (1.0 - k) * full };
+    let parameter = |s: f64| if a_first { s / full } else { 1.0 - s / full };
+    let (s0, s1) = {
+        let (a, b) = (position(k0), position(k1));
+        (a.min(b), a.max(b))
+    };
+    let mut out = Vec::new();
+    let mut j = (s0 / period).floor() - 1.0;
+    while j * period <= s1 {
+        let (from, to) = ((j * period).max(s0), (j * period + dash).min(s1));
+        if from <= to {
+            let (ka, kb) = (parameter(from), parameter(to));
+            out.push((ka.min(kb), ka.max(kb)));
+        }
+        j += 1.0;
+    }
+    out
 }
 
 /// A projected point of an edge: see [`Visibility::project`].
@@ -580,11 +732,9 @@ mod tests {
         let rays = Rays::new(&shot.view, size, &world).unwrap();
         let styles = ObjectStyle::of(&world, style);
         let mesh = &world.meshes[0].mesh;
-        let patches = [Patches::new(
-            mesh.edge_neighbours(),
-            &mesh.edge_mask(EdgeSelection::All),
-        )];
-        outline_map(&caster, &rays, &shot, &styles, &patches, None)
+        let masks = [mesh.edge_mask(EdgeSelection::All)];
+        let patches = [Patches::new(mesh.edge_neighbours(), &masks[0])];
+        outline_map(&caster, &rays, &shot, &styles, (&patches, &masks), None)
     }
 
     #[test]
@@ -649,10 +799,23 @@ mod tests {
             rays: &rays,
             fade_row: view.view_depth_row(),
             host: None,
+            behind_host: false,
         };
         // Triangle 0's edge 1 runs from (1, -1) to (1, 1): visible only above y = 0, i.e. on
         // screen from the middle row up, ending where the near quad's top edge crosses it.
-        let s = vis.visible_stretches(0, (0, 1, NO_NEIGHBOUR), (0, 1.5));
+        let draw = Draw {
+            visible: true,
+            hidden: true,
+        };
+        let hidden = crate::HiddenLines {
+            pattern: crate::LinePattern::Dashed {
+                dash: 2.0,
+                gap: 1.0,
+            },
+            ..crate::HiddenLines::default()
+        };
+        let edge = (0, 1, NO_NEIGHBOUR, true);
+        let (s, h) = vis.stretches(0, edge, (0, 1.5), draw, Some(hidden));
         assert_eq!(s.len(), 1, "{s:?}");
         let top_of_near = {
             let c = cam.view_projection(64, 64) * DVec4::new(1.0, 0.0, 1.0, 1.0);
@@ -664,5 +827,29 @@ mod tests {
             (lower_end - top_of_near).abs() < 1e-6,
             "{ys:?} vs {top_of_near}"
         );
+        // The hidden part, below, in dashes 2 px long and 1 px apart, from the edge's first
+        // end in (x, y, z) order, (1, -1): the lowest dash starts at its projection.
+        assert!(h.len() > 3, "{h:?}");
+        let mut spans: Vec<(f64, f64)> = h
+            .iter()
+            .map(|d| (d.from.y.min(d.to.y), d.from.y.max(d.to.y)))
+            .collect();
+        spans.sort_by(|a, b| b.0.total_cmp(&a.0));
+        let bottom = {
+            let c = cam.view_projection(64, 64) * DVec4::new(1.0, -1.0, 0.0, 1.0);
+            0.5 * (1.0 - c.y / c.w) * 64.0
+        };
+        assert!(
+            (spans[0].1 - bottom).abs() < 1e-9,
+            "{spans:?} from {bottom}"
+        );
+        for (k, &(lo, hi)) in spans.iter().enumerate() {
+            assert!(lo >= top_of_near - 1e-9, "{spans:?}");
+            assert!(hi - lo <= 2.0 + 1e-9, "{spans:?}");
+            if k > 0 {
+                // Whole dashes are a period apart (the last may be cut by the near quad).
+                assert!((spans[k - 1].1 - hi - 3.0).abs() < 1e-6, "{spans:?}");
+            }
+        }
     }
 }

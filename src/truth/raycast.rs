@@ -36,6 +36,7 @@ struct Sample {
     id: u32,
     depth: f32,
     distance: f32,
+    hidden: Option<Line>,
     rgba: [u8; 4],
 }
 
@@ -97,7 +98,7 @@ pub fn draw_raycast_over(shot: &Shot<'_>, host: Option<&HostOccluders<'_>>) -> R
         &rays,
         shot,
         &styles,
-        &patches,
+        (&patches, &masks),
         host_map.as_ref(),
     );
 
@@ -120,7 +121,7 @@ pub fn draw_raycast_over(shot: &Shot<'_>, host: Option<&HostOccluders<'_>>) -> R
                     let pixel = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
                     let k = (y * width + x) as usize;
                     let host = host.as_ref().map_or(-1.0, |h| h[k]);
-                    gt.sample(pixel, outline.line[k], host)
+                    gt.sample(pixel, (outline.line[k], outline.hidden[k]), host)
                 })
                 .collect();
             bar.inc(1);
@@ -136,12 +137,16 @@ pub fn draw_raycast_over(shot: &Shot<'_>, host: Option<&HostOccluders<'_>>) -> R
         ids: Vec::with_capacity(n),
         depth: Vec::with_capacity(n),
         edge_distance: Vec::with_capacity(n),
+        hidden_distance: Vec::with_capacity(n),
     };
     for s in rows.iter().flatten() {
         frame.rgba.extend_from_slice(&s.rgba);
         frame.ids.push(s.id);
         frame.depth.push(s.depth);
         frame.edge_distance.push(s.distance);
+        frame
+            .hidden_distance
+            .push(s.hidden.map_or(f32::INFINITY, |l| l.distance as f32));
     }
     Ok(frame)
 }
@@ -185,6 +190,9 @@ struct Shading {
     background: Color,
     ambient: f64,
     fade: [f64; 2],
+    /// The hidden lines' colour, where they are drawn.
+    hidden: Option<[f64; 4]>,
+    fill_opacity: f64,
 }
 
 impl Shading {
@@ -197,6 +205,8 @@ impl Shading {
             background: s.background,
             ambient: f64::from(s.ambient),
             fade: s.fade_range().map(f64::from),
+            hidden: s.hidden.map(|h| h.color.0.map(f64::from)),
+            fill_opacity: f64::from(s.fill_opacity),
         }
     }
 }
@@ -214,10 +224,22 @@ struct Truth<'a> {
 }
 
 impl Truth<'_> {
-    /// The ground truth at one pixel centre; `outline` is the pixel's line from the outline
-    /// map, `host` the host's reverse depth there (−1 for none).
-    fn sample(&self, pixel: DVec2, outline: Option<Line>, host: f64) -> Sample {
+    /// The ground truth at one pixel centre; `outline` and `hidden` are the pixel's lines from
+    /// the outline map, `host` the host's reverse depth there (−1 for none).
+    fn sample(
+        &self,
+        pixel: DVec2,
+        (outline, hidden): (Option<Line>, Option<Line>),
+        host: f64,
+    ) -> Sample {
         let sh = self.shading;
+        // The hidden line goes over what is below, under the visible line (twin of
+        // `store_pixel` in edge_pass.wgsl).
+        let (h, hidden_rgb) = match (hidden, sh.hidden) {
+            (Some(l), Some(c)) => (l.intensity * c[3], [c[0], c[1], c[2]]),
+            _ => (0.0, [0.0; 3]),
+        };
+        let under = |base: [f64; 3]| [0, 1, 2].map(|k| base[k] + (hidden_rgb[k] - base[k]) * h);
         let world = self.caster.world();
         let (from, to) = self.rays.segment(pixel);
         let hit = self.caster.cast(from, to).filter(|h| {
@@ -225,7 +247,8 @@ impl Truth<'_> {
             1.0 - c.z / c.w >= host
         });
         let Some(hit) = hit else {
-            let bg = sh.background.0.map(f64::from);
+            let bg4 = sh.background.0.map(f64::from);
+            let bg = under([bg4[0], bg4[1], bg4[2]]);
             let (i, wire) = outline.map_or((0.0, [0.0; 4]), |l| {
                 let w = self.styles[l.object as usize].wire;
                 (l.intensity * w[3], w)
@@ -239,7 +262,8 @@ impl Truth<'_> {
                     1.0
                 },
                 distance: outline.map_or(f64::INFINITY, |l| l.distance) as f32,
-                rgba: Color([mix(0), mix(1), mix(2), bg[3].max(i) as f32]).to_srgb8(),
+                hidden,
+                rgba: Color([mix(0), mix(1), mix(2), bg4[3].max(h).max(i) as f32]).to_srgb8(),
             };
         };
         let object = &world.objects[hit.object as usize];
@@ -295,7 +319,19 @@ impl Truth<'_> {
         } else {
             0
         };
-        let surface = surface_color(sh, st, &wm.mesh, tri, e.bary, point);
+        // The surface over the background at the fill opacity (twin of `see_through`).
+        let (surface, alpha) = {
+            let s = surface_color(sh, st, &wm.mesh, tri, e.bary, point);
+            let k = sh.fill_opacity;
+            if k < 1.0 {
+                let bg = sh.background.0.map(f64::from);
+                let a = k + bg[3] * (1.0 - k);
+                let c = [0, 1, 2].map(|j| (s[j] * k + bg[j] * bg[3] * (1.0 - k)) / a.max(1e-30));
+                (under(c), a.max(h))
+            } else {
+                (under(s), 1.0)
+            }
+        };
         let (line, distance, wire) = match outline {
             Some(l) if l.key > own_key => {
                 (l.intensity, l.distance, self.styles[l.object as usize].wire)
@@ -308,7 +344,8 @@ impl Truth<'_> {
             id: hit.id,
             depth: depth as f32,
             distance: distance as f32,
-            rgba: Color([mix(0), mix(1), mix(2), 1.0]).to_srgb8(),
+            hidden,
+            rgba: Color([mix(0), mix(1), mix(2), alpha.max(i) as f32]).to_srgb8(),
         }
     }
 }

@@ -178,7 +178,8 @@ pub async fn read_deferred(
 
 /// Reads a rendered frame back: the 8-bit output, the `Rg32Uint` (slot, triangle) ids and
 /// the diagnostic map, four f32 per pixel (`Rgba32Float`, or their bits in `Rgba32Uint` for
-/// the forward passes; r = distance in pixels, ≥ 1e38 meaning none; g = reverse depth),
+/// the forward passes; r = distance in pixels, ≥ 1e38 meaning none; g = reverse depth; b =
+/// distance to the hidden line, ≥ 1e38 meaning none),
 /// converted to [`Rendering`]'s conventions.
 pub async fn read_rendering(
     device: &wgpu::Device,
@@ -228,6 +229,10 @@ pub fn maps_rendering(
         edge_distance: diagnostic
             .iter()
             .map(|t| if t[0] >= 1e38 { f32::INFINITY } else { t[0] })
+            .collect(),
+        hidden_distance: diagnostic
+            .iter()
+            .map(|t| if t[2] >= 1e38 { f32::INFINITY } else { t[2] })
             .collect(),
     })
 }

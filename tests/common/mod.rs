@@ -150,6 +150,20 @@ impl TestScene {
 pub fn worst_pixels(truth: &Rendering, frame: &Rendering, bound: f64, n: usize) -> String {
     let errors =
         wirepass::tools::compare::distance_errors(truth, frame).unwrap_or_else(|e| panic!("{e}"));
+    worst_of(truth, frame, (&errors, |r| &r.edge_distance), bound, n)
+}
+
+/// A distance map of a rendering.
+pub type DistanceMap = fn(&Rendering) -> &[f32];
+
+/// [`worst_pixels`] of the given per-pixel errors of the distance map `map`.
+pub fn worst_of(
+    truth: &Rendering,
+    frame: &Rendering,
+    (errors, map): (&[Option<f64>], DistanceMap),
+    bound: f64,
+    n: usize,
+) -> String {
     let mut worst: Vec<(usize, f64)> = errors
         .iter()
         .enumerate()
@@ -166,8 +180,8 @@ pub fn worst_pixels(truth: &Rendering, frame: &Rendering, bound: f64, n: usize) 
                 i % width,
                 i / width,
                 truth.ids[i] as i64,
-                truth.edge_distance[i],
-                frame.edge_distance[i]
+                map(truth)[i],
+                map(frame)[i]
             )
         })
         .collect()

@@ -284,7 +284,7 @@ impl RasterFrame {
                 wgpu::Color {
                     r: f64::from(NO_EDGE.to_bits()),
                     g: 0.0,
-                    b: 0.0,
+                    b: f64::from(NO_EDGE.to_bits()),
                     a: 0.0,
                 },
             ));

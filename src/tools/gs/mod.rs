@@ -388,7 +388,7 @@ impl GsPass {
             if maps {
                 gl.clear_buffer_u32_slice(glow::COLOR, 1, &[BACKGROUND_ID, BACKGROUND_ID, 0, 0]);
                 let none = crate::gpu::NO_EDGE.to_bits();
-                gl.clear_buffer_u32_slice(glow::COLOR, 2, &[none, 0, 0, 0]);
+                gl.clear_buffer_u32_slice(glow::COLOR, 2, &[none, 0, none, 0]);
             }
             gl.clear_buffer_f32_slice(glow::DEPTH, 0, &[0.0]);
             gl.use_program(Some(p.program));

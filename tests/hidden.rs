@@ -1,0 +1,258 @@
+//! Hidden lines (`Style::hidden`): the deferred pass draws the hidden parts of the drawn
+//! lines, solid, dashed and dotted, where the ground truth does, and "hidden off" is today's
+//! image, bit for bit.
+
+mod common;
+
+use common::{framing, load, shoot_world, worst_of};
+use glam::{DMat4, DVec3};
+use std::sync::Arc;
+use wirepass::mesh::Procedural;
+use wirepass::tools::offline::Method;
+use wirepass::truth::accuracy::{
+    distance_error, hidden_distance_error, hidden_distance_errors, id_agreement,
+};
+use wirepass::world::{Object, Rendering, World, WorldMesh};
+use wirepass::{Color, EdgeSelection, HiddenLines, InstanceStyle, LinePattern, Style, View};
+
+const SIZE: (u32, u32) = (320, 240);
+
+fn style(pattern: LinePattern, width: f32) -> Style {
+    Style {
+        hidden: Some(HiddenLines {
+            pattern,
+            color: Color([0.8, 0.1, 0.1, 1.0]),
+            width,
+            behind_host: false,
+        }),
+        ..Style::default()
+    }
+}
+
+/// A torus behind and through a cube, both with feature edges: the cube hides much of the
+/// torus's rings, and its own back edges.
+fn cube_and_torus() -> World {
+    let object = |mesh: usize, transform: DMat4| Object {
+        mesh,
+        transform,
+        style: InstanceStyle::default(),
+    };
+    World {
+        meshes: vec![
+            WorldMesh {
+                mesh: Arc::new(Procedural::Cube(300).build().unwrap()),
+                edges: EdgeSelection::Feature(30.0),
+                name: "cube".into(),
+            },
+            WorldMesh {
+                mesh: Arc::new(Procedural::Torus(600).build().unwrap()),
+                edges: EdgeSelection::All,
+                name: "torus".into(),
+            },
+        ],
+        objects: vec![
+            object(0, DMat4::from_scale(DVec3::splat(0.6))),
+            object(
+                1,
+                DMat4::from_translation(DVec3::new(0.4, 0.2, -0.8))
+                    * DMat4::from_rotation_x(1.1)
+                    * DMat4::from_scale(DVec3::splat(1.2)),
+            ),
+        ],
+    }
+}
+
+/// The deferred frame against the ground truth, visible and hidden lines alike; returns the
+/// pixels the hidden-line distance was measured on.
+fn check(name: &str, world: &World, view: View, style: &Style) -> usize {
+    let truth = shoot_world(world, view, style, SIZE, Method::Raycast);
+    let frame = shoot_world(world, view, style, SIZE, Method::Deferred);
+    let (ids, _) = id_agreement(&truth, &frame).unwrap();
+    let visible = distance_error(&truth, &frame).unwrap();
+    let hidden = hidden_distance_error(&truth, &frame).unwrap();
+    println!("{name}: id {ids:.5}, visible {visible:?}, hidden {hidden:?}");
+    assert!(ids >= 0.999, "{name}: id agreement {ids}");
+    assert!(
+        visible.max.unwrap_or(0.0) <= 0.1,
+        "{name}: visible {visible:?}"
+    );
+    let worst = || worst_hidden(&truth, &frame);
+    assert!(
+        hidden.p99.unwrap() <= 0.01,
+        "{name}: hidden {hidden:?}\n{}",
+        worst()
+    );
+    assert!(
+        hidden.max.unwrap() <= 0.1,
+        "{name}: hidden {hidden:?}\n{}",
+        worst()
+    );
+    // Where the truth draws no hidden line, the pass draws none either (but at the very
+    // edge of a line's reach).
+    let extra = (0..truth.ids.len())
+        .filter(|&i| truth.ids[i] == frame.ids[i])
+        .filter(|&i| truth.hidden_distance[i].is_infinite() && frame.hidden_distance[i] < 1.9)
+        .count();
+    assert_eq!(
+        extra,
+        0,
+        "{name}: hidden line pixels the truth has not\n{}",
+        worst()
+    );
+    hidden.pixels
+}
+
+/// The worst hidden-line pixels, for failure messages.
+fn worst_hidden(truth: &Rendering, frame: &Rendering) -> String {
+    let errors = hidden_distance_errors(truth, frame).unwrap();
+    worst_of(truth, frame, (&errors, |r| &r.hidden_distance), 0.01, 8)
+}
+
+fn perspective(world: &World, eye: DVec3) -> View {
+    let (lo, hi) = world.bounds();
+    let centre = 0.5 * (lo + hi);
+    wirepass::Camera {
+        eye: eye.as_vec3(),
+        target: centre.as_vec3(),
+        up: glam::Vec3::Y,
+        fov_y_deg: 45.0,
+        near: 0.05,
+        far: 100.0,
+    }
+    .to_view(f64::from(SIZE.0) / f64::from(SIZE.1))
+}
+
+#[test]
+fn hidden_lines_match_the_ground_truth_in_every_pattern() {
+    let world = cube_and_torus();
+    let view = perspective(&world, DVec3::new(2.5, 1.8, 3.2));
+    let patterns = [
+        LinePattern::Solid,
+        LinePattern::Dashed {
+            dash: 6.0,
+            gap: 4.0,
+        },
+        LinePattern::Dotted { spacing: 5.0 },
+    ];
+    for (pattern, width) in patterns.into_iter().zip([1.0, 2.0, 3.0]) {
+        let pixels = check(
+            &format!("{pattern:?}"),
+            &world,
+            view,
+            &style(pattern, width),
+        );
+        assert!(pixels > 2000, "{pattern:?}: {pixels} hidden-line pixels");
+    }
+}
+
+#[test]
+fn hidden_lines_in_orthographic_and_close_views() {
+    let world = cube_and_torus();
+    let dashed = style(
+        LinePattern::Dashed {
+            dash: 5.0,
+            gap: 3.0,
+        },
+        1.5,
+    );
+    let aspect = f64::from(SIZE.0) / f64::from(SIZE.1);
+    let at = (DVec3::new(-3.0, 2.0, 3.0), DVec3::ZERO, DVec3::Y);
+    let ortho = View::orthographic(at, 3.5, aspect, (0.1, 20.0));
+    check("orthographic", &world, ortho, &dashed);
+    let reversed = View::orthographic_reversed(at, 3.5, aspect, (0.1, 20.0));
+    check("orthographic reversed", &world, reversed, &dashed);
+    // The eye just off the cube's face: all its lines are hidden (behind the face).
+    let close = perspective(&world, DVec3::new(0.3, 0.2, 0.75));
+    check("at a face", &world, close, &dashed);
+    // The eye by a corner of the cube, its edges crossing the near plane.
+    let corner = perspective(&world, DVec3::new(0.7, 0.65, 0.8));
+    check("by a corner", &world, corner, &dashed);
+}
+
+#[test]
+fn a_cad_part_hides_its_own_feature_edges() {
+    let mesh = load("fandisk.obj");
+    let world = World::single(mesh.clone(), EdgeSelection::Feature(30.0));
+    let view = framing(&mesh, SIZE).to_view(f64::from(SIZE.0) / f64::from(SIZE.1));
+    let pixels = check(
+        "fandisk",
+        &world,
+        view,
+        &style(
+            LinePattern::Dashed {
+                dash: 4.0,
+                gap: 3.0,
+            },
+            1.0,
+        ),
+    );
+    assert!(pixels > 500, "fandisk: {pixels} hidden-line pixels");
+}
+
+#[test]
+fn hidden_off_draws_todays_image() {
+    let world = cube_and_torus();
+    let view = perspective(&world, DVec3::new(2.5, 1.8, 3.2));
+    let plain = shoot_world(&world, view, &Style::default(), SIZE, Method::Deferred);
+    assert!(plain.hidden_distance.iter().all(|d| d.is_infinite()));
+    // Hidden lines of no opacity change nothing but the hidden-line map.
+    let mut clear = style(LinePattern::Solid, 2.0);
+    clear.hidden.as_mut().unwrap().color = Color([0.8, 0.1, 0.1, 0.0]);
+    let faint = shoot_world(&world, view, &clear, SIZE, Method::Deferred);
+    assert_eq!(plain.ids, faint.ids);
+    assert_eq!(plain.rgba, faint.rgba);
+    assert_eq!(plain.edge_distance, faint.edge_distance);
+    assert!(faint.hidden_distance.iter().any(|d| d.is_finite()));
+}
+
+/// A see-through surface (`Style::fill_opacity`) with dashed hidden lines: the background
+/// shows through the faded surface where the ground truth says, the lines on top.
+#[test]
+fn see_through_surfaces_blend_like_the_ground_truth() {
+    let world = cube_and_torus();
+    let view = perspective(&world, DVec3::new(2.5, 1.8, 3.2));
+    let mut style = style(
+        LinePattern::Dashed {
+            dash: 6.0,
+            gap: 4.0,
+        },
+        1.5,
+    );
+    style.fill_opacity = 0.35;
+    style.background = Color([0.9, 0.8, 0.2, 1.0]);
+    let truth = shoot_world(&world, view, &style, SIZE, Method::Raycast);
+    let frame = shoot_world(&world, view, &style, SIZE, Method::Deferred);
+    let opaque = shoot_world(
+        &world,
+        view,
+        &Style {
+            fill_opacity: 1.0,
+            ..style.clone()
+        },
+        SIZE,
+        Method::Deferred,
+    );
+    let (mut compared, mut worst, mut faded) = (0, 0, 0);
+    for i in 0..truth.ids.len() {
+        if truth.ids[i] != frame.ids[i] || truth.ids[i] == wirepass::world::BACKGROUND {
+            continue;
+        }
+        compared += 1;
+        let d = (0..4)
+            .map(|c| (i32::from(truth.rgba[4 * i + c]) - i32::from(frame.rgba[4 * i + c])).abs())
+            .max()
+            .unwrap();
+        worst = worst.max(d);
+        // The background's yellow shows through: more red than blue, unlike the opaque
+        // grey-blue surface.
+        let (r, b) = (frame.rgba[4 * i], frame.rgba[4 * i + 2]);
+        let (or, ob) = (opaque.rgba[4 * i], opaque.rgba[4 * i + 2]);
+        if r > b && or < ob {
+            faded += 1;
+        }
+    }
+    println!("{compared} surface pixels, worst channel difference {worst}, {faded} faded");
+    assert!(compared > 10_000);
+    assert!(worst <= 2, "worst channel difference {worst}");
+    assert!(faded > compared / 2, "{faded} of {compared} faded");
+}
