@@ -5,11 +5,13 @@
 //! Mouse: left drag orbits, right or middle drag pans, the wheel zooms, a left click picks
 //! (the window title says what the pixel shows: the triangle, its polygon, the exact point,
 //! and the nearest drawn edge and vertex).
-//! Keys: `E` cycles the edges (polygon, all, feature), `O` toggles outlines, `M` switches the
-//! method, `+`/`-` change the line width, `Esc` quits.
+//! Keys: `E` cycles the edges (polygon, all, feature), `O` toggles outlines, `H` cycles the
+//! hidden lines (off, dashed, dotted, solid; deferred only), `M` switches the method, `+`/`-`
+//! change the line width, `Esc` quits.
 //!
 //! `cargo run --release --example viewer -- [MESH] [--method deferred|forward]
-//! [--edges polygon|all|feature] [--frames N] [--screenshot OUT.png] [--pick X,Y]`
+//! [--edges polygon|all|feature] [--hidden off|dashed|dotted|solid] [--frames N]
+//! [--screenshot OUT.png] [--pick X,Y]`
 //!
 //! With `--frames N` the viewer orbits a little each frame and closes after N frames; with
 //! `--screenshot` it reads the last frame back from the surface, checks that it shows the
@@ -29,7 +31,7 @@ use wirepass::gpu::{
     Composite, DeferredPass, ForwardPass, MeshId, MeshStore, OutputTarget, PassOptions,
     RenderTarget,
 };
-use wirepass::{wgpu, EdgeSelection, Instance, Mesh, Scene, Style};
+use wirepass::{wgpu, EdgeSelection, HiddenLines, Instance, LinePattern, Mesh, Scene, Style};
 
 type AnyError = Box<dyn std::error::Error>;
 
@@ -53,9 +55,35 @@ struct Options {
     mesh: std::path::PathBuf,
     method: Method,
     edges: usize,
+    hidden: usize,
     frames: Option<u64>,
     screenshot: Option<std::path::PathBuf>,
     pick: Option<(u32, u32)>,
+}
+
+/// The hidden-line styles `H` cycles through.
+const HIDDEN: [(&str, Option<LinePattern>); 4] = [
+    ("off", None),
+    (
+        "dashed",
+        Some(LinePattern::Dashed {
+            dash: 6.0,
+            gap: 4.0,
+        }),
+    ),
+    ("dotted", Some(LinePattern::Dotted { spacing: 4.0 })),
+    ("solid", Some(LinePattern::Solid)),
+];
+
+/// The style with hidden lines in `HIDDEN[k]`'s pattern.
+fn with_hidden(style: &Style, k: usize) -> Style {
+    Style {
+        hidden: HIDDEN[k].1.map(|pattern| HiddenLines {
+            pattern,
+            ..HiddenLines::default()
+        }),
+        ..style.clone()
+    }
 }
 
 fn options() -> Result<Options, AnyError> {
@@ -63,6 +91,7 @@ fn options() -> Result<Options, AnyError> {
         mesh: std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/meshes/spot.obj"),
         method: Method::Deferred,
         edges: 0,
+        hidden: 0,
         frames: None,
         screenshot: None,
         pick: None,
@@ -84,6 +113,15 @@ fn options() -> Result<Options, AnyError> {
                     .iter()
                     .position(|(name, _)| *name == e)
                     .ok_or(format!("--edges {e:?} is not polygon, all or feature"))?;
+            }
+            "--hidden" => {
+                let h = value()?;
+                o.hidden = HIDDEN
+                    .iter()
+                    .position(|(name, _)| *name == h)
+                    .ok_or(format!(
+                        "--hidden {h:?} is not off, dashed, dotted or solid"
+                    ))?;
             }
             "--frames" => o.frames = Some(value()?.parse()?),
             "--screenshot" => o.screenshot = Some(value()?.into()),
@@ -118,6 +156,8 @@ struct Viewer {
     style: Style,
     method: Method,
     edges: usize,
+    /// Which of HIDDEN the style draws.
+    hidden: usize,
     drag: Option<MouseButton>,
     cursor: (f64, f64),
     /// Where the left button went down, to tell a click from a drag.
@@ -216,9 +256,10 @@ impl Viewer {
                 let (lo, hi) = mesh.bounds_f64();
                 Orbit::framing(lo, hi)
             },
-            style: Style::default(),
+            style: with_hidden(&Style::default(), o.hidden),
             method: o.method,
             edges: o.edges,
+            hidden: o.hidden,
             drag: None,
             cursor: (0.0, 0.0),
             press: None,
@@ -231,10 +272,11 @@ impl Viewer {
 
     fn title(&self) {
         self.window.set_title(&format!(
-            "wirepass viewer: {:?}, {} edges, outlines {}, width {:.1} (E, O, M, +/-)",
+            "wirepass viewer: {:?}, {} edges, outlines {}, hidden {}, width {:.1} (E, O, H, M, +/-)",
             self.method,
             EDGES[self.edges].0,
             if self.style.silhouettes { "on" } else { "off" },
+            HIDDEN[self.hidden].0,
             self.style.line_width
         ));
     }
@@ -251,6 +293,10 @@ impl Viewer {
         match key.as_ref() {
             Key::Character("e" | "E") => self.edges = (self.edges + 1) % EDGES.len(),
             Key::Character("o" | "O") => self.style.silhouettes = !self.style.silhouettes,
+            Key::Character("h" | "H") => {
+                self.hidden = (self.hidden + 1) % HIDDEN.len();
+                self.style = with_hidden(&self.style, self.hidden);
+            }
             Key::Character("m" | "M") if self.forward.is_some() => {
                 self.method = match self.method {
                     Method::Deferred => Method::Forward,

@@ -10,7 +10,7 @@ use wirepass::tools::bench::Timed;
 use wirepass::tools::load::{load_world, parse_size, parse_vec3, CameraPlacement, WorldOptions};
 use wirepass::tools::offline::{draw, Method};
 use wirepass::world::{Shot, World};
-use wirepass::{Color, EdgeSelection, Result, Style, View};
+use wirepass::{Color, EdgeSelection, HiddenLines, LinePattern, Result, Style, View};
 
 #[derive(Parser)]
 #[command(
@@ -82,6 +82,21 @@ struct SceneArgs {
     /// Fade lines from full strength at view depth START to nothing at END (world units).
     #[arg(long, value_name = "START:END", value_parser = parse_fade)]
     depth_fade: Option<DepthFade>,
+    /// Hidden lines (the parts of the drawn lines that surfaces hide): off, solid,
+    /// dashed[:DASH,GAP] or dotted[:SPACING], lengths in pixels. Only deferred and raycast
+    /// draw them.
+    #[arg(long, default_value = "off", value_name = "STYLE")]
+    hidden: String,
+    /// Hidden-line colour, #rrggbb[aa] (sRGB).
+    #[arg(long, default_value = "#6e7580cc")]
+    hidden_color: String,
+    /// Hidden-line width in pixels.
+    #[arg(long, default_value_t = 1.0)]
+    hidden_width: f32,
+    /// Opacity of the shaded surface over the background, 0..1: below 1 a see-through
+    /// surface, with --hidden lines showing through it.
+    #[arg(long, default_value_t = 1.0)]
+    fill_opacity: f32,
     #[command(flatten)]
     camera: CameraArgs,
 }
@@ -119,9 +134,20 @@ impl SceneArgs {
             line_width: self.line_width.unwrap_or(DEFAULT_LINE_WIDTH),
             wire_color: Color::from_hex(&self.wire_color)?,
             fill_color: Color::from_hex(&self.fill_color)?,
+            fill_opacity: self.fill_opacity,
             background: Color::from_hex(&self.background)?,
             silhouettes: self.silhouettes,
             depth_fade: self.depth_fade,
+            hidden: LinePattern::parse(&self.hidden)?
+                .map(|pattern| -> Result<HiddenLines> {
+                    Ok(HiddenLines {
+                        pattern,
+                        color: Color::from_hex(&self.hidden_color)?,
+                        width: self.hidden_width,
+                        behind_host: false,
+                    })
+                })
+                .transpose()?,
             ..Style::default()
         };
         style.validate()?;
@@ -160,8 +186,9 @@ struct RenderArgs {
     /// Output PNG.
     #[arg(short, long, default_value = "wireframe.png")]
     output: PathBuf,
-    /// Also write ids.npy (global triangle ids), depth.npy, edge_distance.npy and camera.json
-    /// (the view and projection matrices used) into this directory.
+    /// Also write ids.npy (global triangle ids), depth.npy, edge_distance.npy,
+    /// hidden_distance.npy and camera.json (the view and projection matrices used) into this
+    /// directory.
     #[arg(long)]
     dump: Option<PathBuf>,
 }

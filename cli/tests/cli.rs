@@ -39,6 +39,7 @@ fn renders_the_built_in_scene_and_dumps_numpy_files() {
         ("ids.npy", "<u4"),
         ("depth.npy", "<f4"),
         ("edge_distance.npy", "<f4"),
+        ("hidden_distance.npy", "<f4"),
     ] {
         let bytes = std::fs::read(dump.join(name)).unwrap();
         assert_eq!(&bytes[..6], b"\x93NUMPY", "{name}");

@@ -248,7 +248,8 @@ impl Rendering {
         crate::tools::regression::save_rgba_png(path, &self.rgba, self.size)
     }
 
-    /// Writes `ids.npy`, `depth.npy`, `edge_distance.npy` and `camera.json` into `dir`.
+    /// Writes `ids.npy`, `depth.npy`, `edge_distance.npy`, `hidden_distance.npy` and
+    /// `camera.json` into `dir`.
     pub fn dump(&self, dir: &Path, view: &View) -> Result<()> {
         std::fs::create_dir_all(dir).map_err(|source| Error::Io {
             path: dir.to_owned(),
@@ -258,6 +259,11 @@ impl Rendering {
         write_npy(&dir.join("ids.npy"), &shape, &self.ids)?;
         write_npy(&dir.join("depth.npy"), &shape, &self.depth)?;
         write_npy(&dir.join("edge_distance.npy"), &shape, &self.edge_distance)?;
+        write_npy(
+            &dir.join("hidden_distance.npy"),
+            &shape,
+            &self.hidden_distance,
+        )?;
         let path = dir.join("camera.json");
         let text = camera_json(view, self.size);
         std::fs::write(&path, text).map_err(|source| Error::Io { path, source })
