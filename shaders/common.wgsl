@@ -369,6 +369,17 @@ fn cluster_splats(c: Cluster) -> bool {
     return c.spread < 0.0;
 }
 
+// Whether the cluster holds a drawn edge: mesh_records::cluster_records stores the radius
+// of one without as -1 - radius.
+fn cluster_draws(c: Cluster) -> bool {
+    return c.radius >= 0.0;
+}
+
+// The radius of the cluster's bounding sphere.
+fn cluster_radius(c: Cluster) -> f32 {
+    return select(c.radius, -1.0 - c.radius, c.radius < 0.0);
+}
+
 // Twin of clusters::may_fold: false when, seen from `eye`, no triangle of the cluster can have
 // an outline edge: every direction from the eye into the sphere (within β of its centre's)
 // makes an angle with every normal (within the spread of the axis) that stays off 90°. An
@@ -378,8 +389,9 @@ fn cluster_may_fold(c: Cluster, eye: vec4<f32>) -> bool {
     let perspective = eye.w != 0.0;
     let d = select(-eye.xyz, c.center - eye.xyz / eye.w, perspective);
     let distance = length(d);
-    let inside = perspective && !(distance > c.radius);
-    let beta = select(0.0, asin(c.radius / distance), perspective);
+    let radius = cluster_radius(c);
+    let inside = perspective && !(distance > radius);
+    let beta = select(0.0, asin(radius / distance), perspective);
     let gamma = atan2(length(cross(d, c.axis)), dot(d, c.axis));
     let reach = beta + spread;
     let quarter = 1.5707963;

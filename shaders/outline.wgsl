@@ -108,7 +108,7 @@ fn outline_cull(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     let splats = (flags & INSTANCE_EDGES) != 0u && cluster_splats(cluster);
 #if HIDDEN
     // Every drawn edge in view has a hidden part to find.
-    let hidden = (flags & INSTANCE_EDGES) != 0u && cluster_in_view(instances[slot(inst)].clip, cluster);
+    let hidden = (flags & INSTANCE_EDGES) != 0u && cluster_draws(cluster) && cluster_in_view(instances[slot(inst)].clip, cluster);
 #else
     let hidden = false;
 #endif
@@ -137,7 +137,7 @@ fn cluster_in_view(clip: mat4x4<f32>, c: Cluster) -> bool {
     for (var k = 0u; k < 5u; k++) {
         // The plane's function of a local point, dot(plane, clip * (p, 1)).
         let r = planes[k] * clip;
-        inside = inside && dot(r.xyz, c.center) + r.w >= -c.radius * length(r.xyz);
+        inside = inside && dot(r.xyz, c.center) + r.w >= -cluster_radius(c) * length(r.xyz);
     }
     return inside;
 }

@@ -335,6 +335,10 @@ struct BenchArgs {
     /// [default: all of them].
     #[arg(long, value_delimiter = ',', value_parser = parse_timed)]
     methods: Vec<Timed>,
+    /// Hidden lines for the deferred method (off, solid, dashed[:DASH,GAP],
+    /// dotted[:SPACING]); the other methods draw none.
+    #[arg(long, default_value = "off", value_name = "STYLE")]
+    hidden: String,
 }
 
 fn parse_timed(s: &str) -> std::result::Result<Timed, String> {
@@ -380,6 +384,10 @@ fn bench_command(args: &BenchArgs) -> Result<()> {
                 let style = Style {
                     silhouettes,
                     line_width: args.line_width.unwrap_or(DEFAULT_LINE_WIDTH),
+                    hidden: LinePattern::parse(&args.hidden)?.map(|pattern| HiddenLines {
+                        pattern,
+                        ..HiddenLines::default()
+                    }),
                     ..Style::default()
                 };
                 style.validate()?;
@@ -410,6 +418,9 @@ fn bench_command(args: &BenchArgs) -> Result<()> {
     }
     progress.finish_and_clear();
     let device = wirepass::tools::bench::DeviceInfo::of(&ctx);
+    if args.hidden != "off" {
+        println!("Hidden lines: {} (deferred only).\n", args.hidden);
+    }
     print!(
         "{}",
         wirepass::tools::bench::report_markdown(&device, &runs)

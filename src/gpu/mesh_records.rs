@@ -271,7 +271,9 @@ impl EdgeData {
 
 /// The cluster records the outline pass reads: `bounds` with the spread of each cluster
 /// holding an edge to splat (`info`, stored order) stored as −1 − spread, so the outline
-/// pass visits it whatever the eye (`cluster_splats` in common.wgsl).
+/// pass visits it whatever the eye (`cluster_splats` in common.wgsl), and the radius of each
+/// cluster holding no drawn edge stored as −1 − radius, so that hidden lines skip it
+/// (`cluster_draws`).
 pub(crate) fn cluster_records(bounds: &[[f32; 8]], info: &[u32]) -> Vec<[f32; 8]> {
     bounds
         .iter()
@@ -280,6 +282,9 @@ pub(crate) fn cluster_records(bounds: &[[f32; 8]], info: &[u32]) -> Vec<[f32; 8]
             let mut b = *b;
             if tris.iter().any(|i| i >> INFO_SPLAT_SHIFT & 7 != 0) {
                 b[7] = -1.0 - b[7];
+            }
+            if tris.iter().all(|i| i & 7 == 0) {
+                b[3] = -1.0 - b[3];
             }
             b
         })
