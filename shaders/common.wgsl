@@ -81,6 +81,12 @@ struct Instance {
     cluster_first: u32,
     // This record's place in the instance buffer.
     index: u32,
+    // The outline's linear RGBA and width in pixels.
+    outline_color: vec4<f32>,
+    outline_width: f32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 const INSTANCE_EDGES: u32 = 1u;

@@ -100,8 +100,8 @@ struct Pixel {
     depth: f32,
 }
 
-// The line the outline pass left in target pixel `xy`: its key (0 for none) and the
-// instance slot whose line it is.
+// The line the outline pass left in target pixel `xy`: its key (0 for none) and its owner
+// (the instance slot whose line it is, and OWNER_OUTLINE for an outline: `owner_color`).
 fn outline_at(xy: vec2<u32>) -> vec2<u32> {
     var key = 0u;
     var owner = 0u;
@@ -143,7 +143,7 @@ fn empty_pixel(xy: vec2<u32>, inst: u32, outline: vec2<u32>) -> Pixel {
     } else {
         p.distance = key_distance(outline.x);
         p.line = key_intensity(outline.x);
-        p.wire = instances[slot(outline.y)].wire_color;
+        p.wire = owner_color(outline.y);
     }
     return p;
 }
@@ -451,7 +451,7 @@ fn surface_pixel(xy: vec2<u32>, s: Sample, own: f32) -> Pixel {
     } else {
         p.distance = key_distance(outline.x);
         p.line = key_intensity(outline.x);
-        p.wire = instances[slot(outline.y)].wire_color;
+        p.wire = owner_color(outline.y);
     }
     return p;
 }

@@ -51,6 +51,11 @@ struct Instance {
     uint cluster_base;
     uint cluster_first;
     uint index;
+    vec4 outline_color;
+    float outline_width;
+    uint pad0;
+    uint pad1;
+    uint pad2;
 };
 
 // The records of one instanced draw's instances, gl_InstanceID first.

@@ -28,8 +28,9 @@
 // pattern (`dash_nearest`) in their own word (`hidden_lines`). The pattern's phase runs
 // along the edge's projection from its end that comes first in (x, y, z) order.
 //
-// Flags: COLORS (instances differ in line colour: each pixel also keeps the greatest
-// (intensity level, instance) pair, so the edge pass knows whose line it holds), HIDDEN.
+// Flags: COLORS (instances differ in line colour, or an outline's colour differs from the
+// edges': each pixel also keeps the greatest (intensity level, class, instance) word,
+// `OWNER_OUTLINE`, so the edge pass knows whose line it holds and of which class), HIDDEN.
 
 @group(0) @binding(9) var<storage, read> clusters: array<Cluster>;
 // The outline buffer (`outline_tile_marks` in scene.wgsl): the lines, and the output tiles
@@ -230,7 +231,8 @@ fn outline_triangle(inst: u32, t: u32) {
         let n = neighbour_of(word);
         let a = p[i];
         let b = p[(i + 1u) % 3u];
-        var outline = (splat & (1u << i)) != 0u || ((allowed & (1u << i)) != 0u && n == BACKGROUND_ID);
+        // An outline (of its own class, width and colour), or a drawn edge of a large patch.
+        var outline = (allowed & (1u << i)) != 0u && n == BACKGROUND_ID;
         if !outline && (allowed & (1u << i)) != 0u && may_fold && t < n {
             // Shared edges are drawn by the lower id only. The neighbour's centroid, its
             // corners summed in its own order; only the one off the edge is read.
@@ -238,7 +240,8 @@ fn outline_triangle(inst: u32, t: u32) {
             let d = (q.q0.xyz + q.q1.xyz + q.q2.xyz) / 3.0;
             outline = is_silhouette(a, b, p[(i + 2u) % 3u], d, eye);
         }
-        var mode = select(0u, DRAW_VISIBLE, outline);
+        let splats = (splat & (1u << i)) != 0u;
+        var mode = select(0u, DRAW_VISIBLE, outline || splats) | select(0u, DRAW_OUTLINE, outline);
 #if HIDDEN
         // A shared drawn edge is drawn by the lower id only.
         let hidden = outline || ((drawn & (1u << i)) != 0u && (n == BACKGROUND_ID || t < n));
@@ -258,9 +261,15 @@ fn comes_first(a: vec3<f32>, b: vec3<f32>) -> bool {
 }
 
 // What a listed edge draws: its visible runs (into the lines), its hidden runs (HIDDEN, into
-// the hidden lines).
+// the hidden lines); DRAW_OUTLINE: its visible line is an outline, else a drawn edge.
 const DRAW_VISIBLE: u32 = 1u;
 const DRAW_HIDDEN: u32 = 2u;
+const DRAW_OUTLINE: u32 = 4u;
+
+// The classes of line splat_runs writes.
+const LINE_EDGE: u32 = 0u;
+const LINE_OUTLINE: u32 = 1u;
+const LINE_HIDDEN: u32 = 2u;
 
 // Narrows [range.x, range.y] to the parameters u where lo <= p0 + u d <= hi.
 fn keep_between(range: vec2<f32>, p0: f32, d: f32, lo: f32, hi: f32) -> vec2<f32> {
@@ -391,7 +400,8 @@ fn clip_outline(inst: u32, t: u32, n: u32, a: vec3<f32>, b: vec3<f32>, a_first: 
 // (DRAW_VISIBLE, DRAW_HIDDEN). Where the list is full the piece is drawn here.
 fn list_outline(inst: u32, t: u32, i: u32, n: u32, a: vec3<f32>, b: vec3<f32>, a_first: bool, mode: u32) {
     let c = clip_outline(inst, t, n, a, b, a_first);
-    var reach = select(0.0, line_reach(instances[slot(inst)].line_width), (mode & DRAW_VISIBLE) != 0u);
+    let visible_width = select(instances[slot(inst)].line_width, instances[slot(inst)].outline_width, (mode & DRAW_OUTLINE) != 0u);
+    var reach = select(0.0, line_reach(visible_width), (mode & DRAW_VISIBLE) != 0u);
 #if HIDDEN
     reach = max(reach, select(0.0, line_reach(frame.hidden_line.x), (mode & DRAW_HIDDEN) != 0u));
 #endif
@@ -495,11 +505,11 @@ fn draw_piece(seg: Segment, k0: f32, k1: f32, length_px: f32, mode: u32) {
         }
     }
     if (mode & DRAW_VISIBLE) != 0u && count > 0u {
-        splat_runs(seg, k0, k1, &runs, count, false);
+        splat_runs(seg, k0, k1, &runs, count, select(LINE_EDGE, LINE_OUTLINE, (mode & DRAW_OUTLINE) != 0u));
     }
 #if HIDDEN
     if (mode & DRAW_HIDDEN) != 0u && hidden_count > 0u {
-        splat_runs(seg, k0, k1, &hidden_runs, hidden_count, true);
+        splat_runs(seg, k0, k1, &hidden_runs, hidden_count, LINE_HIDDEN);
     }
 #endif
 }
@@ -525,12 +535,14 @@ fn push_run(runs: ptr<function, array<vec2<f32>, MAX_RUNS>>, count: ptr<function
 }
 
 // Writes into every pixel within reach of the segment's `runs` (parameters, between k0 and
-// k1) the key of their nearest point: of a visible line, or (`hidden`) of a dash of the
-// hidden-line pattern, in the hidden lines' word.
-fn splat_runs(seg: Segment, k0: f32, k1: f32, runs: ptr<function, array<vec2<f32>, MAX_RUNS>>, count: u32, hidden: bool) {
-    var width = instances[slot(seg.inst)].line_width;
+// k1) the key of their nearest point, for a line of class `kind`: an edge's or an
+// outline's visible line, or (LINE_HIDDEN) a dash of the hidden-line pattern, in the hidden
+// lines' word.
+fn splat_runs(seg: Segment, k0: f32, k1: f32, runs: ptr<function, array<vec2<f32>, MAX_RUNS>>, count: u32, kind: u32) {
+    var width = select(instances[slot(seg.inst)].line_width, instances[slot(seg.inst)].outline_width, kind == LINE_OUTLINE);
     var pattern = vec2<f32>(0.0);
     var behind_host = false;
+    let hidden = kind == LINE_HIDDEN;
 #if HIDDEN
     if hidden {
         width = frame.hidden_line.x;
@@ -620,7 +632,7 @@ fn splat_runs(seg: Segment, k0: f32, k1: f32, runs: ptr<function, array<vec2<f32
 #endif
 #if COLORS
             atomicMax(&acc_rw[2u * index], key);
-            atomicMax(&acc_rw[2u * index + 1u], (key & 0xfff00000u) | seg.inst);
+            atomicMax(&acc_rw[2u * index + 1u], (key & 0xfff00000u) | select(0u, OWNER_OUTLINE, kind == LINE_OUTLINE) | seg.inst);
 #else
             atomicMax(&acc_rw[index], key);
 #endif

@@ -41,6 +41,18 @@ fn outline_tile_count() -> u32 {
     return ((size.x + 7u) / 8u) * ((size.y + 7u) / 8u);
 }
 
+// The bit of the outline pass's owner word (COLORS: intensity level << 20 | this bit |
+// instance slot) that marks an outline's line, whose colour is the instance's outline
+// colour, not its line colour.
+const OWNER_OUTLINE: u32 = 0x80000u;
+
+// The colour of the outline pass's line whose owner word is `owner`: the owning instance's
+// outline colour for an outline, its line colour for a drawn edge.
+fn owner_color(owner: u32) -> vec4<f32> {
+    let i = slot(owner & (OWNER_OUTLINE - 1u));
+    return select(instances[i].wire_color, instances[i].outline_color, (owner & OWNER_OUTLINE) != 0u);
+}
+
 // Word offset of the hidden lines (HIDDEN): the greatest `line_key` per target pixel.
 fn hidden_lines() -> u32 {
     let pixels = u32(frame.target_size.x) * u32(frame.target_size.y);

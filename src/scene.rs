@@ -10,8 +10,9 @@ use crate::gpu::MeshId;
 use crate::style::{Color, MAX_LINE_WIDTH};
 use glam::DMat4;
 
-/// Most instances a frame may hold; instance slots must fit the outline keys' 20 bits.
-pub const MAX_INSTANCES: u32 = 1 << 20;
+/// Most instances a frame may hold: instance slots must fit 19 bits of the outline pass's
+/// per-pixel owner word, whose 20th says whether the line is an outline or an edge.
+pub const MAX_INSTANCES: u32 = 1 << 19;
 
 /// Per-instance departures from the frame's [`Style`](crate::Style); `None` keeps the
 /// style's setting.
@@ -30,6 +31,12 @@ pub struct InstanceStyle {
     /// Whether this instance's outline (silhouettes and boundaries) is drawn; the style's
     /// [`silhouettes`](crate::Style::silhouettes) otherwise.
     pub outlines: Option<bool>,
+    /// Colour of this instance's outline; otherwise the style's
+    /// [`outline_color`](crate::Style::outline_color), else this instance's line colour.
+    pub outline_color: Option<Color>,
+    /// Width of this instance's outline, in pixels; otherwise the style's
+    /// [`outline_width`](crate::Style::outline_width), else this instance's line width.
+    pub outline_width: Option<f32>,
 }
 
 /// One placement of a mesh: which mesh, where (any affine model → world transform,
@@ -67,19 +74,39 @@ impl Instance {
 }
 
 impl InstanceStyle {
+    /// The colour of the instance's outline in `style`: its own, the style's, or its line
+    /// colour.
+    pub fn outline_color_in(&self, style: &crate::Style) -> Color {
+        self.outline_color
+            .or(style.outline_color)
+            .unwrap_or(self.wire_color.unwrap_or(style.wire_color))
+    }
+
+    /// The width of the instance's outline in `style`: its own, the style's, or its line
+    /// width.
+    pub fn outline_width_in(&self, style: &crate::Style) -> f32 {
+        self.outline_width
+            .or(style.outline_width)
+            .unwrap_or(self.line_width.unwrap_or(style.line_width))
+    }
+
     /// Checks the overrides; `index` names the instance in errors.
     pub fn validate(&self, index: usize) -> Result<()> {
         let bad = |m: String| Err(Error::InvalidScene(format!("instance {index}: {m}")));
-        if let Some(w) = self.line_width {
-            if !(0.0..=MAX_LINE_WIDTH).contains(&w) {
-                return bad(format!(
-                    "line width {w} is not in 0..={MAX_LINE_WIDTH} pixels"
-                ));
+        for (what, w) in [("line", self.line_width), ("outline", self.outline_width)] {
+            if let Some(w) = w {
+                if !(0.0..=MAX_LINE_WIDTH).contains(&w) {
+                    return bad(format!(
+                        "{what} width {w} is not in 0..={MAX_LINE_WIDTH} pixels"
+                    ));
+                }
             }
         }
-        if let Some(c) = self.wire_color {
-            if c.0.iter().any(|v| !v.is_finite()) {
-                return bad(format!("wire colour {:?} is not finite", c.0));
+        for (what, c) in [("wire", self.wire_color), ("outline", self.outline_color)] {
+            if let Some(c) = c {
+                if c.0.iter().any(|v| !v.is_finite()) {
+                    return bad(format!("{what} colour {:?} is not finite", c.0));
+                }
             }
         }
         if let Some(c) = self.fill_color {

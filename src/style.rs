@@ -74,6 +74,14 @@ pub struct Style {
     /// Direction towards the key light in view space (x right, y up, z towards the viewer),
     /// so the lighting follows the camera.
     pub light_view_dir: Vec3,
+    /// Colour of the outlines (silhouettes and boundaries); `None` draws them in
+    /// [`wire_color`](Self::wire_color)
+    /// ([`InstanceStyle::outline_color`](crate::InstanceStyle::outline_color) overrides it).
+    pub outline_color: Option<Color>,
+    /// Width of the outlines in pixels; `None` draws them at
+    /// [`line_width`](Self::line_width)
+    /// ([`InstanceStyle::outline_width`](crate::InstanceStyle::outline_width) overrides it).
+    pub outline_width: Option<f32>,
     /// Draw the outline (silhouette and boundary edges) at full width, over the background
     /// and farther surfaces too, and always, whatever the edge selection. Only the deferred
     /// pass and the ground truth can; the forward baselines draw each edge inside its own
@@ -299,6 +307,8 @@ impl Default for Style {
             background: Color([1.0, 1.0, 1.0, 1.0]),
             ambient: 0.3,
             light_view_dir: Vec3::new(-0.4, 0.6, 1.0),
+            outline_color: None,
+            outline_width: None,
             silhouettes: true,
             depth_fade: None,
             hidden: None,
@@ -309,11 +319,16 @@ impl Default for Style {
 impl Style {
     /// Rejects settings that cannot produce a sensible image.
     pub fn validate(&self) -> Result<()> {
-        if !(self.line_width >= 0.0 && self.line_width <= MAX_LINE_WIDTH) {
-            return Err(Error::InvalidSetting(format!(
-                "line width {} is not in 0..={MAX_LINE_WIDTH} pixels",
-                self.line_width
-            )));
+        let widths = [
+            ("line", Some(self.line_width)),
+            ("outline", self.outline_width),
+        ];
+        for (what, w) in widths {
+            if let Some(w) = w.filter(|w| !(*w >= 0.0 && *w <= MAX_LINE_WIDTH)) {
+                return Err(Error::InvalidSetting(format!(
+                    "{what} width {w} is not in 0..={MAX_LINE_WIDTH} pixels"
+                )));
+            }
         }
         if let Some(DepthFade { start, end }) = self.depth_fade {
             if !(start >= 0.0 && end > start && end.is_finite()) {
@@ -340,7 +355,8 @@ impl Style {
         if self.light_view_dir.try_normalize().is_none() {
             return Err(Error::InvalidSetting("light direction is zero".into()));
         }
-        for c in [self.wire_color, self.fill_color, self.background] {
+        let outline = self.outline_color.unwrap_or(self.wire_color);
+        for c in [self.wire_color, outline, self.fill_color, self.background] {
             if c.0.iter().any(|v| !v.is_finite()) {
                 return Err(Error::InvalidSetting(format!(
                     "colour {:?} is not finite",

@@ -166,6 +166,7 @@ fn gs_draws_many_instances_as_forward_does() {
                 line_width: (k % 7 == 0).then_some(3.0),
                 edges: (k == 42).then_some(false),
                 outlines: None,
+                ..InstanceStyle::default()
             },
         });
     }

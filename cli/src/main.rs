@@ -66,6 +66,12 @@ struct SceneArgs {
     /// Surface colour, #rrggbb (sRGB).
     #[arg(long, default_value = "#c2cfdf")]
     fill_color: String,
+    /// Outline colour, #rrggbb[aa] (sRGB) [default: the line colour].
+    #[arg(long)]
+    outline_color: Option<String>,
+    /// Outline width in pixels [default: the line width].
+    #[arg(long)]
+    outline_width: Option<f32>,
     /// Background colour, #rrggbb (sRGB).
     #[arg(long, default_value = "#ffffff")]
     background: String,
@@ -134,6 +140,12 @@ impl SceneArgs {
             line_width: self.line_width.unwrap_or(DEFAULT_LINE_WIDTH),
             wire_color: Color::from_hex(&self.wire_color)?,
             fill_color: Color::from_hex(&self.fill_color)?,
+            outline_color: self
+                .outline_color
+                .as_deref()
+                .map(Color::from_hex)
+                .transpose()?,
+            outline_width: self.outline_width,
             fill_opacity: self.fill_opacity,
             background: Color::from_hex(&self.background)?,
             silhouettes: self.silhouettes,

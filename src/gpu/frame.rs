@@ -57,6 +57,9 @@ pub(crate) struct InstanceRecord {
     cluster_base: u32,
     cluster_first: u32,
     index: u32,
+    outline_color: [f32; 4],
+    outline_width: f32,
+    _pad: [u32; 3],
 }
 
 /// `Instance.flags`: the instance's edges are drawn.
@@ -66,7 +69,7 @@ const INSTANCE_OUTLINES: u32 = 2;
 
 /// Instance records a uniform buffer holds (`scene.wgsl`, `UNIFORM_INSTANCES`): frames with
 /// up to this many bind them as uniforms, which software rasterizers read many times faster
-/// than storage buffers; 256 records are 56 KiB, within `Limits::default()`'s 64 KiB.
+/// than storage buffers; 256 records are 64 KiB, `Limits::default()`'s largest uniform binding.
 pub(crate) const UNIFORM_INSTANCE_CAPACITY: u32 = 256;
 
 /// Byte offset of `InstanceRecord::index`, read as an instance-rate vertex attribute.
@@ -106,8 +109,10 @@ pub fn guard_band(scene: &Scene<'_>, style: &Style) -> u32 {
     let widest = scene
         .instances
         .iter()
-        .filter_map(|i| i.style.line_width)
+        .flat_map(|i| [i.style.line_width, Some(i.style.outline_width_in(style))])
+        .flatten()
         .chain(style.hidden.map(|h| h.width))
+        .chain(style.outline_width)
         .fold(style.line_width, f32::max);
     (crate::style::line_reach(f64::from(widest)).ceil() as u32).saturating_add(2)
 }
@@ -230,6 +235,8 @@ impl FrameRecords {
             lines |= draws_outline || draws_edges;
             let flags = if draws_edges { INSTANCE_EDGES } else { 0 }
                 | if draws_outline { INSTANCE_OUTLINES } else { 0 };
+            let wire = s.wire_color.unwrap_or(style.wire_color);
+            let width = s.line_width.unwrap_or(style.line_width);
             let record = instance_record(
                 &view,
                 (eye, fade_row),
@@ -237,10 +244,11 @@ impl FrameRecords {
                 mesh,
                 (
                     [
-                        s.wire_color.unwrap_or(style.wire_color).0,
+                        wire.0,
                         s.fill_color.unwrap_or(style.fill_color).0,
+                        s.outline_color_in(style).0,
                     ],
-                    s.line_width.unwrap_or(style.line_width),
+                    [width, s.outline_width_in(style)],
                     flags,
                 ),
                 (slot as u32, clusters as u32),
@@ -270,9 +278,12 @@ impl FrameRecords {
         // Hidden lines are drawn by the outline pass, from every drawn edge in view.
         let hidden = style.hidden.filter(|_| lines);
         outlines |= hidden.is_some();
+        // The edge pass must know whose line, and of which class, each outline-pass pixel
+        // holds where colours differ between instances or between an outline and its edges.
         let mixed_colors = records
             .windows(2)
-            .any(|w| w[0].wire_color != w[1].wire_color);
+            .any(|w| w[0].wire_color != w[1].wire_color)
+            || records.iter().any(|r| r.outline_color != r.wire_color);
 
         let buffers = store.buffers();
         let (gx, gy) = (guard as f64, guard as f64);
@@ -432,7 +443,11 @@ fn instance_record(
     (eye, fade_row): (DVec4, DVec4),
     transform: DMat4,
     mesh: &MeshRecord,
-    ([wire_color, fill_color], line_width, flags): ([[f32; 4]; 2], f32, u32),
+    ([wire_color, fill_color, outline_color], [line_width, outline_width], flags): (
+        [[f32; 4]; 3],
+        [f32; 2],
+        u32,
+    ),
     (slot, cluster_first): (u32, u32),
 ) -> InstanceRecord {
     let model = transform * mesh.local_to_mesh();
@@ -471,6 +486,9 @@ fn instance_record(
         cluster_base: mesh.cluster_base,
         cluster_first,
         index: slot,
+        outline_color,
+        outline_width,
+        _pad: [0; 3],
     }
 }
 
@@ -487,7 +505,7 @@ mod tests {
 
     #[test]
     fn records_match_their_wgsl_layout() {
-        assert_eq!(std::mem::size_of::<InstanceRecord>(), 224);
+        assert_eq!(std::mem::size_of::<InstanceRecord>(), 256);
         assert_eq!(std::mem::size_of::<FrameUniforms>(), 176);
         let r = InstanceRecord::zeroed_for_test();
         let base = &r as *const _ as usize;
@@ -563,7 +581,7 @@ mod tests {
             (view.eye(), view.view_depth_row()),
             transform,
             &mesh,
-            ([[0.0; 4]; 2], 1.0, 0),
+            ([[0.0; 4]; 3], [1.0; 2], 0),
             (0, 0),
         );
         // A stored point q is the mesh point origin + scale q.

@@ -23,8 +23,9 @@
 //!   false). Edge selection (feature angles, adjacency, welding) is computed per mesh in its
 //!   own coordinates. Default: the command line's `--edges`, else the mesh file's own edges
 //!   where it has them (glTF), else `polygon`.
-//! - `outlines`, `wire_color` and `fill_color` (`#rrggbb[aa]`, sRGB; the fill's alpha is
-//!   unused), `line_width` (pixels): per-object overrides of the command line's style.
+//! - `outlines`, `wire_color`, `outline_color` and `fill_color` (`#rrggbb[aa]`, sRGB; the
+//!   fill's alpha is unused), `line_width` and `outline_width` (pixels): per-object overrides
+//!   of the command line's style.
 //! - `camera`: `{"eye", "target", "up", "fov", "near", "far"}` (a perspective look-at;
 //!   `far` may be `null` for an infinite far plane), or `{"view": [16], "projection": [16],
 //!   "depth": "standard"|"reversed"}` (column-major matrices as a renderer has them), or
@@ -144,12 +145,14 @@ pub fn load(
                 "wire_color",
                 "fill_color",
                 "line_width",
+                "outline_color",
+                "outline_width",
             ]
             .contains(&key.as_str())
             {
                 return Err(fail(format!(
                     "{}: unknown field (mesh, transform, edges, outlines, wire_color, \
-                     fill_color, line_width)",
+                     fill_color, line_width, outline_color, outline_width)",
                     field(key)
                 )));
             }
@@ -216,12 +219,18 @@ pub fn load(
         };
         style.wire_color = color("wire_color")?;
         style.fill_color = color("fill_color")?;
-        if let Some(v) = o.get("line_width") {
-            let w = v
-                .as_f64()
-                .ok_or_else(|| fail(format!("{}: not a number", field("line_width"))))?;
-            style.line_width = Some(w as f32);
-        }
+        style.outline_color = color("outline_color")?;
+        let width = |name: &str| -> Result<Option<f32>> {
+            o.get(name)
+                .map(|v| {
+                    v.as_f64()
+                        .map(|w| w as f32)
+                        .ok_or_else(|| fail(format!("{}: not a number", field(name))))
+                })
+                .transpose()
+        };
+        style.line_width = width("line_width")?;
+        style.outline_width = width("outline_width")?;
         style
             .validate(i)
             .map_err(|e| fail(format!("objects[{i}]: {e}")))?;
@@ -441,13 +450,19 @@ mod tests {
                 {"mesh": "sphere:200"},
                 {"mesh": "sphere:200", "transform": {"translate": [3, 0, 0]}, "edges": "none",
                  "wire_color": "#ff0000", "line_width": 3, "fill_color": "#00ff00"},
-                {"mesh": "sphere:200", "edges": "all", "outlines": false}
+                {"mesh": "sphere:200", "edges": "all", "outlines": false},
+                {"mesh": "sphere:200", "outline_color": "#0000ff", "outline_width": 4}
             ],
             "camera": {"eye": [0, 0, 5], "orthographic": {"height": 4, "near": 0.1, "far": 20}}}"##,
         );
         let (world, camera) = load(&path, Some(EdgeSelection::Polygon), &procedural).unwrap();
         assert_eq!(world.meshes.len(), 2, "same mesh and edges load once");
-        assert_eq!(world.objects.len(), 3);
+        assert_eq!(world.objects.len(), 4);
+        assert_eq!(world.objects[3].style.outline_width, Some(4.0));
+        assert_eq!(
+            world.objects[3].style.outline_color,
+            Some(Color([0.0, 0.0, 1.0, 1.0]))
+        );
         assert_eq!(world.objects[1].style.edges, Some(false));
         assert_eq!(world.objects[1].style.line_width, Some(3.0));
         assert_eq!(

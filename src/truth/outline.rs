@@ -87,14 +87,18 @@ struct Stretch {
     depth_w: [f64; 2],
     object: u32,
     width: f64,
+    /// An outline's line, not an edge's (hidden lines: false).
+    outline: bool,
 }
 
 /// What a listed edge draws: its visible parts (an outline, or a drawn edge of a large
-/// patch), its hidden parts (a drawn edge or an outline, with hidden lines on).
+/// patch), its hidden parts (a drawn edge or an outline, with hidden lines on); whether its
+/// visible line is an outline's (its class, colour and width), else an edge's.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 struct Draw {
     visible: bool,
     hidden: bool,
+    outline: bool,
 }
 
 /// The outline map of `caster`'s world for `shot`, seen along `rays`; `masks` are each
@@ -127,16 +131,21 @@ pub(crate) fn outline_map(
             let mesh = &world.meshes[object.mesh].mesh;
             let local = edge_math::local_eye(object.transform, eye);
             let first = caster.first_ids()[o];
-            let width = styles[o].width;
+            let widths = (styles[o].width, styles[o].outline_width);
             let tris = mesh.triangles();
             let neighbours = mesh.edge_neighbours();
             let mut edges: Vec<((u32, u32), Draw)> = Vec::new();
             let both = Draw {
                 visible: true,
                 hidden: hidden.is_some(),
+                outline: false,
             };
             if styles[o].outlines {
-                edges.extend(outline_edges(mesh, local).into_iter().map(|e| (e, both)));
+                let outline = Draw {
+                    outline: true,
+                    ..both
+                };
+                edges.extend(outline_edges(mesh, local).into_iter().map(|e| (e, outline)));
             }
             if styles[o].edges {
                 let splat = &patches[object.mesh].splat;
@@ -159,6 +168,7 @@ pub(crate) fn outline_map(
                                 let only = Draw {
                                     visible: false,
                                     hidden: true,
+                                    outline: false,
                                 };
                                 ((t, i), only)
                             })
@@ -173,6 +183,7 @@ pub(crate) fn outline_map(
                     Some((last, m)) if *last == e => {
                         m.visible |= d.visible;
                         m.hidden |= d.hidden;
+                        m.outline |= d.outline;
                     }
                     _ => merged.push((e, d)),
                 }
@@ -187,7 +198,7 @@ pub(crate) fn outline_map(
                         p[corners[i as usize] as usize],
                         p[corners[(i as usize + 1) % 3] as usize],
                     );
-                    view.stretches(first, (t, i, n, a_first), (o as u32, width), draw, hidden)
+                    view.stretches(first, (t, i, n, a_first), (o as u32, widths), draw, hidden)
                 })
                 .collect::<Vec<_>>()
         })
@@ -255,6 +266,7 @@ fn splat(
                             distance: d,
                             intensity,
                             object: s.object,
+                            outline: s.outline,
                         });
                     }
                 }
@@ -306,7 +318,7 @@ impl Visibility<'_> {
         &self,
         first: u32,
         (t, i, n, a_first): (u32, u32, u32, bool),
-        (object, width): (u32, f64),
+        (object, (edge_width, outline_width)): (u32, (f64, f64)),
         draw: Draw,
         hidden: Option<crate::HiddenLines>,
     ) -> (Vec<Stretch>, Vec<Stretch>) {
@@ -332,6 +344,11 @@ impl Visibility<'_> {
         let (p0, p1) = (at(s.0), at(s.1));
         // Within reach of the image: an edge just outside it still draws its line inside.
         let size = self.rays.size();
+        let width = if draw.outline {
+            outline_width
+        } else {
+            edge_width
+        };
         let hidden_width = hidden.filter(|_| draw.hidden).map(|h| f64::from(h.width));
         let reach = line_reach(width).max(hidden_width.map_or(0.0, line_reach));
         let d = p1.xy - p0.xy;
@@ -376,7 +393,7 @@ impl Visibility<'_> {
         }
         runs.push((start, u.1, last.1));
 
-        let stretch = |(k0, k1): (f64, f64), width: f64| {
+        let stretch = |(k0, k1): (f64, f64), width: f64, outline: bool| {
             let (q0, q1) = (point(k0), point(k1));
             Stretch {
                 from: q0.xy,
@@ -386,12 +403,13 @@ impl Visibility<'_> {
                 depth_w: [q0.depth_w, q1.depth_w],
                 object,
                 width,
+                outline,
             }
         };
         let visible = runs
             .iter()
             .filter(|r| draw.visible && r.2 == Class::Visible)
-            .map(|&(k0, k1, _)| stretch((k0, k1), width))
+            .map(|&(k0, k1, _)| stretch((k0, k1), width, draw.outline))
             .collect();
         let Some(h) = hidden.filter(|_| draw.hidden) else {
             return (visible, Vec::new());
@@ -404,7 +422,7 @@ impl Visibility<'_> {
             .iter()
             .filter(|r| r.2 == Class::Hidden)
             .flat_map(|&(k0, k1, _)| dashes((k0, k1), full, a_first, (dash, period)))
-            .map(|run| stretch(run, f64::from(h.width)))
+            .map(|run| stretch(run, f64::from(h.width), false))
             .collect();
         (visible, hidden)
     }
@@ -806,6 +824,7 @@ mod tests {
         let draw = Draw {
             visible: true,
             hidden: true,
+            outline: true,
         };
         let hidden = crate::HiddenLines {
             pattern: crate::LinePattern::Dashed {
@@ -815,7 +834,7 @@ mod tests {
             ..crate::HiddenLines::default()
         };
         let edge = (0, 1, NO_NEIGHBOUR, true);
-        let (s, h) = vis.stretches(0, edge, (0, 1.5), draw, Some(hidden));
+        let (s, h) = vis.stretches(0, edge, (0, (1.5, 1.5)), draw, Some(hidden));
         assert_eq!(s.len(), 1, "{s:?}");
         let top_of_near = {
             let c = cam.view_projection(64, 64) * DVec4::new(1.0, 0.0, 1.0, 1.0);

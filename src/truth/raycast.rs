@@ -224,6 +224,16 @@ struct Truth<'a> {
 }
 
 impl Truth<'_> {
+    /// The colour of a line of the outline map: its object's outline or line colour.
+    fn line_color(&self, l: &Line) -> [f64; 4] {
+        let st = &self.styles[l.object as usize];
+        if l.outline {
+            st.outline
+        } else {
+            st.wire
+        }
+    }
+
     /// The ground truth at one pixel centre; `outline` and `hidden` are the pixel's lines from
     /// the outline map, `host` the host's reverse depth there (−1 for none).
     fn sample(
@@ -250,7 +260,7 @@ impl Truth<'_> {
             let bg4 = sh.background.0.map(f64::from);
             let bg = under([bg4[0], bg4[1], bg4[2]]);
             let (i, wire) = outline.map_or((0.0, [0.0; 4]), |l| {
-                let w = self.styles[l.object as usize].wire;
+                let w = self.line_color(&l);
                 (l.intensity * w[3], w)
             });
             let mix = |k: usize| (bg[k] + (wire[k] - bg[k]) * i) as f32;
@@ -333,9 +343,7 @@ impl Truth<'_> {
             }
         };
         let (line, distance, wire) = match outline {
-            Some(l) if l.key > own_key => {
-                (l.intensity, l.distance, self.styles[l.object as usize].wire)
-            }
+            Some(l) if l.key > own_key => (l.intensity, l.distance, self.line_color(&l)),
             _ => (own_line, own, st.wire),
         };
         let i = line * wire[3];

@@ -287,6 +287,9 @@ impl Rays {
 /// Each object's look, as the GPU's instance records carry it.
 pub(crate) struct ObjectStyle {
     pub wire: [f64; 4],
+    /// The outline's colour and width.
+    pub outline: [f64; 4],
+    pub outline_width: f64,
     /// The surface's colour (linear RGB).
     pub fill: [f64; 3],
     pub width: f64,
@@ -312,6 +315,8 @@ impl ObjectStyle {
                     let c = o.style.fill_color.unwrap_or(style.fill_color).0;
                     [0, 1, 2].map(|i| f64::from(c[i]))
                 },
+                outline: o.style.outline_color_in(style).0.map(f64::from),
+                outline_width: f64::from(o.style.outline_width_in(style)),
                 width: f64::from(o.style.line_width.unwrap_or(style.line_width)),
                 edges: o.style.edges.unwrap_or(true),
                 outlines: o.style.outlines.unwrap_or(style.silhouettes),
@@ -584,4 +589,6 @@ pub struct Line {
     pub intensity: f64,
     /// The object it belongs to.
     pub object: u32,
+    /// Whether it is an outline (drawn in the object's outline colour), not an edge.
+    pub outline: bool,
 }
