@@ -1,5 +1,7 @@
 //! Image regression: every case renders a shared mesh with one method, edge mode and camera
-//! at 256×256 and compares it with FLIP against a blessed PNG under `tests/reference/`.
+//! at 256×256 (and some, by the deferred method, in a technical style: dashed hidden lines,
+//! outlines of their own colour and width, a see-through surface) and compares it with FLIP
+//! against a blessed PNG under `tests/reference/`.
 //! One test runs every case and reports all failing cases at once; each failure writes
 //! `<case>.actual.png` and `<case>.diff.png` under `target/regression/`.
 //!
@@ -29,6 +31,28 @@ const MESHES: &[(&str, &[&str])] = &[
 
 /// The GPU methods (the CPU ray cast is the accuracy tests' judge, not a regression case).
 const METHODS: &[Method] = &[Method::Deferred, Method::Forward, Method::TwoPass];
+
+/// The meshes and edge modes also drawn in the technical style (`technical`), by the deferred
+/// method only (the others draw neither hidden lines nor outlines of their own).
+const TECHNICAL: &[(&str, &str)] = &[("fandisk", "feature:30"), ("suzanne", "polygon")];
+
+/// A CAD view: dashed hidden lines, outlines of their own colour and width, and a
+/// see-through surface.
+fn technical() -> Style {
+    Style {
+        hidden: Some(wirepass::HiddenLines {
+            pattern: wirepass::LinePattern::Dashed {
+                dash: 5.0,
+                gap: 3.0,
+            },
+            ..wirepass::HiddenLines::default()
+        }),
+        outline_color: Some(wirepass::Color([0.02, 0.05, 0.3, 1.0])),
+        outline_width: Some(2.5),
+        fill_opacity: 0.6,
+        ..Style::default()
+    }
+}
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum View {
@@ -85,6 +109,8 @@ const MEASURED: &[(&str, [f32; 2], [f32; 2])] = &[
     ("fandisk_deferred_feature30_inside", [0.0, 0.0], [0.00001, 0.00000]),
     ("fandisk_deferred_polygon_framing", [0.0, 0.0], [0.00002, 0.00039]),
     ("fandisk_deferred_polygon_inside", [0.0, 0.0], [0.00003, 0.00046]),
+    ("fandisk_deferred_feature30_framing_technical", [0.0, 0.0], [0.00001, 0.00002]),
+    ("fandisk_deferred_feature30_inside_technical", [0.0, 0.0], [0.00001, 0.00002]),
     ("fandisk_forward_feature30_framing", [0.01209, 0.05217], [0.01209, 0.05217]),
     ("fandisk_forward_feature30_inside", [0.00273, 0.01388], [0.03050, 0.63335]),
     ("fandisk_forward_polygon_framing", [0.00071, 0.00804], [0.00071, 0.00807]),
@@ -111,6 +137,8 @@ const MEASURED: &[(&str, [f32; 2], [f32; 2])] = &[
     ("suzanne_deferred_feature30_inside", [0.0, 0.0], [0.00002, 0.00028]),
     ("suzanne_deferred_polygon_framing", [0.0, 0.0], [0.00001, 0.00007]),
     ("suzanne_deferred_polygon_inside", [0.0, 0.0], [0.00003, 0.00051]),
+    ("suzanne_deferred_polygon_framing_technical", [0.0, 0.0], [0.00001, 0.0001]),
+    ("suzanne_deferred_polygon_inside_technical", [0.0, 0.0], [0.00002, 0.00034]),
     ("suzanne_forward_all_framing", [0.00057, 0.00802], [0.00057, 0.00798]),
     ("suzanne_forward_all_inside", [0.00323, 0.01275], [0.00323, 0.01276]),
     ("suzanne_forward_feature30_framing", [0.00061, 0.00830], [0.00061, 0.00826]),
@@ -185,54 +213,61 @@ fn every_case_matches_its_reference() {
     let measured = measured_for(ctx);
     let mut failures = Vec::new();
     let mut cases = 0;
+    // (mesh, edge mode, style name, style, methods)
+    let mut runs: Vec<(&str, &str, &str, Style, &[Method])> = Vec::new();
     for &(mesh_name, modes) in MESHES {
-        let mesh = load(&format!("{mesh_name}.obj"));
         for &mode in modes {
-            let edges: EdgeSelection = mode.parse().unwrap_or_else(|e| panic!("{e}"));
-            let world = World::single(mesh.clone(), edges);
-            let style = Style::default();
-            for view in [View::Framing, View::Inside] {
-                let shot = Shot {
-                    world: &world,
-                    view: view.camera(&mesh).to_view(1.0),
-                    style: &style,
-                    size: SIZE,
-                };
-                for &method in METHODS {
-                    cases += 1;
-                    let case = format!(
-                        "{mesh_name}_{}_{}_{}",
-                        method.name(),
-                        mode.replace(':', ""),
-                        view.name()
-                    );
-                    let frame = match draw(ctx, &shot, method) {
-                        Ok(frame) => frame,
-                        Err(e) => {
-                            failures.push(format!("{case}: render failed: {e}"));
-                            continue;
-                        }
-                    };
-                    let reference = reference_dir().join(format!("{case}.png"));
-                    let Some(t) = threshold(&case, measured) else {
-                        failures.push(format!(
-                            "{case}: no threshold in MEASURED; measure it on both adapters"
-                        ));
+            runs.push((mesh_name, mode, "", Style::default(), METHODS));
+        }
+    }
+    for &(mesh_name, mode) in TECHNICAL {
+        runs.push((
+            mesh_name,
+            mode,
+            "_technical",
+            technical(),
+            &[Method::Deferred],
+        ));
+    }
+    for (mesh_name, mode, style_name, style, methods) in runs {
+        let mesh = load(&format!("{mesh_name}.obj"));
+        let edges: EdgeSelection = mode.parse().unwrap_or_else(|e| panic!("{e}"));
+        let world = World::single(mesh.clone(), edges);
+        for view in [View::Framing, View::Inside] {
+            let shot = Shot {
+                world: &world,
+                view: view.camera(&mesh).to_view(1.0),
+                style: &style,
+                size: SIZE,
+            };
+            for &method in methods {
+                cases += 1;
+                let case = format!(
+                    "{mesh_name}_{}_{}_{}{style_name}",
+                    method.name(),
+                    mode.replace(':', ""),
+                    view.name()
+                );
+                let frame = match draw(ctx, &shot, method) {
+                    Ok(frame) => frame,
+                    Err(e) => {
+                        failures.push(format!("{case}: render failed: {e}"));
                         continue;
-                    };
-                    match check_against_reference(
-                        &frame.rgba,
-                        frame.size,
-                        &reference,
-                        &t,
-                        &out_dir(),
-                    ) {
-                        Ok(Outcome::Pass(d)) => {
-                            eprintln!("measured {case} {} {} {}", d.mean, d.p99, d.max)
-                        }
-                        Ok(Outcome::Blessed(path)) => eprintln!("blessed {}", path.display()),
-                        Err(e) => failures.push(format!("{case}: {e}")),
                     }
+                };
+                let reference = reference_dir().join(format!("{case}.png"));
+                let Some(t) = threshold(&case, measured) else {
+                    failures.push(format!(
+                        "{case}: no threshold in MEASURED; measure it on both adapters"
+                    ));
+                    continue;
+                };
+                match check_against_reference(&frame.rgba, frame.size, &reference, &t, &out_dir()) {
+                    Ok(Outcome::Pass(d)) => {
+                        eprintln!("measured {case} {} {} {}", d.mean, d.p99, d.max)
+                    }
+                    Ok(Outcome::Blessed(path)) => eprintln!("blessed {}", path.display()),
+                    Err(e) => failures.push(format!("{case}: {e}")),
                 }
             }
         }
