@@ -66,11 +66,11 @@ struct SceneArgs {
     /// Surface colour, #rrggbb (sRGB).
     #[arg(long, default_value = "#c2cfdf")]
     fill_color: String,
-    /// Outline colour, #rrggbb[aa] (sRGB) [default: the line colour].
+    /// Outline colour, #rrggbb[aa] (sRGB) [default: the line colour, or the scene file's].
     #[arg(long)]
     outline_color: Option<String>,
-    /// Outline width in pixels [default: the line width].
-    #[arg(long)]
+    /// Outline width in pixels [default: the line width, or the scene file's].
+    #[arg(long, allow_hyphen_values = true)]
     outline_width: Option<f32>,
     /// Background colour, #rrggbb (sRGB).
     #[arg(long, default_value = "#ffffff")]
@@ -90,19 +90,19 @@ struct SceneArgs {
     depth_fade: Option<DepthFade>,
     /// Hidden lines (the parts of the drawn lines that surfaces hide): off, solid,
     /// dashed[:DASH,GAP] or dotted[:SPACING], lengths in pixels. Only deferred and raycast
-    /// draw them.
-    #[arg(long, default_value = "off", value_name = "STYLE")]
-    hidden: String,
-    /// Hidden-line colour, #rrggbb[aa] (sRGB).
-    #[arg(long, default_value = "#6e7580cc")]
-    hidden_color: String,
-    /// Hidden-line width in pixels.
-    #[arg(long, default_value_t = 1.0)]
-    hidden_width: f32,
+    /// draw them [default: off, or the scene file's].
+    #[arg(long, value_name = "STYLE")]
+    hidden: Option<String>,
+    /// Hidden-line colour, #rrggbb[aa] (sRGB) [default: #7c8189cc, or the scene file's].
+    #[arg(long)]
+    hidden_color: Option<String>,
+    /// Hidden-line width in pixels [default: 1, or the scene file's].
+    #[arg(long, allow_hyphen_values = true)]
+    hidden_width: Option<f32>,
     /// Opacity of the shaded surface over the background, 0..1: below 1 a see-through
-    /// surface, with --hidden lines showing through it.
-    #[arg(long, default_value_t = 1.0)]
-    fill_opacity: f32,
+    /// surface, with --hidden lines showing through it [default: 1, or the scene file's].
+    #[arg(long, allow_hyphen_values = true)]
+    fill_opacity: Option<f32>,
     #[command(flatten)]
     camera: CameraArgs,
 }
@@ -136,30 +136,19 @@ impl SceneArgs {
     /// Checks the settings, then loads the scene and places the camera.
     fn load(&self) -> Result<(World, View, Style, (u32, u32))> {
         let size = parse_size(&self.size)?;
+        // The command line's settings, checked before loading; a scene file's `style` fills
+        // in those the command line leaves unset.
+        let color = |c: &Option<String>| c.as_deref().map(Color::from_hex).transpose();
+        let (outline_color, hidden_color) =
+            (color(&self.outline_color)?, color(&self.hidden_color)?);
+        let hidden = self.hidden.as_deref().map(LinePattern::parse).transpose()?;
         let style = Style {
             line_width: self.line_width.unwrap_or(DEFAULT_LINE_WIDTH),
             wire_color: Color::from_hex(&self.wire_color)?,
             fill_color: Color::from_hex(&self.fill_color)?,
-            outline_color: self
-                .outline_color
-                .as_deref()
-                .map(Color::from_hex)
-                .transpose()?,
-            outline_width: self.outline_width,
-            fill_opacity: self.fill_opacity,
             background: Color::from_hex(&self.background)?,
             silhouettes: self.silhouettes,
             depth_fade: self.depth_fade,
-            hidden: LinePattern::parse(&self.hidden)?
-                .map(|pattern| -> Result<HiddenLines> {
-                    Ok(HiddenLines {
-                        pattern,
-                        color: Color::from_hex(&self.hidden_color)?,
-                        width: self.hidden_width,
-                        behind_host: false,
-                    })
-                })
-                .transpose()?,
             ..Style::default()
         };
         style.validate()?;
@@ -170,6 +159,22 @@ impl SceneArgs {
         };
         let loaded = load_world(self.mesh.as_deref(), &options)?;
         print_notes(&loaded.notes);
+        let file = loaded.style;
+        let style = Style {
+            outline_color: outline_color.or(file.outline_color),
+            outline_width: self.outline_width.or(file.outline_width),
+            fill_opacity: self.fill_opacity.or(file.fill_opacity).unwrap_or(1.0),
+            hidden: hidden.or(file.hidden).flatten().map(|pattern| HiddenLines {
+                pattern,
+                color: hidden_color
+                    .or(file.hidden_color)
+                    .unwrap_or(HiddenLines::default().color),
+                width: self.hidden_width.or(file.hidden_width).unwrap_or(1.0),
+                behind_host: false,
+            }),
+            ..style
+        };
+        style.validate()?;
         let placement = self.camera.placement();
         let file_camera = loaded.camera.filter(|_| placement.is_empty());
         if let Some(wirepass::tools::scene_file::FileCamera::Gltf(c)) = &file_camera {

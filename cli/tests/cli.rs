@@ -100,6 +100,32 @@ fn bad_settings_give_one_clear_line() {
         (&["render", "--depth-fade", "5", "-o", o], "START:END"),
         (&["render", "--depth-fade", "5:1", "-o", o], "depth fade"),
         (&["render", "--line-width", "1000", "-o", o], "line width"),
+        (
+            &["render", "--hidden", "wavy", "-o", o],
+            "hidden-line style",
+        ),
+        (
+            &["render", "--hidden", "dashed:0,2", "-o", o],
+            "hidden line pattern",
+        ),
+        (
+            &[
+                "render",
+                "--hidden",
+                "solid",
+                "--hidden-width",
+                "0",
+                "-o",
+                o,
+            ],
+            "hidden line width",
+        ),
+        (&["render", "--fill-opacity", "2", "-o", o], "fill opacity"),
+        (
+            &["render", "--outline-width", "-2", "-o", o],
+            "outline width",
+        ),
+        (&["render", "--outline-color", "blue", "-o", o], "colour"),
     ];
     for (args, expect) in cases {
         let (ok, err) = wirepass(args);
@@ -296,6 +322,41 @@ fn renders_a_scene_file_with_global_ids_in_the_dump() {
     let camera: serde_json::Value =
         serde_json::from_slice(&std::fs::read(dump.join("camera.json")).unwrap()).unwrap();
     assert_eq!(camera["orthographic"], true);
+    // The file's style: hidden lines, which the command line can turn off again.
+    let styled = temp("styled.json");
+    std::fs::write(
+        &styled,
+        r#"{"objects": [{"mesh": "torus:800", "edges": "all"},
+                        {"mesh": "sphere:200", "transform": {"translate": [0, 0, -1.5]}}],
+            "camera": {"eye": [0, 0, 6], "target": [0, 0, 0], "up": [0, 1, 0], "fov": 40,
+                       "near": 0.1, "far": 20},
+            "style": {"hidden": "solid", "hidden_width": 2}}"#,
+    )
+    .unwrap();
+    let hidden_pixels = |extra: &[&str]| {
+        let dir = temp(&format!("styled-dump{}", extra.len()));
+        let mut args = vec![
+            "render",
+            styled.to_str().unwrap(),
+            "--size",
+            "96x64",
+            "-o",
+            png.to_str().unwrap(),
+            "--dump",
+            dir.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let (ok, err) = wirepass(&args);
+        assert!(ok, "{err}");
+        let bytes = std::fs::read(dir.join("hidden_distance.npy")).unwrap();
+        let header = u16::from_le_bytes([bytes[8], bytes[9]]) as usize + 10;
+        bytes[header..]
+            .chunks_exact(4)
+            .filter(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]).is_finite())
+            .count()
+    };
+    assert!(hidden_pixels(&[]) > 50, "the file's hidden lines");
+    assert_eq!(hidden_pixels(&["--hidden", "off"]), 0);
     // A bad field in the file is one line naming the file and the field.
     let bad = temp("bad.json");
     std::fs::write(

@@ -8,7 +8,7 @@
 use crate::camera::{Camera, View};
 use crate::error::{Error, Result};
 use crate::mesh::{self, EdgeSelection, Mesh, Procedural};
-use crate::tools::scene_file::FileCamera;
+use crate::tools::scene_file::{FileCamera, FileStyle};
 use crate::world::World;
 use glam::{DVec3, Vec3};
 use std::path::Path;
@@ -55,6 +55,8 @@ pub struct Loaded {
     pub camera: Option<FileCamera>,
     /// Notes from the loader (glTF: skipped primitives, unused cameras, …).
     pub notes: Vec<String>,
+    /// A scene file's frame style (empty for other files).
+    pub style: FileStyle,
 }
 
 /// Loads what `spec` names as a world: a scene file (`.json`, with its camera if it has
@@ -64,6 +66,7 @@ pub struct Loaded {
 pub fn load_world(spec: Option<&str>, options: &WorldOptions) -> Result<Loaded> {
     let edges = options.edges;
     let lower = spec.map(str::to_ascii_lowercase).unwrap_or_default();
+    let mut style = FileStyle::default();
     let (world, cameras, notes) = match spec {
         None => (
             crate::world::default_world(edges.unwrap_or_default()),
@@ -71,8 +74,9 @@ pub fn load_world(spec: Option<&str>, options: &WorldOptions) -> Result<Loaded> 
             Vec::new(),
         ),
         Some(s) if lower.ends_with(".json") => {
-            let (world, camera) = crate::tools::scene_file::load(Path::new(s), edges, &mesh_spec)?;
-            (world, camera.into_iter().collect(), Vec::new())
+            let file = crate::tools::scene_file::load(Path::new(s), edges, &mesh_spec)?;
+            style = file.style;
+            (file.world, file.camera.into_iter().collect(), Vec::new())
         }
         Some(s) if lower.ends_with(".gltf") || lower.ends_with(".glb") => {
             let doc = mesh::formats::gltf::load_gltf(Path::new(s))?;
@@ -106,6 +110,7 @@ pub fn load_world(spec: Option<&str>, options: &WorldOptions) -> Result<Loaded> 
         world,
         camera,
         notes,
+        style,
     })
 }
 

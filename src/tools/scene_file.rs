@@ -9,7 +9,8 @@
 //!       "edges": "feature:30", "outlines": false, "wire_color": "#c03020", "line_width": 3,
 //!       "fill_color": "#d0c0a0" }
 //!   ],
-//!   "camera": { "eye": [4, 3, 6], "target": [0, 0, 0], "up": [0, 1, 0], "fov": 40, "near": 0.1, "far": 100 }
+//!   "camera": { "eye": [4, 3, 6], "target": [0, 0, 0], "up": [0, 1, 0], "fov": 40, "near": 0.1, "far": 100 },
+//!   "style": { "hidden": "dashed:6,4", "fill_opacity": 0.5 }
 //! }
 //! ```
 //!
@@ -26,6 +27,9 @@
 //! - `outlines`, `wire_color`, `outline_color` and `fill_color` (`#rrggbb[aa]`, sRGB; the
 //!   fill's alpha is unused), `line_width` and `outline_width` (pixels): per-object overrides
 //!   of the command line's style.
+//! - `style` (optional): the frame's `hidden` (`off`, `solid`, `dashed[:DASH,GAP]`,
+//!   `dotted[:SPACING]`), `hidden_color`, `hidden_width`, `fill_opacity`, `outline_color` and
+//!   `outline_width`, where the command line does not set them.
 //! - `camera`: `{"eye", "target", "up", "fov", "near", "far"}` (a perspective look-at;
 //!   `far` may be `null` for an infinite far plane), or `{"view": [16], "projection": [16],
 //!   "depth": "standard"|"reversed"}` (column-major matrices as a renderer has them), or
@@ -40,7 +44,7 @@ use crate::camera::{Camera, DepthRange, View};
 use crate::error::{Error, Result};
 use crate::mesh::EdgeSelection;
 use crate::scene::InstanceStyle;
-use crate::style::Color;
+use crate::style::{Color, LinePattern};
 use crate::world::{Object, World, WorldMesh};
 use glam::{DMat4, DQuat, DVec3, EulerRot};
 use serde_json::Value;
@@ -102,7 +106,7 @@ pub fn load(
     path: &Path,
     edges: Option<EdgeSelection>,
     load_mesh: &dyn Fn(&str) -> Result<crate::Mesh>,
-) -> Result<(World, Option<FileCamera>)> {
+) -> Result<SceneFile> {
     let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
         path: path.to_owned(),
         source,
@@ -116,10 +120,16 @@ pub fn load(
         .as_object()
         .ok_or_else(|| fail("the scene is not a JSON object".into()))?;
     for key in top.keys() {
-        if key != "objects" && key != "camera" {
-            return Err(fail(format!("unknown field {key:?} (objects, camera)")));
+        if !["objects", "camera", "style"].contains(&key.as_str()) {
+            return Err(fail(format!(
+                "unknown field {key:?} (objects, camera, style)"
+            )));
         }
     }
+    let style = match top.get("style") {
+        None => FileStyle::default(),
+        Some(v) => file_style(v).map_err(|m| fail(format!("style{m}")))?,
+    };
     let objects = top
         .get("objects")
         .ok_or_else(|| fail("no \"objects\" list".into()))?
@@ -245,7 +255,84 @@ pub fn load(
         None => None,
         Some(c) => Some(camera(c).map_err(|m| fail(format!("camera{m}")))?),
     };
-    Ok((world, camera))
+    Ok(SceneFile {
+        world,
+        camera,
+        style,
+    })
+}
+
+/// What a scene file holds: its objects, its camera, and its frame style.
+#[derive(Clone, Debug)]
+pub struct SceneFile {
+    /// The meshes and objects.
+    pub world: World,
+    /// The camera, if the file has one.
+    pub camera: Option<FileCamera>,
+    /// The frame's style settings the file gives.
+    pub style: FileStyle,
+}
+
+/// The frame's style as a scene file's `style` gives it; `None` where it says nothing (the
+/// command line's settings then hold).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FileStyle {
+    /// `hidden`: `off` (`Some(None)`), `solid`, `dashed[:DASH,GAP]` or `dotted[:SPACING]`.
+    pub hidden: Option<Option<LinePattern>>,
+    /// `hidden_color`.
+    pub hidden_color: Option<Color>,
+    /// `hidden_width`, pixels.
+    pub hidden_width: Option<f32>,
+    /// `fill_opacity`, 0..1.
+    pub fill_opacity: Option<f32>,
+    /// `outline_color`.
+    pub outline_color: Option<Color>,
+    /// `outline_width`, pixels.
+    pub outline_width: Option<f32>,
+}
+
+fn file_style(v: &Value) -> std::result::Result<FileStyle, String> {
+    let o = v.as_object().ok_or(": not an object")?;
+    const KEYS: [&str; 6] = [
+        "hidden",
+        "hidden_color",
+        "hidden_width",
+        "fill_opacity",
+        "outline_color",
+        "outline_width",
+    ];
+    if let Some(k) = o.keys().find(|k| !KEYS.contains(&k.as_str())) {
+        return Err(format!(".{k}: unknown field ({})", KEYS.join(", ")));
+    }
+    let text = |k: &str| -> std::result::Result<Option<&str>, String> {
+        o.get(k)
+            .map(|v| v.as_str().ok_or(format!(".{k}: not a string")))
+            .transpose()
+    };
+    let number = |k: &str| -> std::result::Result<Option<f32>, String> {
+        o.get(k)
+            .map(|v| {
+                v.as_f64()
+                    .map(|x| x as f32)
+                    .ok_or(format!(".{k}: not a number"))
+            })
+            .transpose()
+    };
+    let color = |k: &str| -> std::result::Result<Option<Color>, String> {
+        text(k)?
+            .map(|t| Color::from_hex(t).map_err(|e| format!(".{k}: {e}")))
+            .transpose()
+    };
+    Ok(FileStyle {
+        hidden: text("hidden")?
+            .map(|t| LinePattern::parse(t).map_err(|e| format!(".hidden: {e}")))
+            .transpose()?,
+        hidden_color: color("hidden_color")?,
+        hidden_width: number("hidden_width")?,
+        fill_opacity: number("fill_opacity")?,
+        outline_color: color("outline_color")?,
+        outline_width: number("outline_width")?,
+    })
 }
 
 /// A mesh spec relative to the scene file's folder: procedural names stay as they are.
@@ -453,9 +540,23 @@ mod tests {
                 {"mesh": "sphere:200", "edges": "all", "outlines": false},
                 {"mesh": "sphere:200", "outline_color": "#0000ff", "outline_width": 4}
             ],
-            "camera": {"eye": [0, 0, 5], "orthographic": {"height": 4, "near": 0.1, "far": 20}}}"##,
+            "camera": {"eye": [0, 0, 5], "orthographic": {"height": 4, "near": 0.1, "far": 20}},
+            "style": {"hidden": "dotted:3", "fill_opacity": 0.25, "outline_width": 2}}"##,
         );
-        let (world, camera) = load(&path, Some(EdgeSelection::Polygon), &procedural).unwrap();
+        let SceneFile {
+            world,
+            camera,
+            style,
+        } = load(&path, Some(EdgeSelection::Polygon), &procedural).unwrap();
+        assert_eq!(
+            style,
+            FileStyle {
+                hidden: Some(Some(LinePattern::Dotted { spacing: 3.0 })),
+                fill_opacity: Some(0.25),
+                outline_width: Some(2.0),
+                ..FileStyle::default()
+            }
+        );
         assert_eq!(world.meshes.len(), 2, "same mesh and edges load once");
         assert_eq!(world.objects.len(), 4);
         assert_eq!(world.objects[3].style.outline_width, Some(4.0));
@@ -520,6 +621,18 @@ mod tests {
             (
                 r#"{"objects": [{"mesh": "sphere:100"}], "camera": {"eye": [0, 0, 5], "orthographic": {"height": -1, "near": 0, "far": 1}}}"#,
                 "camera.orthographic.height",
+            ),
+            (
+                r#"{"objects": [{"mesh": "sphere:100"}], "style": {"hidden": "wavy"}}"#,
+                "style.hidden",
+            ),
+            (
+                r#"{"objects": [{"mesh": "sphere:100"}], "style": {"fill_opacity": "half"}}"#,
+                "style.fill_opacity",
+            ),
+            (
+                r#"{"objects": [{"mesh": "sphere:100"}], "style": {"hiden": "solid"}}"#,
+                "style.hiden",
             ),
         ];
         for (k, (text, want)) in cases.iter().enumerate() {
