@@ -456,8 +456,8 @@ fn surface_pixel(xy: vec2<u32>, s: Sample, own: f32) -> Pixel {
     return p;
 }
 
-// Writes pixel `p` of target pixel `xy` into the output.
-// The visible line goes over the hidden line, which goes over what is below.
+// Writes pixel `p` of target pixel `xy` into the output: the visible line over the hidden
+// line, over the surface at its opacity, over what is below.
 fn store_pixel(xy: vec2<u32>, p: Pixel) {
     let out = xy - vec2<u32>(frame.output_offset);
     let i = p.line * p.wire.a;
