@@ -48,6 +48,9 @@ struct Frame {
     // (period 0 for solid, `dash_nearest`) in pixels.
     hidden_color: vec4<f32>,
     hidden_line: vec4<f32>,
+    // Chains of drawn edges (HIDDEN with a pattern, `chain_phases`): words of the phase
+    // tables in the outline buffer, chains over all instances, entries of `chain_work`.
+    chain_work: vec4<u32>,
 }
 
 // Per instance (src/gpu/frame.rs, InstanceRecord). "Local" coordinates are the mesh
@@ -84,9 +87,11 @@ struct Instance {
     // The outline's linear RGBA and width in pixels.
     outline_color: vec4<f32>,
     outline_width: f32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
+    // Its phase table (`chain_phases`): word offset among the frame's phase tables, and
+    // log2 of its slots.
+    phase_table: u32,
+    table_log2: u32,
+    _pad: u32,
 }
 
 const INSTANCE_EDGES: u32 = 1u;

@@ -64,6 +64,11 @@ struct OutlineListRead {
 // would draw every piece of its triangle's outline edges while the other lanes of its
 // cluster, most of them without any, wait for it.
 fn piece_list() -> u32 {
+    return phase_tables() + frame.chain_work.x;
+}
+
+// Word offset of the phase tables (`chain_phases`), after the tile list.
+fn phase_tables() -> u32 {
     return outline_tile_list() + 4u + outline_tile_count();
 }
 
@@ -177,8 +182,10 @@ fn outline_pieces_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_i
         let v = corners(base + t) + instances[slot(inst)].vertex_base;
         let a = vertex_at(v[i]).xyz;
         let b = vertex_at(v[(i + 1u) % 3u]).xyz;
-        let c = clip_outline(inst, t, neighbour(base + t, i), a, b, comes_first(a, b));
-        draw_piece(c.seg, f32(piece) / f32(c.pieces), f32(piece + 1u) / f32(c.pieces), c.length_px, word >> 2u);
+        let mode = word >> 2u;
+        let anchor = pattern_anchor(inst, t, i, a, b, mode);
+        let c = clip_outline(inst, t, neighbour(base + t, i), a, b, anchor);
+        draw_piece(c.seg, f32(piece) / f32(c.pieces), f32(piece + 1u) / f32(c.pieces), c.length_px, mode);
     }
 }
 
@@ -248,17 +255,119 @@ fn outline_triangle(inst: u32, t: u32) {
         mode |= select(0u, DRAW_HIDDEN, hidden);
 #endif
         if mode != 0u {
-            list_outline(inst, t, i, n, a, b, comes_first(a, b), mode);
+            list_outline(inst, t, i, n, a, b, pattern_anchor(inst, t, i, a, b, mode), mode);
         }
     }
 }
 
 // Whether a comes before b in (x, y, z) order: the end of an edge that anchors its line
 // pattern, the same whichever triangle draws the edge and whatever the vertices' numbers
-// (twin of `comes_first` in src/truth/outline.rs).
+// (twin of `comes_first` in src/mesh/chains.rs).
 fn comes_first(a: vec3<f32>, b: vec3<f32>) -> bool {
     return a.x < b.x || (a.x == b.x && (a.y < b.y || (a.y == b.y && a.z < b.z)));
 }
+
+// Where the hidden-line pattern of edge i (a -> b) of triangle t of `inst` stands: its
+// position at the edge's start along the pattern (at a, or at b), and +1 as it runs from a
+// towards b, -1 from b towards a. An edge in a chain of drawn edges (src/mesh/chains.rs)
+// takes the position `chain_phases` found for it this frame; any other edge starts the
+// pattern at its end that comes first.
+fn pattern_anchor(inst: u32, t: u32, i: u32, a: vec3<f32>, b: vec3<f32>, mode: u32) -> vec2<f32> {
+#if HIDDEN
+    let chained = (info[instances[slot(inst)].triangle_base + t] >> (INFO_CHAINED_SHIFT + i)) & 1u;
+    let edges = instances[slot(inst)].flags & INSTANCE_EDGES;
+    if (mode & DRAW_HIDDEN) != 0u && frame.chain_work.x != 0u && chained != 0u && edges != 0u {
+        return chain_anchor(inst, phase_key(t, i));
+    }
+#endif
+    return vec2<f32>(0.0, select(-1.0, 1.0, comes_first(a, b)));
+}
+
+#if HIDDEN
+// First of the triangle info bits marking the drawn edges in chains (mesh_records.rs).
+const INFO_CHAINED_SHIFT: u32 = 26u;
+
+// The mesh store's chain records (src/gpu/mesh_records.rs, ChainRecords): per chain (first
+// edge record, edge count), then per edge (start vertex, end vertex, key | forward << 31,
+// phase table slot), the vertices as the listing triangle runs the edge.
+@group(0) @binding(26) var<storage, read> chains: array<vec4<u32>>;
+
+// The instances whose chains are visited (src/gpu/frame.rs, ChainWork).
+struct ChainWork {
+    slot: u32,
+    chain_base: u32,
+    chains: u32,
+    before: u32,
+}
+@group(0) @binding(27) var<storage, read> chain_work: array<ChainWork>;
+
+// Twins of `phase_key` and `phase_slot` in mesh_records.rs.
+fn phase_key(t: u32, i: u32) -> u32 {
+    return (t << 2u) | i;
+}
+
+fn phase_slot(key: u32, log2: u32) -> u32 {
+    return (key * 0x9e3779b1u) >> (32u - log2);
+}
+
+// One invocation per chain of every instance in `chain_work`: walks the chain from its
+// start, writing into the instance's phase table, for each edge, its key and the pattern's
+// position where the chain enters it: the summed length of the projections of the edges
+// before it (each in front of the near plane and not beyond the far one, as `edge_span`
+// clips them), reduced modulo the pattern's period (the pattern repeats, and small
+// positions keep f32's precision).
+@compute @workgroup_size(64)
+fn chain_phases(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let g = gid.x + gid.y * groups.x * 64u;
+    if g >= frame.chain_work.y {
+        return;
+    }
+    var lo = 0u;
+    var hi = frame.chain_work.z;
+    while hi - lo > 1u {
+        let mid = (lo + hi) / 2u;
+        if chain_work[mid].before <= g {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let work = chain_work[lo];
+    let inst = work.slot;
+    let head = chains[work.chain_base + g - work.before];
+    let table = phase_tables() + instances[slot(inst)].phase_table;
+    let vbase = instances[slot(inst)].vertex_base;
+    let period = frame.hidden_line.z;
+    var position = 0.0;
+    for (var k = 0u; k < head.y; k++) {
+        let e = chains[work.chain_base + head.x + k];
+        atomicStore(&acc_rw[table + 2u * e.w], e.z);
+        atomicStore(&acc_rw[table + 2u * e.w + 1u], bitcast<u32>(position));
+        let span = edge_span(inst, vertex_at(vbase + e.x).xyz, vertex_at(vbase + e.y).xyz);
+        position += select(0.0, length(span.p1.xy - span.p0.xy), span.s.x <= span.s.y);
+        position -= period * floor(position / period);
+    }
+}
+
+// The pattern's position and direction (`pattern_anchor`) of the chained edge `key` of
+// `inst`, from its phase table: probed from `phase_slot` on, every slot up to the key's was
+// written this frame (the table's layout is fixed at upload).
+fn chain_anchor(inst: u32, key: u32) -> vec2<f32> {
+    let log2 = instances[slot(inst)].table_log2;
+    let table = phase_tables() + instances[slot(inst)].phase_table;
+    let mask = (1u << log2) - 1u;
+    var at = phase_slot(key, log2);
+    for (var probe = 0u; probe <= mask; probe++) {
+        let word = atomicLoad(&acc_rw[table + 2u * at]);
+        if (word & 0x7fffffffu) == key {
+            let position = bitcast<f32>(atomicLoad(&acc_rw[table + 2u * at + 1u]));
+            return vec2<f32>(position, select(-1.0, 1.0, (word >> 31u) != 0u));
+        }
+        at = (at + 1u) & mask;
+    }
+    return vec2<f32>(0.0, 1.0);
+}
+#endif
 
 // What a listed edge draws: its visible runs (into the lines), its hidden runs (HIDDEN, into
 // the hidden lines); DRAW_OUTLINE: its visible line is an outline, else a drawn edge.
@@ -341,21 +450,16 @@ fn seg_class(s: Segment, k: f32) -> u32 {
 #endif
 }
 
-// Edge a -> b of triangle t of `inst` (with neighbour n) on screen: its segment in front of
-// the near plane, not beyond the far one, and inside the image and its guard band (not the
-// targets: a tile then samples and bisects the same points as the whole image, and computes
-// exactly what the whole image does), its length, and the pieces it is drawn in (0 when
-// nothing is left of it). The line pattern is anchored at a (`a_first`) or b, or where the
-// near or far plane cuts the edge short of that end.
-struct Clipped {
-    seg: Segment,
-    length_px: f32,
-    pieces: u32,
+// Edge a -> b of `inst` projected: the parameters s.x..s.y of the part in front of the near
+// plane and not beyond the far one (none where s.x > s.y), and the projections of its ends.
+struct Span {
+    s: vec2<f32>,
+    p0: Projected,
+    p1: Projected,
 }
 
-fn clip_outline(inst: u32, t: u32, n: u32, a: vec3<f32>, b: vec3<f32>, a_first: bool) -> Clipped {
-    var c: Clipped;
-    c.pieces = 0u;
+fn edge_span(inst: u32, a: vec3<f32>, b: vec3<f32>) -> Span {
+    var span: Span;
     let clip = instances[slot(inst)].clip;
     let ha = vec4<f32>(a, 1.0);
     let hb = vec4<f32>(b, 1.0);
@@ -365,15 +469,40 @@ fn clip_outline(inst: u32, t: u32, n: u32, a: vec3<f32>, b: vec3<f32>, a_first: 
     let fade_row = instances[slot(inst)].fade_row;
     var s = keep_positive(vec2<f32>(0.0, 1.0), ca.z, cb.z);
     s = keep_positive(s, dot(depth_row, ha), dot(depth_row, hb));
+    span.s = s;
     if !(s.x <= s.y) {
-        return c;
+        return span;
     }
     let da = dot(depth_row, ha);
     let db = dot(depth_row, hb);
     let fa = dot(fade_row, ha);
     let fb = dot(fade_row, hb);
-    let p0 = project(mix(ca, cb, s.x), mix(da, db, s.x), mix(fa, fb, s.x));
-    let p1 = project(mix(ca, cb, s.y), mix(da, db, s.y), mix(fa, fb, s.y));
+    span.p0 = project(mix(ca, cb, s.x), mix(da, db, s.x), mix(fa, fb, s.x));
+    span.p1 = project(mix(ca, cb, s.y), mix(da, db, s.y), mix(fa, fb, s.y));
+    return span;
+}
+
+// Edge a -> b of triangle t of `inst` (with neighbour n) on screen: its segment in front of
+// the near plane, not beyond the far one, and inside the image and its guard band (not the
+// targets: a tile then samples and bisects the same points as the whole image, and computes
+// exactly what the whole image does), its length, and the pieces it is drawn in (0 when
+// nothing is left of it). The line pattern stands at `anchor` (`pattern_anchor`) where the
+// near or far plane leaves the edge's start (a when anchor.y is +1, b when -1).
+struct Clipped {
+    seg: Segment,
+    length_px: f32,
+    pieces: u32,
+}
+
+fn clip_outline(inst: u32, t: u32, n: u32, a: vec3<f32>, b: vec3<f32>, anchor: vec2<f32>) -> Clipped {
+    var c: Clipped;
+    c.pieces = 0u;
+    let span = edge_span(inst, a, b);
+    if !(span.s.x <= span.s.y) {
+        return c;
+    }
+    let p0 = span.p0;
+    let p1 = span.p1;
     let d = p1.xy - p0.xy;
     let lo = -frame.output_offset;
     let hi = frame.image_size + frame.output_offset;
@@ -388,8 +517,9 @@ fn clip_outline(inst: u32, t: u32, n: u32, a: vec3<f32>, b: vec3<f32>, a_first: 
     c.seg.t = t;
     c.seg.n = n;
     let full = length(d);
-    c.seg.phase = select((1.0 - u.x) * full, u.x * full, a_first);
-    c.seg.phase_dir = select(-1.0, 1.0, a_first);
+    let a_first = anchor.y > 0.0;
+    c.seg.phase = anchor.x + select((1.0 - u.x) * full, u.x * full, a_first);
+    c.seg.phase_dir = anchor.y;
     c.length_px = length(c.seg.end.xy - c.seg.start.xy);
     c.pieces = max(u32(ceil(c.length_px / PIECE_PX)), 1u);
     return c;
@@ -398,8 +528,8 @@ fn clip_outline(inst: u32, t: u32, n: u32, a: vec3<f32>, b: vec3<f32>, a_first: 
 // Lists the pieces of edge i (a -> b) of triangle t of `inst`, with neighbour n, that lie
 // within reach of the targets (of a tile) for outline_pieces_main, to draw as `mode` says
 // (DRAW_VISIBLE, DRAW_HIDDEN). Where the list is full the piece is drawn here.
-fn list_outline(inst: u32, t: u32, i: u32, n: u32, a: vec3<f32>, b: vec3<f32>, a_first: bool, mode: u32) {
-    let c = clip_outline(inst, t, n, a, b, a_first);
+fn list_outline(inst: u32, t: u32, i: u32, n: u32, a: vec3<f32>, b: vec3<f32>, anchor: vec2<f32>, mode: u32) {
+    let c = clip_outline(inst, t, n, a, b, anchor);
     let visible_width = select(instances[slot(inst)].line_width, instances[slot(inst)].outline_width, (mode & DRAW_OUTLINE) != 0u);
     var reach = select(0.0, line_reach(visible_width), (mode & DRAW_VISIBLE) != 0u);
 #if HIDDEN

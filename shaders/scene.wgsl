@@ -36,7 +36,8 @@ fn list_group(group: vec3<u32>) -> u32 {
 // src/gpu/targets.rs): the outline pass's line per target pixel (one word, two with COLORS),
 // with HIDDEN its hidden line per target pixel (`hidden_lines`), then a mark per 8×8 output
 // tile its lines reach, then the list of those tiles (a list header as `list_size` fills it,
-// then one packed tile per item), then its list of pieces.
+// then one packed tile per item), then the phase tables (`chain_phases`), then its list of
+// pieces.
 fn outline_tile_count() -> u32 {
     let size = vec2<u32>(frame.output_size);
     return ((size.x + 7u) / 8u) * ((size.y + 7u) / 8u);

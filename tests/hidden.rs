@@ -256,3 +256,83 @@ fn see_through_surfaces_blend_like_the_ground_truth() {
     assert!(worst <= 2, "worst channel difference {worst}");
     assert!(faded > compared / 2, "{faded} of {compared} faded");
 }
+
+/// A closed cylinder of `n` sides, radius 1, from y = -0.5 to 0.5: its rims are circles of
+/// `n` short feature edges each, chains of drawn edges.
+fn cylinder(n: u32) -> wirepass::Mesh {
+    let mut p = Vec::new();
+    for y in [-0.5f32, 0.5] {
+        p.extend((0..n).map(|k| {
+            let a = k as f32 / n as f32 * std::f32::consts::TAU;
+            glam::Vec3::new(a.cos(), y, a.sin())
+        }));
+    }
+    p.extend([
+        glam::Vec3::new(0.0, -0.5, 0.0),
+        glam::Vec3::new(0.0, 0.5, 0.0),
+    ]);
+    let mut tris = Vec::new();
+    for k in 0..n {
+        let j = (k + 1) % n;
+        tris.extend([
+            [k, n + k, j],
+            [j, n + k, n + j],
+            [2 * n, k, j],
+            [2 * n + 1, n + j, n + k],
+        ]);
+    }
+    wirepass::Mesh::new(p, None, tris, None).unwrap()
+}
+
+/// Dashes run on along a chain of drawn edges: the hidden half of a cylinder's rim, made of
+/// edges shorter than a dash, is dashed evenly (about half its pixels on, as its own
+/// pattern says), not restarted with a dash at every vertex; and where the ground truth puts
+/// them.
+#[test]
+fn dashes_run_on_along_a_chain_of_short_edges() {
+    let world = World::single(cylinder(160), EdgeSelection::Feature(30.0));
+    let view = perspective(&world, DVec3::new(0.6, 2.2, 2.6));
+    let dashed = style(
+        LinePattern::Dashed {
+            dash: 6.0,
+            gap: 6.0,
+        },
+        1.0,
+    );
+    let pixels = check("cylinder", &world, view, &dashed);
+    assert!(pixels > 500, "cylinder: {pixels} hidden-line pixels");
+    // Pixels a hidden line covers at its core, dashed and solid.
+    let core = |style: &Style, method| {
+        let r = shoot_world(&world, view, style, SIZE, method);
+        r.hidden_distance.iter().filter(|&&d| d <= 0.5).count() as f64
+    };
+    let solid = style(LinePattern::Solid, 1.0);
+    for method in [Method::Raycast, Method::Deferred] {
+        let share = core(&dashed, method) / core(&solid, method);
+        println!("{method:?}: {share:.3} of the solid line's core is dashed");
+        // A 6 px dash and its round caps' 0.5 px each, every 12 px: 0.583 (restarted at every
+        // vertex of the 3 px edges, it would be 1).
+        assert!((0.52..0.65).contains(&share), "{method:?}: {share}");
+    }
+    // Three instances, one mirrored: each instance's chains in its own phase table.
+    let mut world = world;
+    let object = |transform| Object {
+        mesh: 0,
+        transform,
+        style: InstanceStyle::default(),
+    };
+    world.objects = vec![
+        object(DMat4::from_translation(DVec3::new(-1.2, 0.0, -0.5))),
+        object(
+            DMat4::from_translation(DVec3::new(1.2, 0.1, -0.3))
+                * DMat4::from_scale(DVec3::new(-1.0, 1.0, 1.0)),
+        ),
+        object(DMat4::from_translation(DVec3::new(0.0, -0.2, -2.5)) * DMat4::from_rotation_z(0.4)),
+    ];
+    let view = perspective(&world, DVec3::new(0.8, 3.0, 4.5));
+    let pixels = check("three cylinders", &world, view, &dashed);
+    assert!(
+        pixels > 1000,
+        "three cylinders: {pixels} hidden-line pixels"
+    );
+}

@@ -523,7 +523,7 @@ fn set_edges_redraws_a_stored_mesh_as_a_fresh_upload_would() {
         let id = switched.ids[0];
         switched
             .store
-            .set_edges(&ctx.queue, id, &mesh, edges)
+            .set_edges(&ctx.device, &ctx.queue, id, &mesh, edges)
             .unwrap_or_else(|e| panic!("{e}"));
         let fresh =
             Uploaded::new(&ctx.device, &ctx.queue, &world).unwrap_or_else(|e| panic!("{e}"));

@@ -46,6 +46,10 @@ pub(crate) enum Res {
     /// The edge pass's list of tiles for `tile_main`.
     TilesRw = 24,
     Tiles = 25,
+    /// The mesh store's chain records (`mesh_records::ChainRecords`).
+    Chains = 26,
+    /// The frame's instances whose chains `chain_phases` visits (`frame::ChainWork`).
+    ChainWork = 27,
     /// The host's own depth texture, which the host-depth pass resolves into [`Res::HostDepth`]
     /// (read as unfilterable float; multisampled or not).
     HostSource = 30,
@@ -344,6 +348,8 @@ pub(crate) fn bind_group(
             ),
             Info => store.info.as_entire_binding(),
             Clusters => store.clusters.as_entire_binding(),
+            Chains => store.chains.as_entire_binding(),
+            ChainWork => f.chain_work.as_entire_binding(),
             Ids => wgpu::BindingResource::TextureView(sources.ids.ok_or_else(|| missing(r))?),
             HostDepth => {
                 wgpu::BindingResource::TextureView(sources.host_depth.ok_or_else(|| missing(r))?)
@@ -468,6 +474,8 @@ mod tests {
             "out_ids" => OutIds,
             "tiles_rw" => TilesRw,
             "tiles" => Tiles,
+            "chains" => Chains,
+            "chain_work" => ChainWork,
             "host_source" => HostSource,
             "host" => HostParams,
             "host_out" => HostOut,

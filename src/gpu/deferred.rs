@@ -395,6 +395,7 @@ impl DeferredPass {
             output: region.size,
             acc_colors: data.mixed_colors,
             acc_hidden: data.hidden,
+            acc_phase_words: data.chain_phases().0,
             result: self.composite.is_some(),
             diagnostic: self.diagnostics,
             host: host.is_some(),

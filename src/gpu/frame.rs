@@ -36,6 +36,7 @@ pub(crate) struct FrameUniforms {
     fill_opacity: f32,
     hidden_color: [f32; 4],
     hidden_line: [f32; 4],
+    chain_work: [u32; 4],
 }
 
 /// Mirror of WGSL `struct Instance`; field order and padding match it.
@@ -59,7 +60,9 @@ pub(crate) struct InstanceRecord {
     index: u32,
     outline_color: [f32; 4],
     outline_width: f32,
-    _pad: [u32; 3],
+    phase_table: u32,
+    table_log2: u32,
+    _pad: u32,
 }
 
 /// `Instance.flags`: the instance's edges are drawn.
@@ -152,6 +155,9 @@ pub(crate) struct FrameData {
     /// Whether instances differ in line colour (the outline pass then keeps, per pixel,
     /// which instance's line it holds).
     pub mixed_colors: bool,
+    /// The instances whose chains' pattern positions `chain_phases` finds ([`ChainWork`]),
+    /// at least one (empty) entry, for binding.
+    pub chain_work: wgpu::Buffer,
     /// Whether the instance buffer can be bound as a uniform array of
     /// [`UNIFORM_INSTANCE_CAPACITY`] records.
     pub uniform_instances: bool,
@@ -174,6 +180,19 @@ pub(crate) struct FrameRecords {
     pub patches: bool,
     pub hidden: bool,
     pub mixed_colors: bool,
+    pub chain_work: Vec<ChainWork>,
+}
+
+/// An instance whose drawn edges' chains carry a dashed or dotted hidden-line pattern: its
+/// slot, its mesh's first chain record, its number of chains, and the chains of the
+/// instances before it in the list (`chain_phases` in outline.wgsl finds its chain by it).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub(crate) struct ChainWork {
+    slot: u32,
+    chain_base: u32,
+    chains: u32,
+    before: u32,
 }
 
 impl FrameRecords {
@@ -278,6 +297,30 @@ impl FrameRecords {
         // Hidden lines are drawn by the outline pass, from every drawn edge in view.
         let hidden = style.hidden.filter(|_| lines);
         outlines |= hidden.is_some();
+        // A pattern runs along chains of drawn edges: each instance drawing edges of a mesh
+        // with chains gets a phase table in the outline buffer.
+        let patterned = hidden.is_some_and(|h| h.pattern.dash_period()[1] > 0.0);
+        let mut chain_work = Vec::new();
+        let (mut phase_words, mut chains) = (0u64, 0u64);
+        for (slot, record) in records.iter_mut().enumerate() {
+            let mesh = store.record(scene.instances[order[slot] as usize].mesh)?;
+            if !patterned || record.flags & INSTANCE_EDGES == 0 || mesh.chains == 0 {
+                continue;
+            }
+            record.phase_table = u32::try_from(phase_words).map_err(|_| too_many_chains())?;
+            chain_work.push(ChainWork {
+                slot: slot as u32,
+                chain_base: mesh.chain_base,
+                chains: mesh.chains,
+                before: u32::try_from(chains).map_err(|_| too_many_chains())?,
+            });
+            phase_words += 2 << mesh.table_log2;
+            chains += u64::from(mesh.chains);
+        }
+        let phase_words = u32::try_from(phase_words.next_power_of_two())
+            .ok()
+            .filter(|_| u32::try_from(chains).is_ok())
+            .ok_or_else(too_many_chains)?;
         // The edge pass must know whose line, and of which class, each outline-pass pixel
         // holds where colours differ between instances or between an outline and its edges.
         let mixed_colors = records
@@ -324,6 +367,16 @@ impl FrameRecords {
                 let [dash, period] = h.pattern.dash_period();
                 [h.width, dash, period, 0.0]
             }),
+            chain_work: [
+                if chain_work.is_empty() {
+                    0
+                } else {
+                    phase_words
+                },
+                chains as u32,
+                chain_work.len() as u32,
+                0,
+            ],
         };
         Ok(FrameRecords {
             uniforms,
@@ -337,8 +390,15 @@ impl FrameRecords {
             patches,
             hidden: hidden.is_some(),
             mixed_colors,
+            chain_work,
         })
     }
+}
+
+fn too_many_chains() -> Error {
+    Error::InvalidScene(
+        "the scene's chains of drawn edges need more than 2^32 phase table words".into(),
+    )
 }
 
 impl FrameData {
@@ -356,6 +416,7 @@ impl FrameData {
             hidden,
             region,
             mixed_colors,
+            chain_work,
         } = built;
         let frame = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("wirepass frame"),
@@ -384,9 +445,17 @@ impl FrameData {
             contents: &contents,
             usage,
         });
+        let mut work: Vec<u8> = bytemuck::cast_slice(&chain_work).to_vec();
+        work.resize(work.len().max(16), 0);
+        let chain_work = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("wirepass chain work"),
+            contents: &work,
+            usage: wgpu::BufferUsages::STORAGE,
+        });
         FrameData {
             uniforms,
             frame,
+            chain_work,
             instances,
             draws,
             order,
@@ -405,6 +474,11 @@ impl FrameData {
     /// Clusters of all instances together.
     pub fn uniforms_clusters(&self) -> u32 {
         self.uniforms.clusters
+    }
+
+    /// Words of the outline buffer's phase tables, and the chains `chain_phases` visits.
+    pub fn chain_phases(&self) -> (u32, u32) {
+        (self.uniforms.chain_work[0], self.uniforms.chain_work[1])
     }
 
     /// Whether the store's vertex or per-triangle buffers are bound as two halves.
@@ -488,7 +562,9 @@ fn instance_record(
         index: slot,
         outline_color,
         outline_width,
-        _pad: [0; 3],
+        phase_table: 0,
+        table_log2: mesh.table_log2,
+        _pad: 0,
     }
 }
 
@@ -506,7 +582,7 @@ mod tests {
     #[test]
     fn records_match_their_wgsl_layout() {
         assert_eq!(std::mem::size_of::<InstanceRecord>(), 256);
-        assert_eq!(std::mem::size_of::<FrameUniforms>(), 176);
+        assert_eq!(std::mem::size_of::<FrameUniforms>(), 192);
         let r = InstanceRecord::zeroed_for_test();
         let base = &r as *const _ as usize;
         assert_eq!(
@@ -564,6 +640,10 @@ mod tests {
             triangles: 0,
             cluster_base: 0,
             clusters: 0,
+            chain_base: 0,
+            chain_records: 0,
+            chains: 0,
+            table_log2: 1,
             origin: DVec3::new(5.0, -3.0, 2.0),
             scale: 0.25,
             order: vec![].into(),

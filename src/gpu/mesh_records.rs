@@ -39,6 +39,7 @@ pub(crate) struct MeshData {
     pub scale: f64,
     pub order: Arc<[u32]>,
     pub bounds: (DVec3, DVec3),
+    pub chains: ChainRecords,
 }
 
 impl MeshData {
@@ -94,6 +95,7 @@ impl MeshData {
             bounds_of_clusters: bounds,
             info: edges.info,
             lines: edges.lines,
+            chains: edges.chains,
             origin,
             scale,
             order,
@@ -212,15 +214,23 @@ fn quad_bits(mesh: &Mesh, mask: &[u8], stored: &[u32], t: usize) -> u32 {
         | u32::from(mask[n] & ALL_EDGES) << (QUAD_SHIFT + 5)
 }
 
+/// First of the three bits of [`EdgeData::info`] that mark the drawn edges in a chain of more
+/// than one edge, whose pattern position the outline pass looks up ([`ChainRecords`]); an
+/// edge alone starts its pattern at its end that comes first, as its chain would.
+const INFO_CHAINED_SHIFT: u32 = 26;
+
 /// A mesh's edge data under one edge selection, in stored order.
 pub(crate) struct EdgeData {
     /// Per stored triangle, the 4 bytes the passes read (`triangle_info` in common.wgsl):
     /// bits 0–2 the drawn edges, bit 3 a boundary edge, bits 4–7 the fold code of
     /// [`Mesh::outline_hints`], bits 8–10 the edges that may be drawn as outlines, bit 11
     /// a large patch, bits 12–14 the drawn edges the outline pass draws, bit 15 a patch of
-    /// two triangles, bits 16–25 that quad's other triangle ([`quad_bits`]).
+    /// two triangles, bits 16–25 that quad's other triangle ([`quad_bits`]), bits 26–28 the
+    /// drawn edges in chains ([`INFO_CHAINED_SHIFT`]).
     pub info: Vec<u32>,
     pub lines: MeshLines,
+    /// The drawn edges' chains, as the outline pass's chain records.
+    pub chains: ChainRecords,
 }
 
 impl EdgeData {
@@ -236,6 +246,7 @@ impl EdgeData {
         let patches = Patches::ordered(neighbours, &mask, |t, u| stored[t] < stored[u]);
         let hints = mesh.outline_hints();
         let outline = mesh.outline_mask();
+        let (chains, chained) = ChainRecords::new(mesh, &mask, &stored);
         let info = order
             .iter()
             .map(|&t| {
@@ -256,6 +267,7 @@ impl EdgeData {
                     | large
                     | u32::from(patches.splat[t]) << INFO_SPLAT_SHIFT
                     | quad
+                    | u32::from(chained[t]) << INFO_CHAINED_SHIFT
             })
             .collect();
         let lines = MeshLines {
@@ -265,7 +277,94 @@ impl EdgeData {
                 .any(|(&m, &large)| m != ALL_EDGES && !large),
             splat: patches.splat.iter().any(|&b| b != 0),
         };
-        EdgeData { info, lines }
+        EdgeData {
+            info,
+            lines,
+            chains,
+        }
+    }
+}
+
+/// A mesh's chains of more than one drawn edge ([`crate::mesh::chains`]) as the outline
+/// pass's `chain_phases` reads them, in 16-byte records: one per chain (its first edge
+/// record, relative to the first record, and its edge count), then one per edge in chain order (its
+/// start and end vertex as the triangle listing it runs, and [`phase_key`] | forward << 31,
+/// and its place in the phase table). Each frame, `chain_phases` writes every edge's key and
+/// pattern position into its instance's phase table, an open-addressed hash table (linear
+/// probing from [`phase_slot`]) whose layout is fixed here: the outline pass finds an edge's
+/// position by its key, probing only slots written in the same frame.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub(crate) struct ChainRecords {
+    pub records: Vec<[u32; 4]>,
+    pub chains: u32,
+    /// log2 of the phase table's slots (at least twice the edges, so probes stay short).
+    pub table_log2: u32,
+}
+
+/// The key of edge `i` of stored triangle `t` (mesh-relative) in a phase table.
+pub(crate) fn phase_key(t: u32, i: u32) -> u32 {
+    t << 2 | i
+}
+
+/// The slot a phase table of 2^`log2` slots probes first for `key` (twin of `phase_slot` in
+/// outline.wgsl): Fibonacci hashing.
+pub(crate) fn phase_slot(key: u32, log2: u32) -> u32 {
+    key.wrapping_mul(0x9e37_79b1) >> (32 - log2)
+}
+
+impl ChainRecords {
+    /// The chain records of `mesh`'s drawn edges (`mask`), each shared edge listed from the
+    /// side with the lower stored index (`stored`), as the outline pass lists it; and per
+    /// triangle, the edges in those chains.
+    fn new(mesh: &Mesh, mask: &[u8], stored: &[u32]) -> (ChainRecords, Vec<u8>) {
+        let neighbours = mesh.edge_neighbours();
+        let mut listed = Vec::new();
+        for (t, n) in neighbours.iter().enumerate() {
+            for i in 0..3u8 {
+                let n = n[usize::from(i)];
+                let mine = n == NO_NEIGHBOUR || stored[t] < stored[n as usize];
+                if mask[t] & (1 << i) != 0 && mine {
+                    listed.push((t as u32, i));
+                }
+            }
+        }
+        let tris = mesh.triangles();
+        let all = crate::mesh::chains::chains(mesh.positions(), tris, &listed);
+        let mut chains = crate::mesh::chains::Chains::default();
+        let mut chained = vec![0u8; tris.len()];
+        for chain in all.iter().filter(|c| c.len() > 1) {
+            chains.starts.push(chains.edges.len() as u32);
+            chains.edges.extend_from_slice(chain);
+            for e in chain {
+                chained[e.t as usize] |= 1 << e.i;
+            }
+        }
+        let edges = chains.edges.len() as u32;
+        let table_log2 = (2 * edges).max(2).next_power_of_two().trailing_zeros();
+        let mask = (1u32 << table_log2) - 1;
+        let mut taken = vec![false; 1 << table_log2];
+        let first = chains.starts.len() as u32;
+        let mut records: Vec<[u32; 4]> = chains.iter().map(|_| [0; 4]).collect();
+        for (k, chain) in chains.iter().enumerate() {
+            records[k] = [first + chains.starts[k], chain.len() as u32, 0, 0];
+        }
+        for e in &chains.edges {
+            let key = phase_key(stored[e.t as usize], u32::from(e.i));
+            let mut slot = phase_slot(key, table_log2);
+            while taken[slot as usize] {
+                slot = (slot + 1) & mask;
+            }
+            taken[slot as usize] = true;
+            let tri = tris[e.t as usize];
+            let (a, b) = (tri[usize::from(e.i)], tri[(usize::from(e.i) + 1) % 3]);
+            records.push([a, b, key | u32::from(e.forward) << 31, slot]);
+        }
+        let records = ChainRecords {
+            records,
+            chains: first,
+            table_log2,
+        };
+        (records, chained)
     }
 }
 
@@ -406,6 +505,44 @@ mod tests {
                 assert_eq!(q, tris[n as usize].map(|v| p[v as usize]), "{t} {i}");
             }
         }
+    }
+
+    #[test]
+    fn chain_records_place_every_chained_edge_where_its_probe_finds_it() {
+        // A cube split 5 times a side: each of its 12 feature edges a chain of 5 edges.
+        let mesh = crate::mesh::cube(300).unwrap();
+        let order: Vec<u32> = (0..mesh.triangle_count() as u32).rev().collect();
+        let data = EdgeData::new(&mesh, EdgeSelection::Feature(30.0), &order);
+        let c = &data.chains;
+        assert_eq!(c.chains, 12);
+        let heads = &c.records[..12];
+        let edges = &c.records[12..];
+        assert_eq!(edges.len(), 60);
+        assert!(heads.iter().all(|h| h[1] == 5));
+        let slots = 1u32 << c.table_log2;
+        assert!(slots >= 2 * edges.len() as u32);
+        let mut taken = vec![None; slots as usize];
+        for e in edges {
+            assert!(taken[e[3] as usize].replace(e[2] & 0x7fff_ffff).is_none());
+        }
+        for e in edges {
+            // Probing from the key's slot meets only taken slots before the key's own.
+            let key = e[2] & 0x7fff_ffff;
+            let mut at = phase_slot(key, c.table_log2);
+            while taken[at as usize] != Some(key) {
+                assert!(taken[at as usize].is_some());
+                at = (at + 1) % slots;
+            }
+            // The key's triangle marks the edge as chained.
+            let (t, i) = (key >> 2, key & 3);
+            assert_ne!(data.info[t as usize] >> (INFO_CHAINED_SHIFT + i) & 1, 0);
+        }
+        let chained: u32 = data
+            .info
+            .iter()
+            .map(|w| (w >> INFO_CHAINED_SHIFT & 7).count_ones())
+            .sum();
+        assert_eq!(chained, 60);
     }
 
     #[test]

@@ -31,6 +31,8 @@ pub(crate) const VERTEX_BYTES: u64 = 16;
 pub(crate) const TRIANGLE_BYTES: u64 = 12;
 /// Bytes per cluster bound.
 pub(crate) const CLUSTER_BYTES: u64 = 32;
+/// Bytes per chain record (`mesh_records::ChainRecords`).
+pub(crate) const CHAIN_BYTES: u64 = 16;
 /// Storage buffers per shader stage that the pipelines reading a mesh split over two
 /// bindings need (`wgpu::Limits::default()` allows 8; without them, such a mesh is an error
 /// naming the binding limit).
@@ -54,6 +56,12 @@ pub(crate) struct MeshRecord {
     pub triangles: u32,
     pub cluster_base: u32,
     pub clusters: u32,
+    /// Its chain records (`mesh_records::ChainRecords`): where they start, how many, how many of them
+    /// head a chain, and log2 of the slots of its phase table.
+    pub chain_base: u32,
+    pub chain_records: u32,
+    pub chains: u32,
+    pub table_log2: u32,
     /// Mesh coordinates of a stored position `q`: `origin + scale · q`.
     pub origin: DVec3,
     pub scale: f64,
@@ -145,6 +153,7 @@ enum Kind {
     Vertex,
     Triangle,
     Cluster,
+    Chain,
 }
 
 /// All meshes' GPU buffers. Insert meshes once; instances of them are then drawn by any
@@ -166,7 +175,7 @@ enum Kind {
 /// let id = meshes.insert(device, queue, &sphere, EdgeSelection::Feature(30.0))?;
 /// assert_eq!(meshes.triangle_count(id)?, sphere.triangle_count() as u32);
 /// // Switch which edges are drawn without uploading the mesh again.
-/// meshes.set_edges(queue, id, &sphere, EdgeSelection::All)?;
+/// meshes.set_edges(device, queue, id, &sphere, EdgeSelection::All)?;
 /// # Ok(()) }
 /// ```
 pub struct MeshStore {
@@ -175,6 +184,7 @@ pub struct MeshStore {
     vertices: FreeList,
     triangles: FreeList,
     clusters: FreeList,
+    chains: FreeList,
     pools: Vec<(Kind, Pool)>,
     slots: Vec<(u32, Option<MeshRecord>)>,
     free_slots: Vec<u32>,
@@ -206,6 +216,7 @@ impl MeshStore {
             vertices: FreeList::default(),
             triangles: FreeList::default(),
             clusters: FreeList::default(),
+            chains: FreeList::default(),
             pools: vec![
                 pool(
                     Kind::Vertex,
@@ -235,6 +246,12 @@ impl MeshStore {
                     Kind::Cluster,
                     "wirepass clusters",
                     CLUSTER_BYTES,
+                    wgpu::BufferUsages::empty(),
+                ),
+                pool(
+                    Kind::Chain,
+                    "wirepass chains",
+                    CHAIN_BYTES,
                     wgpu::BufferUsages::empty(),
                 ),
             ],
@@ -272,17 +289,21 @@ impl MeshStore {
         let vertex_base = self.alloc(device, queue, Kind::Vertex, vertices)?;
         let triangle_base = self.alloc(device, queue, Kind::Triangle, triangles)?;
         let cluster_base = self.alloc(device, queue, Kind::Cluster, clusters)?;
+        let chains = &data.chains;
+        let chain_records = count(chains.records.len(), "chain records")?;
+        let chain_base = self.alloc(device, queue, Kind::Chain, chain_records)?;
         let write = |pool: &Pool, base: u32, bytes: &[u8]| {
             if !bytes.is_empty() {
                 queue.write_buffer(&pool.buffer, u64::from(base) * pool.stride, bytes);
             }
         };
-        let [v, i, n, t, c] = [0, 1, 2, 3, 4].map(|k| &self.pools[k].1);
+        let [v, i, n, t, c, h] = [0, 1, 2, 3, 4, 5].map(|k| &self.pools[k].1);
         write(v, vertex_base, bytemuck::cast_slice(&data.vertices));
         write(i, triangle_base, bytemuck::cast_slice(&data.indices));
         write(n, triangle_base, bytemuck::cast_slice(&data.neighbours));
         write(t, triangle_base, bytemuck::cast_slice(&data.info));
         write(c, cluster_base, bytemuck::cast_slice(&data.clusters));
+        write(h, chain_base, bytemuck::cast_slice(&chains.records));
 
         let record = MeshRecord {
             vertex_base,
@@ -291,6 +312,10 @@ impl MeshStore {
             triangles,
             cluster_base,
             clusters,
+            chain_base,
+            chain_records,
+            chains: chains.chains,
+            table_log2: chains.table_log2,
             origin: data.origin,
             scale: data.scale,
             order: data.order,
@@ -322,6 +347,7 @@ impl MeshStore {
         self.triangles
             .release(record.triangle_base, record.triangles);
         self.clusters.release(record.cluster_base, record.clusters);
+        self.chains.release(record.chain_base, record.chain_records);
         let entry = &mut self.slots[id.slot as usize];
         entry.0 = entry.0.wrapping_add(1);
         entry.1 = None;
@@ -335,12 +361,13 @@ impl MeshStore {
     /// not as an error): the selection decides which pipelines draw the mesh.
     pub fn set_edges(
         &mut self,
+        device: &wgpu::Device,
         queue: &wgpu::Queue,
         id: MeshId,
         mesh: &Mesh,
         edges: EdgeSelection,
     ) -> Result<()> {
-        let record = self.record(id)?;
+        let record = self.record(id)?.clone();
         if mesh.triangle_count() as u64 != u64::from(record.triangles) {
             return Err(Error::Misuse(format!(
                 "set_edges got a mesh of {} triangles for a stored mesh of {}",
@@ -350,6 +377,11 @@ impl MeshStore {
         }
         let edges = EdgeData::new(mesh, edges, &record.order);
         let clusters = cluster_records(&record.bounds_of_clusters, &edges.info);
+        // The chains change with the selection: their records move to a region of their size.
+        let (old_base, old_records) = (record.chain_base, record.chain_records);
+        let chain_records = count(edges.chains.records.len(), "chain records")?;
+        let chain_base = self.alloc(device, queue, Kind::Chain, chain_records)?;
+        self.chains.release(old_base, old_records);
         let (info, cluster) = (&self.pools[3].1, &self.pools[4].1);
         queue.write_buffer(
             &info.buffer,
@@ -363,9 +395,21 @@ impl MeshStore {
                 bytemuck::cast_slice(&clusters),
             );
         }
+        let chain = &self.pools[5].1;
+        if !edges.chains.records.is_empty() {
+            queue.write_buffer(
+                &chain.buffer,
+                u64::from(chain_base) * chain.stride,
+                bytemuck::cast_slice(&edges.chains.records),
+            );
+        }
         let slot = id.slot as usize;
         if let Some(record) = self.slots[slot].1.as_mut() {
             record.lines = edges.lines;
+            record.chain_base = chain_base;
+            record.chain_records = chain_records;
+            record.chains = edges.chains.chains;
+            record.table_log2 = edges.chains.table_log2;
         }
         self.version += 1;
         Ok(())
@@ -426,6 +470,7 @@ impl MeshStore {
             neighbours: b(2),
             info: b(3),
             clusters: b(4),
+            chains: b(5),
             split: self.split(),
         }
     }
@@ -503,6 +548,7 @@ impl MeshStore {
             Kind::Vertex => &mut self.vertices,
             Kind::Triangle => &mut self.triangles,
             Kind::Cluster => &mut self.clusters,
+            Kind::Chain => &mut self.chains,
         };
         if let Some(at) = list.alloc(n) {
             return Ok(at);
@@ -519,13 +565,21 @@ impl MeshStore {
             .map(|(_, p)| p.stride)
             .max()
             .unwrap_or(4);
-        let most = self.limits.max_buffer_size / stride;
+        // The chain records are bound whole, never split.
+        let (limit_name, limit) = match kind {
+            Kind::Chain => (
+                "max_storage_buffer_binding_size",
+                self.limits.max_storage_buffer_binding_size,
+            ),
+            _ => ("max_buffer_size", self.limits.max_buffer_size),
+        };
+        let most = limit / stride;
         let capacity = capacity.min(most).min(u64::from(u32::MAX - 1)) as u32;
         if capacity < old + n {
             return Err(Error::OverLimit {
                 what: format!("the elements of kind {kind:?} in the mesh store"),
                 value: u64::from(old) + u64::from(n),
-                limit_name: "max_buffer_size",
+                limit_name,
                 limit: most,
             });
         }
@@ -589,6 +643,7 @@ pub(crate) struct StoreBuffers {
     pub neighbours: wgpu::Buffer,
     pub info: wgpu::Buffer,
     pub clusters: wgpu::Buffer,
+    pub chains: wgpu::Buffer,
     pub split: Split,
 }
 

@@ -2,7 +2,8 @@
 //! boundaries) and the drawn edges of large patches, drawn from the triangles into every
 //! pixel within reach of their visible runs. Three dispatches: a cull of the clusters that
 //! may hold such an edge, one invocation per listed triangle listing the edges' pieces, one
-//! per piece drawing it.
+//! per piece drawing it; before them, for dashed or dotted hidden lines, one invocation per
+//! chain of drawn edges finding where the pattern stands along it.
 
 use super::bindings::{self, dispatch, store_resources, Compute, Res, Size, Sources};
 use super::frame::FrameData;
@@ -22,6 +23,8 @@ struct OutlinePipelines {
     draw: Compute,
     /// Draws the listed pieces, one a lane.
     pieces: Compute,
+    /// Finds the pattern's position along every chain (HIDDEN).
+    phases: Option<Compute>,
 }
 
 /// Where the piece dispatch's size lies in a frame's cluster list buffer: after the cluster
@@ -96,10 +99,35 @@ impl OutlinePass {
         )?;
         draw_res.push(Res::Cull);
         let draw = Compute::new(device, &module, "outline_main", draw_res, self.format)?;
+        let phases = if v.hidden {
+            let mut res = vec![
+                Res::Frame,
+                bindings::instances(v.uniform_instances),
+                Res::Vertices,
+            ];
+            if v.split {
+                res.push(Res::VerticesHi);
+            }
+            res.extend([Res::Chains, Res::ChainWork, Res::AccRw]);
+            Some(Compute::new(
+                device,
+                &module,
+                "chain_phases",
+                res,
+                self.format,
+            )?)
+        } else {
+            None
+        };
         if let Some(e) = scope.end() {
             return Err(Error::Device(format!("building the outline pass: {e}")));
         }
-        let p = Arc::new(OutlinePipelines { cull, draw, pieces });
+        let p = Arc::new(OutlinePipelines {
+            cull,
+            draw,
+            pieces,
+            phases,
+        });
         cache.insert(v, p.clone());
         Ok(p)
     }
@@ -123,15 +151,29 @@ impl OutlinePass {
         let draw = p.draw.bind(device, sources)?;
         let pieces = p.pieces.bind(device, sources)?;
         let data = sources.frame;
-        encoder.clear_buffer(&t.acc, 0, Some(t.acc_pieces));
+        encoder.clear_buffer(&t.acc, 0, Some(t.acc_phases));
         encoder.copy_buffer_to_buffer(reset, 0, &t.acc, t.acc_tiles, LIST_HEADER);
         encoder.copy_buffer_to_buffer(reset, 0, &t.acc, t.acc_pieces, LIST_HEADER);
         encoder.copy_buffer_to_buffer(reset, 0, list, 0, LIST_HEADER);
-        let groups = data.uniforms_clusters().div_ceil(GROUP);
         let max = device.limits().max_compute_workgroups_per_dimension.max(1);
-        let (x, y) = (groups.clamp(1, max), groups.div_ceil(max).max(1));
+        let grid = |n: u32| {
+            let groups = n.div_ceil(GROUP);
+            Size::Grid(groups.clamp(1, max), groups.div_ceil(max).max(1))
+        };
+        let chains = data.chain_phases().1;
+        if let (Some(phases), true) = (&p.phases, chains > 0) {
+            let group = phases.bind(device, sources)?;
+            let names = ("wirepass chain phases", "outline.chains");
+            dispatch(
+                encoder,
+                timer.as_deref_mut(),
+                names,
+                (phases, &group),
+                grid(chains),
+            );
+        }
         let names = ("wirepass outline cull", "outline.cull");
-        let size = Size::Grid(x, y);
+        let size = grid(data.uniforms_clusters());
         dispatch(encoder, timer.as_deref_mut(), names, (&p.cull, &cull), size);
         let names = ("wirepass outline pass", "outline.draw");
         let size = Size::Indirect(list, 0);

@@ -96,10 +96,12 @@ pub(crate) struct Targets {
     /// The outline buffer (`outline_tile_marks` in scene.wgsl): one u32 per target pixel,
     /// or two where instances differ in line colour, and one more for hidden lines where
     /// they are drawn; a mark per output tile; the list of
-    /// the tiles the lines reach, from byte `acc_tiles`; the outline pass's piece list, from
-    /// byte `acc_pieces`.
+    /// the tiles the lines reach, from byte `acc_tiles`; the phase tables of chains of drawn
+    /// edges (`chain_phases` in outline.wgsl), from byte `acc_phases`; the outline pass's
+    /// piece list, from byte `acc_pieces`.
     pub acc: wgpu::Buffer,
     pub acc_tiles: u64,
+    pub acc_phases: u64,
     pub acc_pieces: u64,
     pub acc_colors: bool,
     pub acc_hidden: bool,
@@ -122,6 +124,8 @@ pub(crate) struct TargetSpec {
     pub output: (u32, u32),
     pub acc_colors: bool,
     pub acc_hidden: bool,
+    /// Words of phase tables.
+    pub acc_phase_words: u32,
     pub result: bool,
     pub diagnostic: bool,
     pub host: bool,
@@ -135,6 +139,7 @@ impl Targets {
             output: self.output,
             acc_colors: self.acc_colors,
             acc_hidden: self.acc_hidden,
+            acc_phase_words: ((self.acc_pieces - self.acc_phases) / 4) as u32,
             result: self.result.is_some(),
             diagnostic: self.diagnostic.is_some(),
             host: self.host.is_some(),
@@ -161,7 +166,8 @@ impl Targets {
         // no room for itself).
         let words = 1 + u64::from(spec.acc_colors) + u64::from(spec.acc_hidden);
         let acc_tiles = pixels * 4 * words + 4 * tiles;
-        let acc_pieces = acc_tiles + LIST_HEADER + 4 * tiles;
+        let acc_phases = acc_tiles + LIST_HEADER + 4 * tiles;
+        let acc_pieces = acc_phases + 4 * u64::from(spec.acc_phase_words);
         if acc_pieces + LIST_HEADER > binding {
             return Err(Error::OverLimit {
                 what: format!("the outline buffer for a {w}x{h} target, in bytes"),
@@ -218,6 +224,7 @@ impl Targets {
                 wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_SRC,
             ),
             acc_tiles,
+            acc_phases,
             acc_pieces,
             acc_colors: spec.acc_colors,
             acc_hidden: spec.acc_hidden,

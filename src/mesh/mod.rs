@@ -4,6 +4,7 @@
 //! in `formats` (feature `formats`). It uses only the crate's error type.
 
 pub mod adjacency;
+pub(crate) mod chains;
 pub mod clusters;
 #[cfg(feature = "formats")]
 pub mod formats;

@@ -14,6 +14,9 @@
 //! that draw their edges, by the same definition: the pixels of a large patch near an
 //! undrawn edge find their lines here.
 //!
+//! A hidden-line pattern runs along each chain of drawn edges ([`crate::mesh::chains`]): an
+//! edge's dashes start where the chain's projected length before it leaves the pattern.
+//!
 //! Visibility along an edge is found by casting a ray through points every 1/8 pixel of its
 //! projection and bisecting each change to 2⁻³⁰ of the edge. The GPU pass does the same at
 //! 1/4 pixel, testing each point against the triangles rasterized around it instead of a ray
@@ -28,8 +31,9 @@ use crate::mesh::patches::Patches;
 use crate::style::{depth_fade, line_intensity, line_key, line_reach};
 use crate::truth::rays::{HostMap, Line, ObjectStyle, RayCaster, Rays};
 use crate::world::Shot;
-use glam::{DVec2, DVec4};
+use glam::{DVec2, DVec3, DVec4};
 use rayon::prelude::*;
+use std::collections::HashMap;
 
 /// Visibility samples per pixel of projected edge length.
 const SAMPLES_PER_PIXEL: f64 = 8.0;
@@ -188,17 +192,26 @@ pub(crate) fn outline_map(
                     _ => merged.push((e, d)),
                 }
             }
+            let period = hidden.map_or(0.0, |h| f64::from(h.pattern.dash_period()[1]));
+            let chained = if styles[o].edges && period > 0.0 {
+                view.chain_anchors(mesh, first, &masks[object.mesh], period)
+            } else {
+                HashMap::new()
+            };
+            let weld = crate::mesh::adjacency::weld_by_position(mesh.positions());
             merged
                 .into_par_iter()
                 .map(move |((t, i), draw)| {
                     let n = neighbours[t as usize][i as usize];
                     let corners = tris[t as usize];
                     let p = mesh.positions();
-                    let a_first = comes_first(
-                        p[corners[i as usize] as usize],
-                        p[corners[(i as usize + 1) % 3] as usize],
-                    );
-                    view.stretches(first, (t, i, n, a_first), (o as u32, widths), draw, hidden)
+                    let (a, b) = (corners[i as usize], corners[(i as usize + 1) % 3]);
+                    let (wa, wb) = (weld[a as usize], weld[b as usize]);
+                    let anchor = match chained.get(&(wa.min(wb), wa.max(wb))) {
+                        Some(&(position, entry)) => (position, entry == wa),
+                        None => (0.0, comes_first(p[a as usize], p[b as usize])),
+                    };
+                    view.stretches(first, (t, i, n, anchor), (o as u32, widths), draw, hidden)
                 })
                 .collect::<Vec<_>>()
         })
@@ -216,14 +229,11 @@ pub(crate) fn outline_map(
     OutlineMap { line, hidden }
 }
 
-/// Whether `a` comes before `b` in (x, y, z) order (in the mesh's own coordinates): the end
-/// of an edge that anchors its line pattern, the same whichever triangle draws the edge and
-/// whatever its vertices' numbers. Twin of `comes_first` in outline.wgsl, which compares the
-/// store's rebased coordinates (the same order, but where rebasing rounds two coordinates
-/// together).
-fn comes_first(a: glam::Vec3, b: glam::Vec3) -> bool {
-    a.x < b.x || (a.x == b.x && (a.y < b.y || (a.y == b.y && a.z < b.z)))
-}
+// Whether one point comes before another in (x, y, z) order (in the mesh's own
+// coordinates): the end of an edge that anchors its line pattern. `comes_first` in
+// outline.wgsl compares the store's rebased coordinates (the same order, but where rebasing
+// rounds two coordinates together).
+use crate::mesh::chains::comes_first;
 
 /// Per pixel, the stretch whose line colours it most (the greatest key), skipping lines that
 /// `host` hides.
@@ -310,14 +320,77 @@ enum Class {
 }
 
 impl Visibility<'_> {
+    /// The part of the edge `a` → `b` (world coordinates) in front of the near plane and not
+    /// beyond the far one, as parameters along it, and the projections of its ends.
+    fn span(&self, a: DVec3, b: DVec3) -> Option<((f64, f64), Projected, Projected)> {
+        let (ca, cb) = (self.rays.clip(a), self.rays.clip(b));
+        let depth = self.rays.rows().depth;
+        let (ha, hb) = (a.extend(1.0), b.extend(1.0));
+        let mut s = (0.0, 1.0);
+        keep_positive(&mut s, ca.z, cb.z);
+        keep_positive(&mut s, depth.dot(ha), depth.dot(hb));
+        if !(s.0 <= s.1) {
+            return None;
+        }
+        let at = |k: f64| {
+            let c = ca.lerp(cb, k);
+            let f = self.fade_row.dot(ha.lerp(hb, k));
+            self.project(c, f)
+        };
+        Some((s, at(s.0), at(s.1)))
+    }
+
+    /// Where the hidden-line pattern (of period `period`) stands on each chained drawn edge
+    /// (`mask`) of `mesh`, the object whose first global id is `first`: by the edge's welded
+    /// ends (lower, higher), the pattern's position where the chain enters it (modulo the
+    /// period) and the welded vertex it enters at. The position is the summed length of the
+    /// projections ([`Self::span`]) of the chain's edges before it.
+    fn chain_anchors(
+        &self,
+        mesh: &crate::Mesh,
+        first: u32,
+        mask: &[u8],
+        period: f64,
+    ) -> HashMap<(u32, u32), (f64, u32)> {
+        let neighbours = mesh.edge_neighbours();
+        let tris = mesh.triangles();
+        let listed: Vec<(u32, u8)> = (0..tris.len())
+            .flat_map(|t| (0..3u8).map(move |i| (t, i)))
+            .filter(|&(t, i)| {
+                let n = neighbours[t][usize::from(i)];
+                mask[t] & (1 << i) != 0 && (n == NO_NEIGHBOUR || (t as u32) < n)
+            })
+            .map(|(t, i)| (t as u32, i))
+            .collect();
+        let weld = crate::mesh::adjacency::weld_by_position(mesh.positions());
+        let chains = crate::mesh::chains::chains(mesh.positions(), tris, &listed);
+        let mut out = HashMap::new();
+        for chain in chains.iter().filter(|c| c.len() > 1) {
+            let mut position = 0.0;
+            for e in chain {
+                let i = usize::from(e.i);
+                let (a, b) = (tris[e.t as usize][i], tris[e.t as usize][(i + 1) % 3]);
+                let (wa, wb) = (weld[a as usize], weld[b as usize]);
+                let entry = if e.forward { wa } else { wb };
+                out.insert((wa.min(wb), wa.max(wb)), (position, entry));
+                let corners = self.caster.corners(first + e.t);
+                if let Some((_, p0, p1)) = self.span(corners[i], corners[(i + 1) % 3]) {
+                    position = (position + p0.xy.distance(p1.xy)).rem_euclid(period);
+                }
+            }
+        }
+        out
+    }
+
     /// The visible stretches (where `draw.visible`) and the dashes of the hidden stretches
     /// (where `draw.hidden`, in `hidden`'s pattern and width) of edge `i` of triangle `t`
-    /// (neighbour `n`; its pattern anchored at corner `i` when `a_first`, else at `i + 1`)
-    /// of the object whose first global id is `first`.
+    /// (neighbour `n`) of the object whose first global id is `first`; its pattern stands at
+    /// `anchor.0` at corner `i` when `anchor.1`, else at `i + 1` (or where a clip plane cuts
+    /// the edge short of that end), and runs towards the other end.
     fn stretches(
         &self,
         first: u32,
-        (t, i, n, a_first): (u32, u32, u32, bool),
+        (t, i, n, anchor): (u32, u32, u32, (f64, bool)),
         (object, (edge_width, outline_width)): (u32, (f64, f64)),
         draw: Draw,
         hidden: Option<crate::HiddenLines>,
@@ -325,23 +398,10 @@ impl Visibility<'_> {
         let none = (Vec::new(), Vec::new());
         let corners = self.caster.corners(first + t);
         let (a, b) = (corners[i as usize], corners[(i as usize + 1) % 3]);
-        let (ca, cb) = (self.rays.clip(a), self.rays.clip(b));
-        let depth = self.rays.rows().depth;
-        let (ha, hb) = (a.extend(1.0), b.extend(1.0));
         // In front of the near plane, not beyond the far plane.
-        let mut s = (0.0, 1.0);
-        keep_positive(&mut s, ca.z, cb.z);
-        keep_positive(&mut s, depth.dot(ha), depth.dot(hb));
-        if !(s.0 <= s.1) {
+        let Some((_, p0, p1)) = self.span(a, b) else {
             return none;
-        }
-        let fade = |h: DVec4| self.fade_row.dot(h);
-        let at = |k: f64| {
-            let c = ca.lerp(cb, k);
-            let f = fade(ha.lerp(hb, k));
-            self.project(c, f)
         };
-        let (p0, p1) = (at(s.0), at(s.1));
         // Within reach of the image: an edge just outside it still draws its line inside.
         let size = self.rays.size();
         let width = if draw.outline {
@@ -421,7 +481,7 @@ impl Visibility<'_> {
         let hidden = runs
             .iter()
             .filter(|r| r.2 == Class::Hidden)
-            .flat_map(|&(k0, k1, _)| dashes((k0, k1), full, a_first, (dash, period)))
+            .flat_map(|&(k0, k1, _)| dashes((k0, k1), full, anchor, (dash, period)))
             .map(|run| stretch(run, f64::from(h.width), false))
             .collect();
         (visible, hidden)
@@ -470,20 +530,27 @@ impl Visibility<'_> {
 
 /// The dashes of the pattern (dash, period; period 0 for solid) within the run `(k0, k1)` of
 /// an edge's parameter, where the whole (clipped) edge is `full` pixels long on screen and
-/// the pattern runs from parameter 0 (`a_first`) or 1. Dashes are the cores
-/// `[j·period, j·period + dash]` of pattern position, for every integer j; a dot is a dash
-/// of no length.
+/// the pattern stands at `start` at parameter 0 (`a_first`) or 1 and runs towards the other
+/// end. Dashes are the cores `[j·period, j·period + dash]` of pattern position, for every
+/// integer j; a dot is a dash of no length.
 fn dashes(
     (k0, k1): (f64, f64),
     full: f64,
-    a_first: bool,
+    (start, a_first): (f64, bool),
     (dash, period): (f64, f64),
 ) -> Vec<(f64, f64)> {
     if !(period > 0.0) || !(full > 0.0) {
         return vec![(k0, k1)];
     }
-    let position = |k: f64| if a_first { k * full } else { (1.0 - k) * full };
-    let parameter = |s: f64| if a_first { s / full } else { 1.0 - s / full };
+    let position = |k: f64| start + if a_first { k * full } else { (1.0 - k) * full };
+    let parameter = |s: f64| {
+        let s = s - start;
+        if a_first {
+            s / full
+        } else {
+            1.0 - s / full
+        }
+    };
     let (s0, s1) = {
         let (a, b) = (position(k0), position(k1));
         (a.min(b), a.max(b))
@@ -833,7 +900,7 @@ mod tests {
             },
             ..crate::HiddenLines::default()
         };
-        let edge = (0, 1, NO_NEIGHBOUR, true);
+        let edge = (0, 1, NO_NEIGHBOUR, (0.0, true));
         let (s, h) = vis.stretches(0, edge, (0, (1.5, 1.5)), draw, Some(hidden));
         assert_eq!(s.len(), 1, "{s:?}");
         let top_of_near = {
