@@ -255,7 +255,7 @@ fn outline_triangle(inst: u32, t: u32) {
         mode |= select(0u, DRAW_HIDDEN, hidden);
 #endif
         if mode != 0u {
-            list_outline(inst, t, i, n, a, b, pattern_anchor(inst, t, i, a, b, mode), mode);
+            list_outline(inst, t, i, n, a, b, mode);
         }
     }
 }
@@ -528,8 +528,10 @@ fn clip_outline(inst: u32, t: u32, n: u32, a: vec3<f32>, b: vec3<f32>, anchor: v
 // Lists the pieces of edge i (a -> b) of triangle t of `inst`, with neighbour n, that lie
 // within reach of the targets (of a tile) for outline_pieces_main, to draw as `mode` says
 // (DRAW_VISIBLE, DRAW_HIDDEN). Where the list is full the piece is drawn here.
-fn list_outline(inst: u32, t: u32, i: u32, n: u32, a: vec3<f32>, b: vec3<f32>, anchor: vec2<f32>, mode: u32) {
-    let c = clip_outline(inst, t, n, a, b, anchor);
+fn list_outline(inst: u32, t: u32, i: u32, n: u32, a: vec3<f32>, b: vec3<f32>, mode: u32) {
+    // The pattern's anchor only matters where a piece is drawn here (the piece pass finds it
+    // for the pieces it draws): looking it up for every listed edge would cost every lane.
+    let c = clip_outline(inst, t, n, a, b, vec2<f32>(0.0, 1.0));
     let visible_width = select(instances[slot(inst)].line_width, instances[slot(inst)].outline_width, (mode & DRAW_OUTLINE) != 0u);
     var reach = select(0.0, line_reach(visible_width), (mode & DRAW_VISIBLE) != 0u);
 #if HIDDEN
@@ -563,7 +565,8 @@ fn list_outline(inst: u32, t: u32, i: u32, n: u32, a: vec3<f32>, b: vec3<f32>, a
             atomicMax(&acc_rw[list], size.x);
             atomicMax(&acc_rw[list + 1u], size.y);
         } else {
-            draw_piece(c.seg, k0, k1, c.length_px, mode);
+            let anchored = clip_outline(inst, t, n, a, b, pattern_anchor(inst, t, i, a, b, mode));
+            draw_piece(anchored.seg, k0, k1, c.length_px, mode);
         }
     }
 }

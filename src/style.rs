@@ -142,10 +142,14 @@ impl Default for HiddenLines {
 
 /// A line pattern along an edge's projection, in pixels.
 ///
-/// Patterns are anchored to the geometry, not to the screen: the pattern's phase starts at
-/// the edge's end that comes first in (x, y, z) order of the mesh's coordinates (where that
-/// end lies behind the near plane, at the plane) and runs along its projection, so it does
-/// not crawl over the image as the camera moves.
+/// Patterns are anchored to the geometry, not to the screen, and run on along chains of
+/// drawn edges (edges joined where exactly two drawn edges meet): a chain starts at its end
+/// that comes first in (x, y, z) order of the mesh's coordinates (a closed one at its vertex
+/// that comes first), and the pattern stands on each edge where the projected length of the
+/// chain before it leaves it (where an edge's start lies behind the near plane, at the
+/// plane). So a circle of many short edges dashes evenly, and the pattern does not crawl
+/// over the image as the camera moves. Outlines that are not drawn edges (silhouettes) run
+/// their pattern from their end that comes first.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum LinePattern {
     /// The whole line.
