@@ -40,14 +40,12 @@ struct Frame {
     clusters: u32,
     // Host depth: 1 when the id target was seeded from the host's depth.
     host_depth: u32,
-    // Hidden lines (HIDDEN): 1 when those the host's depth hides are drawn too.
-    hidden_behind_host: u32,
+    _pad: u32,
     // Opacity of the shaded surface over the background (`see_through`).
     fill_opacity: f32,
-    // Hidden lines (HIDDEN): linear RGBA colour; width, dash and period of the pattern
-    // (period 0 for solid, `dash_nearest`) in pixels.
+    // Hidden lines (HIDDEN): linear RGBA colour of every instance's (without COLORS, they
+    // share one).
     hidden_color: vec4<f32>,
-    hidden_line: vec4<f32>,
     // Chains of drawn edges (HIDDEN with a pattern, `chain_phases`): words of the phase
     // tables in the outline buffer, chains over all instances, entries of `chain_work`.
     chain_work: vec4<u32>,
@@ -66,10 +64,15 @@ struct Instance {
     eye: vec4<f32>,
     // View depth (distance in front of the eye along the view axis) of a local point.
     fade_row: vec4<f32>,
-    // Rows of the local -> world normal matrix.
-    normal_x: vec4<f32>,
-    normal_y: vec4<f32>,
-    normal_z: vec4<f32>,
+    // Rows of the local -> world normal matrix, each with a number of the hidden-line
+    // pattern (INSTANCE_HIDDEN): its width, dash and period (0 for solid, `dash_nearest`) in
+    // pixels.
+    normal_x: vec3<f32>,
+    hidden_width: f32,
+    normal_y: vec3<f32>,
+    hidden_dash: f32,
+    normal_z: vec3<f32>,
+    hidden_period: f32,
     wire_color: vec4<f32>,
     // Linear RGBA of the shaded surface.
     fill_color: vec4<f32>,
@@ -84,8 +87,10 @@ struct Instance {
     cluster_first: u32,
     // This record's place in the instance buffer.
     index: u32,
-    // The outline's linear RGBA and width in pixels.
-    outline_color: vec4<f32>,
+    // The outline's and the hidden lines' linear RGBA as f16 (`unpack_color`); the outline's
+    // width in pixels.
+    outline_color: vec2<u32>,
+    hidden_color: vec2<u32>,
     outline_width: f32,
     // Its phase table (`chain_phases`): word offset among the frame's phase tables, and
     // log2 of its slots.
@@ -96,6 +101,14 @@ struct Instance {
 
 const INSTANCE_EDGES: u32 = 1u;
 const INSTANCE_OUTLINES: u32 = 2u;
+// Its hidden lines are drawn (HIDDEN); those the host's depth hides count as hidden.
+const INSTANCE_HIDDEN: u32 = 4u;
+const INSTANCE_BEHIND_HOST: u32 = 8u;
+
+// A colour packed as two pairs of f16 (src/gpu/frame.rs, pack_color).
+fn unpack_color(c: vec2<u32>) -> vec4<f32> {
+    return vec4<f32>(unpack2x16float(c.x), unpack2x16float(c.y));
+}
 
 // Instance ids of the id target, BACKGROUND_ID (background) and HOST_ID (host geometry in
 // front), are written before this file from `gpu::BACKGROUND_ID` and `gpu::HOST_ID`.

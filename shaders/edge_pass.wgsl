@@ -117,12 +117,18 @@ fn outline_at(xy: vec2<u32>) -> vec2<u32> {
     return vec2<u32>(key, owner);
 }
 
-// The key of the hidden line the outline pass left in target pixel `xy` (0 for none).
-fn hidden_at(xy: vec2<u32>) -> u32 {
+// The key of the hidden line the outline pass left in target pixel `xy` (0 for none), and
+// its owner word (COLORS: `hidden_color_of`; 0 otherwise).
+fn hidden_at(xy: vec2<u32>) -> vec2<u32> {
 #if HIDDEN
-    return acc[hidden_lines() + xy.y * u32(frame.target_size.x) + xy.x];
+    let k = xy.y * u32(frame.target_size.x) + xy.x;
+#if COLORS
+    return vec2<u32>(acc[hidden_lines() + 2u * k], acc[hidden_lines() + 2u * k + 1u]);
 #else
-    return 0u;
+    return vec2<u32>(acc[hidden_lines() + k], 0u);
+#endif
+#else
+    return vec2<u32>(0u);
 #endif
 }
 
@@ -463,8 +469,13 @@ fn store_pixel(xy: vec2<u32>, p: Pixel) {
     let i = p.line * p.wire.a;
     let hidden_key = hidden_at(xy);
 #if HIDDEN
-    let h = key_intensity(hidden_key) * frame.hidden_color.a;
-    let hidden = frame.hidden_color.rgb;
+#if COLORS
+    let hidden_color = hidden_color_of(hidden_key.y);
+#else
+    let hidden_color = frame.hidden_color;
+#endif
+    let h = key_intensity(hidden_key.x) * hidden_color.a;
+    let hidden = hidden_color.rgb;
 #endif
 #if MODE_SHADE
     var base = frame.background;
@@ -515,7 +526,7 @@ fn store_pixel(xy: vec2<u32>, p: Pixel) {
 #endif
 #if MODE_DIAGNOSTIC
     // b: the distance to the hidden line that colours the pixel (NO_EDGE for none).
-    textureStore(out_diagnostic, out, vec4<f32>(p.distance, p.depth, key_distance(hidden_key), 0.0));
+    textureStore(out_diagnostic, out, vec4<f32>(p.distance, p.depth, key_distance(hidden_key.x), 0.0));
     textureStore(out_ids, out, vec4<u32>(p.inst, p.tri, 0u, 0u));
 #endif
 }

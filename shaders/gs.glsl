@@ -38,9 +38,12 @@ struct Instance {
     vec4 depth_row;
     vec4 eye;
     vec4 fade_row;
-    vec4 normal_x;
-    vec4 normal_y;
-    vec4 normal_z;
+    vec3 normal_x;
+    float hidden_width;
+    vec3 normal_y;
+    float hidden_dash;
+    vec3 normal_z;
+    float hidden_period;
     vec4 wire_color;
     vec4 fill_color;
     float line_width;
@@ -51,7 +54,8 @@ struct Instance {
     uint cluster_base;
     uint cluster_first;
     uint index;
-    vec4 outline_color;
+    uvec2 outline_color;
+    uvec2 hidden_color;
     float outline_width;
     uint pad0;
     uint pad1;

@@ -114,7 +114,8 @@ fn outline_cull(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     let splats = (flags & INSTANCE_EDGES) != 0u && cluster_splats(cluster);
 #if HIDDEN
     // Every drawn edge in view has a hidden part to find.
-    let hidden = (flags & INSTANCE_EDGES) != 0u && cluster_draws(cluster) && cluster_in_view(instances[slot(inst)].clip, cluster);
+    let draws_hidden = (flags & (INSTANCE_EDGES | INSTANCE_HIDDEN)) == (INSTANCE_EDGES | INSTANCE_HIDDEN);
+    let hidden = draws_hidden && cluster_draws(cluster) && cluster_in_view(instances[slot(inst)].clip, cluster);
 #else
     let hidden = false;
 #endif
@@ -207,7 +208,8 @@ fn outline_triangle(inst: u32, t: u32) {
     let splat = select(0u, (bits >> 12u) & 7u, (flags & INSTANCE_EDGES) != 0u);
 #if HIDDEN
     // Drawn edges: their hidden parts, wherever they are.
-    let drawn = select(0u, bits & 7u, (flags & INSTANCE_EDGES) != 0u);
+    let hidden_lines = (flags & INSTANCE_HIDDEN) != 0u;
+    let drawn = select(0u, bits & 7u, (flags & INSTANCE_EDGES) != 0u && hidden_lines);
 #else
     let drawn = 0u;
 #endif
@@ -251,7 +253,7 @@ fn outline_triangle(inst: u32, t: u32) {
         var mode = select(0u, DRAW_VISIBLE, outline || splats) | select(0u, DRAW_OUTLINE, outline);
 #if HIDDEN
         // A shared drawn edge is drawn by the lower id only.
-        let hidden = outline || ((drawn & (1u << i)) != 0u && (n == BACKGROUND_ID || t < n));
+        let hidden = (outline && hidden_lines) || ((drawn & (1u << i)) != 0u && (n == BACKGROUND_ID || t < n));
         mode |= select(0u, DRAW_HIDDEN, hidden);
 #endif
         if mode != 0u {
@@ -337,7 +339,7 @@ fn chain_phases(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     let head = chains[work.chain_base + g - work.before];
     let table = phase_tables() + instances[slot(inst)].phase_table;
     let vbase = instances[slot(inst)].vertex_base;
-    let period = frame.hidden_line.z;
+    let period = instances[slot(inst)].hidden_period;
     var position = 0.0;
     for (var k = 0u; k < head.y; k++) {
         let e = chains[work.chain_base + head.x + k];
@@ -417,6 +419,8 @@ const RUN_BISECTIONS: u32 = 12u;
 // An edge is drawn in pieces of at most this many pixels, each with up to MAX_RUNS visible
 // runs (more is beyond any real mesh at this scale; the last run then absorbs the rest).
 const PIECE_PX: f32 = 16.0;
+// Pixels this far past a line's reach still get its key (`splat_runs`).
+const REACH_SLACK: f32 = 1e-3;
 const MAX_RUNS: u32 = 8u;
 
 // The screen segment of an outline edge, clipped to the view and the targets.
@@ -444,7 +448,8 @@ fn seg_class(s: Segment, k: f32) -> u32 {
     let w = 1.0 / q.inv_w;
     let c = class_at(q.xy, q.near_w * w, w, q.reverse, s.inst, s.t, s.n);
 #if HIDDEN
-    return select(c, 1u, c == 2u && frame.hidden_behind_host != 0u);
+    let behind_host = (instances[slot(s.inst)].flags & INSTANCE_BEHIND_HOST) != 0u;
+    return select(c, 1u, c == 2u && behind_host);
 #else
     return min(c, 1u);
 #endif
@@ -535,7 +540,7 @@ fn list_outline(inst: u32, t: u32, i: u32, n: u32, a: vec3<f32>, b: vec3<f32>, m
     let visible_width = select(instances[slot(inst)].line_width, instances[slot(inst)].outline_width, (mode & DRAW_OUTLINE) != 0u);
     var reach = select(0.0, line_reach(visible_width), (mode & DRAW_VISIBLE) != 0u);
 #if HIDDEN
-    reach = max(reach, select(0.0, line_reach(frame.hidden_line.x), (mode & DRAW_HIDDEN) != 0u));
+    reach = max(reach, select(0.0, line_reach(instances[slot(inst)].hidden_width), (mode & DRAW_HIDDEN) != 0u));
 #endif
     let first = frame.target_origin - reach;
     let last = frame.target_origin + frame.target_size + reach;
@@ -678,9 +683,10 @@ fn splat_runs(seg: Segment, k0: f32, k1: f32, runs: ptr<function, array<vec2<f32
     let hidden = kind == LINE_HIDDEN;
 #if HIDDEN
     if hidden {
-        width = frame.hidden_line.x;
-        pattern = frame.hidden_line.yz;
-        behind_host = frame.hidden_behind_host != 0u;
+        let inst = instances[slot(seg.inst)];
+        width = inst.hidden_width;
+        pattern = vec2<f32>(inst.hidden_dash, inst.hidden_period);
+        behind_host = (inst.flags & INSTANCE_BEHIND_HOST) != 0u;
     }
 #endif
     let reach = line_reach(width);
@@ -744,7 +750,9 @@ fn splat_runs(seg: Segment, k0: f32, k1: f32, runs: ptr<function, array<vec2<f32
                     best_k = kr;
                 }
             }
-            if !(best < reach) {
+            // Within reach, with room for f32's rounding: every pixel the f64 definition
+            // reaches gets the line (which is of no intensity out there).
+            if !(best < reach + REACH_SLACK) {
                 continue;
             }
             let q = seg_at(seg, best_k);
@@ -759,7 +767,12 @@ fn splat_runs(seg: Segment, k0: f32, k1: f32, runs: ptr<function, array<vec2<f32
             let index = u32(xy.y) * u32(frame.target_size.x) + u32(xy.x);
 #if HIDDEN
             if hidden {
+#if COLORS
+                atomicMax(&acc_rw[hidden_lines() + 2u * index], key);
+                atomicMax(&acc_rw[hidden_lines() + 2u * index + 1u], (key & 0xfff00000u) | seg.inst);
+#else
                 atomicMax(&acc_rw[hidden_lines() + index], key);
+#endif
                 continue;
             }
 #endif

@@ -52,10 +52,11 @@ const OWNER_OUTLINE: u32 = 0x80000u;
 // outline colour for an outline, its line colour for a drawn edge.
 fn owner_color(owner: u32) -> vec4<f32> {
     let i = slot(owner & (OWNER_OUTLINE - 1u));
-    return select(instances[i].wire_color, instances[i].outline_color, (owner & OWNER_OUTLINE) != 0u);
+    return select(instances[i].wire_color, unpack_color(instances[i].outline_color), (owner & OWNER_OUTLINE) != 0u);
 }
 
-// Word offset of the hidden lines (HIDDEN): the greatest `line_key` per target pixel.
+// Word offset of the hidden lines (HIDDEN): the greatest `line_key` per target pixel (with
+// COLORS, and its owner word, as the lines' are: `hidden_color_of`).
 fn hidden_lines() -> u32 {
     let pixels = u32(frame.target_size.x) * u32(frame.target_size.y);
 #if COLORS
@@ -65,10 +66,16 @@ fn hidden_lines() -> u32 {
 #endif
 }
 
+// The colour of the hidden line whose owner word (COLORS) is `owner`.
+fn hidden_color_of(owner: u32) -> vec4<f32> {
+    return unpack_color(instances[slot(owner & (OWNER_OUTLINE - 1u))].hidden_color);
+}
+
 // Word offset of the tile marks.
 fn outline_tile_marks() -> u32 {
 #if HIDDEN
-    return hidden_lines() + u32(frame.target_size.x) * u32(frame.target_size.y);
+    // The hidden lines take as many words as the lines.
+    return 2u * hidden_lines();
 #else
     return hidden_lines();
 #endif

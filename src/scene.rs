@@ -7,7 +7,7 @@
 use crate::camera::View;
 use crate::error::{Error, Result};
 use crate::gpu::MeshId;
-use crate::style::{Color, MAX_LINE_WIDTH};
+use crate::style::{Color, HiddenLines, MAX_LINE_WIDTH};
 use glam::DMat4;
 
 /// Most instances a frame may hold: instance slots must fit 19 bits of the outline pass's
@@ -37,6 +37,10 @@ pub struct InstanceStyle {
     /// Width of this instance's outline, in pixels; otherwise the style's
     /// [`outline_width`](crate::Style::outline_width), else this instance's line width.
     pub outline_width: Option<f32>,
+    /// This instance's hidden lines: `Some(Some(h))` draws them in `h` (also in a frame whose
+    /// style draws none, as for a selected part), `Some(None)` draws none of them; otherwise
+    /// the style's [`hidden`](crate::Style::hidden).
+    pub hidden: Option<Option<HiddenLines>>,
 }
 
 /// One placement of a mesh: which mesh, where (any affine model → world transform,
@@ -90,9 +94,19 @@ impl InstanceStyle {
             .unwrap_or(self.line_width.unwrap_or(style.line_width))
     }
 
+    /// The instance's hidden lines in `style`: its own, or the style's.
+    pub fn hidden_in(&self, style: &crate::Style) -> Option<HiddenLines> {
+        self.hidden.unwrap_or(style.hidden)
+    }
+
     /// Checks the overrides; `index` names the instance in errors.
     pub fn validate(&self, index: usize) -> Result<()> {
         let bad = |m: String| Err(Error::InvalidScene(format!("instance {index}: {m}")));
+        if let Some(Some(h)) = self.hidden {
+            if let Err(e) = h.validate() {
+                return bad(e.to_string());
+            }
+        }
         for (what, w) in [("line", self.line_width), ("outline", self.outline_width)] {
             if let Some(w) = w {
                 if !(0.0..=MAX_LINE_WIDTH).contains(&w) {

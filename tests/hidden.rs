@@ -336,3 +336,60 @@ fn dashes_run_on_along_a_chain_of_short_edges() {
         "three cylinders: {pixels} hidden-line pixels"
     );
 }
+
+/// Each instance's own hidden-line style (`InstanceStyle::hidden`): its colour, width and
+/// pattern, none at all, or the frame's; and a frame drawing none but for one instance (a
+/// selected part seen through the others).
+#[test]
+fn hidden_line_styles_per_instance() {
+    let mut world = cube_and_torus();
+    let dotted = HiddenLines {
+        pattern: LinePattern::Dotted { spacing: 4.0 },
+        color: Color([0.1, 0.3, 0.9, 1.0]),
+        width: 2.5,
+        behind_host: false,
+    };
+    let dashed = style(
+        LinePattern::Dashed {
+            dash: 6.0,
+            gap: 4.0,
+        },
+        1.0,
+    );
+    let view = perspective(&world, DVec3::new(2.5, 1.8, 3.2));
+    for (name, frame, cube, torus) in [
+        ("own and the frame's", &dashed, None, Some(Some(dotted))),
+        ("own and none", &dashed, Some(Some(dotted)), Some(None)),
+        (
+            "one instance only",
+            &Style::default(),
+            None,
+            Some(Some(dotted)),
+        ),
+    ] {
+        world.objects[0].style.hidden = cube;
+        world.objects[1].style.hidden = torus;
+        check(name, &world, view, frame);
+        // The hidden lines' colours: each instance's own, where the truth draws one.
+        let truth = shoot_world(&world, view, frame, SIZE, Method::Raycast);
+        let deferred = shoot_world(&world, view, frame, SIZE, Method::Deferred);
+        let (mut compared, mut worst) = (0, 0);
+        for i in 0..truth.ids.len() {
+            let lines = truth.hidden_distance[i] < 0.5 && truth.edge_distance[i] > 3.0;
+            if !lines || truth.ids[i] != deferred.ids[i] {
+                continue;
+            }
+            compared += 1;
+            let d = (0..4)
+                .map(|c| {
+                    (i32::from(truth.rgba[4 * i + c]) - i32::from(deferred.rgba[4 * i + c])).abs()
+                })
+                .max()
+                .unwrap();
+            worst = worst.max(d);
+        }
+        println!("{name}: {compared} hidden-line pixels, worst channel difference {worst}");
+        assert!(compared > 30, "{name}: {compared}");
+        assert!(worst <= 2, "{name}: worst channel difference {worst}");
+    }
+}

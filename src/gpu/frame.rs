@@ -32,10 +32,9 @@ pub(crate) struct FrameUniforms {
     triangle_split: u32,
     clusters: u32,
     host_depth: u32,
-    hidden_behind_host: u32,
+    _pad: u32,
     fill_opacity: f32,
     hidden_color: [f32; 4],
-    hidden_line: [f32; 4],
     chain_work: [u32; 4],
 }
 
@@ -47,7 +46,12 @@ pub(crate) struct InstanceRecord {
     depth_row: [f32; 4],
     eye: [f32; 4],
     fade_row: [f32; 4],
-    normal: [[f32; 4]; 3],
+    normal_x: [f32; 3],
+    hidden_width: f32,
+    normal_y: [f32; 3],
+    hidden_dash: f32,
+    normal_z: [f32; 3],
+    hidden_period: f32,
     wire_color: [f32; 4],
     fill_color: [f32; 4],
     line_width: f32,
@@ -58,7 +62,8 @@ pub(crate) struct InstanceRecord {
     cluster_base: u32,
     cluster_first: u32,
     index: u32,
-    outline_color: [f32; 4],
+    outline_color: [u32; 2],
+    hidden_color: [u32; 2],
     outline_width: f32,
     phase_table: u32,
     table_log2: u32,
@@ -69,6 +74,16 @@ pub(crate) struct InstanceRecord {
 const INSTANCE_EDGES: u32 = 1;
 /// `Instance.flags`: the instance's outline is drawn.
 const INSTANCE_OUTLINES: u32 = 2;
+/// `Instance.flags`: the instance's hidden lines are drawn.
+const INSTANCE_HIDDEN: u32 = 4;
+/// `Instance.flags`: the parts of its lines the host's depth hides are drawn as hidden.
+const INSTANCE_BEHIND_HOST: u32 = 8;
+
+/// A linear RGBA colour as WGSL's `unpack2x16float` reads it from two words.
+fn pack_color(c: [f32; 4]) -> [u32; 2] {
+    let h = |v: f32| u32::from(half::f16::from_f32(v).to_bits());
+    [h(c[0]) | h(c[1]) << 16, h(c[2]) | h(c[3]) << 16]
+}
 
 /// Instance records a uniform buffer holds (`scene.wgsl`, `UNIFORM_INSTANCES`): frames with
 /// up to this many bind them as uniforms, which software rasterizers read many times faster
@@ -112,9 +127,15 @@ pub fn guard_band(scene: &Scene<'_>, style: &Style) -> u32 {
     let widest = scene
         .instances
         .iter()
-        .flat_map(|i| [i.style.line_width, Some(i.style.outline_width_in(style))])
+        .flat_map(|i| {
+            let hidden = i.style.hidden_in(style).map(|h| h.width);
+            [
+                i.style.line_width,
+                Some(i.style.outline_width_in(style)),
+                hidden,
+            ]
+        })
         .flatten()
-        .chain(style.hidden.map(|h| h.width))
         .chain(style.outline_width)
         .fold(style.line_width, f32::max);
     (crate::style::line_reach(f64::from(widest)).ceil() as u32).saturating_add(2)
@@ -241,7 +262,7 @@ impl FrameRecords {
         let mut clusters = 0u64;
         let mut outlines = false;
         let mut patches = false;
-        let mut lines = false;
+        let mut hidden_styles = Vec::with_capacity(order.len());
         for (slot, &i) in order.iter().enumerate() {
             let instance = &scene.instances[i as usize];
             let mesh = store.record(instance.mesh)?;
@@ -251,9 +272,17 @@ impl FrameRecords {
             // The outline pass also draws the edges of large patches.
             outlines |= draws_outline || (draws_edges && mesh.lines.splat);
             patches |= draws_edges && mesh.lines.small_patches;
-            lines |= draws_outline || draws_edges;
+            // Hidden lines are drawn by the outline pass, from every drawn line in view.
+            let hidden = s.hidden_in(style).filter(|_| draws_outline || draws_edges);
+            outlines |= hidden.is_some();
             let flags = if draws_edges { INSTANCE_EDGES } else { 0 }
-                | if draws_outline { INSTANCE_OUTLINES } else { 0 };
+                | if draws_outline { INSTANCE_OUTLINES } else { 0 }
+                | if hidden.is_some() { INSTANCE_HIDDEN } else { 0 }
+                | if hidden.is_some_and(|h| h.behind_host) {
+                    INSTANCE_BEHIND_HOST
+                } else {
+                    0
+                };
             let wire = s.wire_color.unwrap_or(style.wire_color);
             let width = s.line_width.unwrap_or(style.line_width);
             let record = instance_record(
@@ -272,6 +301,8 @@ impl FrameRecords {
                 ),
                 (slot as u32, clusters as u32),
             );
+            let record = with_hidden(record, hidden);
+            hidden_styles.push(hidden);
             clusters += u64::from(mesh.clusters);
             records.push(record);
             let slot = slot as u32;
@@ -294,17 +325,16 @@ impl FrameRecords {
         }
         let clusters = u32::try_from(clusters)
             .map_err(|_| Error::InvalidScene(format!("{clusters} clusters over all instances")))?;
-        // Hidden lines are drawn by the outline pass, from every drawn edge in view.
-        let hidden = style.hidden.filter(|_| lines);
-        outlines |= hidden.is_some();
-        // A pattern runs along chains of drawn edges: each instance drawing edges of a mesh
-        // with chains gets a phase table in the outline buffer.
-        let patterned = hidden.is_some_and(|h| h.pattern.dash_period()[1] > 0.0);
+        let hidden_color = hidden_styles.iter().flatten().map(|h| h.color).next();
+        // A pattern runs along chains of drawn edges: each instance drawing patterned hidden
+        // lines along the edges of a mesh with chains gets a phase table in the outline
+        // buffer.
         let mut chain_work = Vec::new();
         let (mut phase_words, mut chains) = (0u64, 0u64);
         for (slot, record) in records.iter_mut().enumerate() {
             let mesh = store.record(scene.instances[order[slot] as usize].mesh)?;
-            if !patterned || record.flags & INSTANCE_EDGES == 0 || mesh.chains == 0 {
+            let wanted = INSTANCE_EDGES | INSTANCE_HIDDEN;
+            if record.hidden_period == 0.0 || record.flags & wanted != wanted || mesh.chains == 0 {
                 continue;
             }
             record.phase_table = u32::try_from(phase_words).map_err(|_| too_many_chains())?;
@@ -323,10 +353,18 @@ impl FrameRecords {
             .ok_or_else(too_many_chains)?;
         // The edge pass must know whose line, and of which class, each outline-pass pixel
         // holds where colours differ between instances or between an outline and its edges.
+        // Likewise for hidden lines whose colours differ between instances.
         let mixed_colors = records
             .windows(2)
             .any(|w| w[0].wire_color != w[1].wire_color)
-            || records.iter().any(|r| r.outline_color != r.wire_color);
+            || records
+                .iter()
+                .any(|r| r.outline_color != pack_color(r.wire_color))
+            || hidden_styles
+                .iter()
+                .flatten()
+                .any(|h| Some(h.color) != hidden_color);
+        let hidden = hidden_color.is_some();
 
         let buffers = store.buffers();
         let (gx, gy) = (guard as f64, guard as f64);
@@ -360,13 +398,10 @@ impl FrameRecords {
             triangle_split: buffers.split.triangles,
             clusters,
             host_depth: 0,
-            hidden_behind_host: u32::from(hidden.is_some_and(|h| h.behind_host)),
+            _pad: 0,
             fill_opacity: style.fill_opacity,
-            hidden_color: hidden.map_or([0.0; 4], |h| h.color.0),
-            hidden_line: hidden.map_or([0.0; 4], |h| {
-                let [dash, period] = h.pattern.dash_period();
-                [h.width, dash, period, 0.0]
-            }),
+            hidden_color: hidden_color.map_or([0.0; 4], |c| c.0),
+
             chain_work: [
                 if chain_work.is_empty() {
                     0
@@ -388,7 +423,7 @@ impl FrameRecords {
             guard,
             outlines,
             patches,
-            hidden: hidden.is_some(),
+            hidden,
             mixed_colors,
             chain_work,
         })
@@ -543,13 +578,18 @@ fn instance_record(
     }
     let local_eye = crate::edge_math::local_eye(model, eye);
     let normal = DMat3::from_mat4(transform).inverse().transpose();
-    let row = |m: DMat3, i: usize| m.row(i).as_vec3().extend(0.0).to_array();
+    let row = |i: usize| normal.row(i).as_vec3().to_array();
     InstanceRecord {
         clip: rows.clip.as_mat4().to_cols_array_2d(),
         depth_row: rows.depth.as_vec4().to_array(),
         eye: local_eye.as_vec4().to_array(),
         fade_row: (model.transpose() * fade_row).as_vec4().to_array(),
-        normal: [row(normal, 0), row(normal, 1), row(normal, 2)],
+        normal_x: row(0),
+        hidden_width: 0.0,
+        normal_y: row(1),
+        hidden_dash: 0.0,
+        normal_z: row(2),
+        hidden_period: 0.0,
         wire_color,
         fill_color,
         line_width,
@@ -560,11 +600,27 @@ fn instance_record(
         cluster_base: mesh.cluster_base,
         cluster_first,
         index: slot,
-        outline_color,
+        outline_color: pack_color(outline_color),
+        hidden_color: [0; 2],
         outline_width,
         phase_table: 0,
         table_log2: mesh.table_log2,
         _pad: 0,
+    }
+}
+
+/// `record` drawing the hidden lines `hidden`, if any.
+fn with_hidden(record: InstanceRecord, hidden: Option<crate::HiddenLines>) -> InstanceRecord {
+    let Some(h) = hidden else {
+        return record;
+    };
+    let [dash, period] = h.pattern.dash_period();
+    InstanceRecord {
+        hidden_width: h.width,
+        hidden_dash: dash,
+        hidden_period: period,
+        hidden_color: pack_color(h.color.0),
+        ..record
     }
 }
 
@@ -582,7 +638,7 @@ mod tests {
     #[test]
     fn records_match_their_wgsl_layout() {
         assert_eq!(std::mem::size_of::<InstanceRecord>(), 256);
-        assert_eq!(std::mem::size_of::<FrameUniforms>(), 192);
+        assert_eq!(std::mem::size_of::<FrameUniforms>(), 176);
         let r = InstanceRecord::zeroed_for_test();
         let base = &r as *const _ as usize;
         assert_eq!(

@@ -94,7 +94,7 @@ pub(crate) struct Targets {
     pub ids: wgpu::Texture,
     pub depth: wgpu::Texture,
     /// The outline buffer (`outline_tile_marks` in scene.wgsl): one u32 per target pixel,
-    /// or two where instances differ in line colour, and one more for hidden lines where
+    /// or two where instances differ in line colour, and as many more for hidden lines where
     /// they are drawn; a mark per output tile; the list of
     /// the tiles the lines reach, from byte `acc_tiles`; the phase tables of chains of drawn
     /// edges (`chain_phases` in outline.wgsl), from byte `acc_phases`; the outline pass's
@@ -164,7 +164,7 @@ impl Targets {
         // then room for a piece per PIXELS_PER_PIECE target pixels (at least MIN_PIECES),
         // less where the binding limit leaves less (the outline pass draws the pieces it has
         // no room for itself).
-        let words = 1 + u64::from(spec.acc_colors) + u64::from(spec.acc_hidden);
+        let words = (1 + u64::from(spec.acc_colors)) * (1 + u64::from(spec.acc_hidden));
         let acc_tiles = pixels * 4 * words + 4 * tiles;
         let acc_phases = acc_tiles + LIST_HEADER + 4 * tiles;
         let acc_pieces = acc_phases + 4 * u64::from(spec.acc_phase_words);

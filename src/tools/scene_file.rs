@@ -27,6 +27,10 @@
 //! - `outlines`, `wire_color`, `outline_color` and `fill_color` (`#rrggbb[aa]`, sRGB; the
 //!   fill's alpha is unused), `line_width` and `outline_width` (pixels): per-object overrides
 //!   of the command line's style.
+//! - `hidden` (`off`, `solid`, `dashed[:DASH,GAP]`, `dotted[:SPACING]`), `hidden_color` and
+//!   `hidden_width`: the object's own hidden lines (drawn whatever the frame's), what it
+//!   leaves out taken from the file's `style`, else the defaults; `"hidden": "off"` draws
+//!   none of its hidden lines.
 //! - `style` (optional): the frame's `hidden` (`off`, `solid`, `dashed[:DASH,GAP]`,
 //!   `dotted[:SPACING]`), `hidden_color`, `hidden_width`, `fill_opacity`, `outline_color` and
 //!   `outline_width`, where the command line does not set them.
@@ -126,7 +130,7 @@ pub fn load(
             )));
         }
     }
-    let style = match top.get("style") {
+    let file_style = match top.get("style") {
         None => FileStyle::default(),
         Some(v) => file_style(v).map_err(|m| fail(format!("style{m}")))?,
     };
@@ -157,12 +161,16 @@ pub fn load(
                 "line_width",
                 "outline_color",
                 "outline_width",
+                "hidden",
+                "hidden_color",
+                "hidden_width",
             ]
             .contains(&key.as_str())
             {
                 return Err(fail(format!(
                     "{}: unknown field (mesh, transform, edges, outlines, wire_color, \
-                     fill_color, line_width, outline_color, outline_width)",
+                     fill_color, line_width, outline_color, outline_width, hidden, \
+                     hidden_color, hidden_width)",
                     field(key)
                 )));
             }
@@ -241,6 +249,36 @@ pub fn load(
         };
         style.line_width = width("line_width")?;
         style.outline_width = width("outline_width")?;
+        // The object's own hidden lines; what it leaves out comes from the file's style,
+        // else the defaults.
+        let pattern = match o.get("hidden") {
+            None => None,
+            Some(v) => Some(
+                v.as_str()
+                    .ok_or_else(|| fail(format!("{}: not a string", field("hidden"))))
+                    .and_then(|t| {
+                        LinePattern::parse(t).map_err(|e| fail(format!("{}: {e}", field("hidden"))))
+                    })?,
+            ),
+        };
+        let (hidden_color, hidden_width) = (color("hidden_color")?, width("hidden_width")?);
+        if pattern.is_some() || hidden_color.is_some() || hidden_width.is_some() {
+            let pattern = pattern
+                .or(file_style.hidden)
+                .unwrap_or(Some(crate::style::HiddenLines::default().pattern));
+            style.hidden = Some(pattern.map(|pattern| {
+                crate::style::HiddenLines {
+                    pattern,
+                    color: hidden_color
+                        .or(file_style.hidden_color)
+                        .unwrap_or(crate::style::HiddenLines::default().color),
+                    width: hidden_width
+                        .or(file_style.hidden_width)
+                        .unwrap_or(crate::style::HiddenLines::default().width),
+                    behind_host: false,
+                }
+            }));
+        }
         style
             .validate(i)
             .map_err(|e| fail(format!("objects[{i}]: {e}")))?;
@@ -258,7 +296,7 @@ pub fn load(
     Ok(SceneFile {
         world,
         camera,
-        style,
+        style: file_style,
     })
 }
 
@@ -538,7 +576,9 @@ mod tests {
                 {"mesh": "sphere:200", "transform": {"translate": [3, 0, 0]}, "edges": "none",
                  "wire_color": "#ff0000", "line_width": 3, "fill_color": "#00ff00"},
                 {"mesh": "sphere:200", "edges": "all", "outlines": false},
-                {"mesh": "sphere:200", "outline_color": "#0000ff", "outline_width": 4}
+                {"mesh": "sphere:200", "outline_color": "#0000ff", "outline_width": 4,
+                 "hidden": "dashed:5,2", "hidden_width": 2},
+                {"mesh": "sphere:200", "hidden": "off"}
             ],
             "camera": {"eye": [0, 0, 5], "orthographic": {"height": 4, "near": 0.1, "far": 20}},
             "style": {"hidden": "dotted:3", "fill_opacity": 0.25, "outline_width": 2}}"##,
@@ -558,7 +598,21 @@ mod tests {
             }
         );
         assert_eq!(world.meshes.len(), 2, "same mesh and edges load once");
-        assert_eq!(world.objects.len(), 4);
+        assert_eq!(world.objects.len(), 5);
+        // Its own pattern and width, the colour a default, as the file's style gives none.
+        assert_eq!(
+            world.objects[3].style.hidden,
+            Some(Some(crate::HiddenLines {
+                pattern: LinePattern::Dashed {
+                    dash: 5.0,
+                    gap: 2.0
+                },
+                width: 2.0,
+                ..crate::HiddenLines::default()
+            }))
+        );
+        assert_eq!(world.objects[4].style.hidden, Some(None));
+        assert_eq!(world.objects[0].style.hidden, None);
         assert_eq!(world.objects[3].style.outline_width, Some(4.0));
         assert_eq!(
             world.objects[3].style.outline_color,
@@ -601,6 +655,14 @@ mod tests {
             (
                 r#"{"objects": [{"mesh": "sphere:100", "line_width": 1000}]}"#,
                 "line width 1000",
+            ),
+            (
+                r#"{"objects": [{"mesh": "sphere:100", "hidden": "wavy"}]}"#,
+                "objects[0].hidden",
+            ),
+            (
+                r#"{"objects": [{"mesh": "sphere:100", "hidden_width": -1}]}"#,
+                "hidden line width -1",
             ),
             (
                 r#"{"objects": [{"mesh": "sphere:100", "fill_color": "green"}]}"#,

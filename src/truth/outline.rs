@@ -93,6 +93,10 @@ struct Stretch {
     width: f64,
     /// An outline's line, not an edge's (hidden lines: false).
     outline: bool,
+    /// A hidden line drawn over the host's surface ([`HiddenLines::behind_host`]).
+    ///
+    /// [`HiddenLines::behind_host`]: crate::HiddenLines::behind_host
+    over_host: bool,
 }
 
 /// What a listed edge draws: its visible parts (an outline, or a drawn edge of a large
@@ -116,13 +120,11 @@ pub(crate) fn outline_map(
     host: Option<&HostMap>,
 ) -> OutlineMap {
     let world = caster.world();
-    let hidden = shot.style.hidden;
     let view = Visibility {
         caster,
         rays,
         fade_row: shot.view.view_depth_row(),
         host,
-        behind_host: hidden.is_some_and(|h| h.behind_host),
     };
     let view = &view;
     let eye = shot.view.eye();
@@ -132,6 +134,7 @@ pub(crate) fn outline_map(
         .enumerate()
         .filter(|(o, _)| styles[*o].outlines || styles[*o].edges)
         .flat_map(|(o, object)| {
+            let hidden = styles[o].hidden;
             let mesh = &world.meshes[object.mesh].mesh;
             let local = edge_math::local_eye(object.transform, eye);
             let first = caster.first_ids()[o];
@@ -219,13 +222,8 @@ pub(crate) fn outline_map(
     let fade = shot.style.fade_range().map(f64::from);
     let visible: Vec<Stretch> = visible.into_iter().flatten().collect();
     let line = splat(&visible, shot.size, fade, host);
-    let hidden = match hidden {
-        Some(h) => {
-            let stretches: Vec<Stretch> = hidden_stretches.into_iter().flatten().collect();
-            splat(&stretches, shot.size, fade, host.filter(|_| !h.behind_host))
-        }
-        None => vec![None; line.len()],
-    };
+    let stretches: Vec<Stretch> = hidden_stretches.into_iter().flatten().collect();
+    let hidden = splat(&stretches, shot.size, fade, host);
     OutlineMap { line, hidden }
 }
 
@@ -263,6 +261,7 @@ fn splat(
                     }
                     let near_w = s.near_w[0] + (s.near_w[1] - s.near_w[0]) * at;
                     // The pixel shows the host, and its surface is in front of the line's point.
+                    let host = host.filter(|_| !s.over_host);
                     if host.is_some_and(|h| h.hides_line((x, y), 1.0 - near_w, d)) {
                         continue;
                     }
@@ -304,10 +303,6 @@ struct Visibility<'a> {
     fade_row: DVec4,
     /// The host's depth, if the host gave it.
     host: Option<&'a HostMap>,
-    /// Points the host hides count as hidden ([`HiddenLines::behind_host`]), not as neither.
-    ///
-    /// [`HiddenLines::behind_host`]: crate::HiddenLines::behind_host
-    behind_host: bool,
 }
 
 /// What a point of a line is: visible, hidden by a surface (or by the host, for hidden lines
@@ -419,10 +414,11 @@ impl Visibility<'_> {
             return none;
         }
         let point = |k: f64| p0.lerp(&p1, k);
+        let behind_host = hidden.is_some_and(|h| draw.hidden && h.behind_host);
         let class = |k: f64| {
             let q = point(k);
             let w = 1.0 / q.inv_w;
-            self.class(q.xy, (q.near_w * w, w), first, (t, n))
+            self.class(q.xy, (q.near_w * w, w), first, (t, n), behind_host)
         };
 
         // Runs of one class, as (from, to, class) in parameters of p0 → p1.
@@ -453,7 +449,7 @@ impl Visibility<'_> {
         }
         runs.push((start, u.1, last.1));
 
-        let stretch = |(k0, k1): (f64, f64), width: f64, outline: bool| {
+        let stretch = |(k0, k1): (f64, f64), width: f64, (outline, over_host): (bool, bool)| {
             let (q0, q1) = (point(k0), point(k1));
             Stretch {
                 from: q0.xy,
@@ -464,12 +460,13 @@ impl Visibility<'_> {
                 object,
                 width,
                 outline,
+                over_host,
             }
         };
         let visible = runs
             .iter()
             .filter(|r| draw.visible && r.2 == Class::Visible)
-            .map(|&(k0, k1, _)| stretch((k0, k1), width, draw.outline))
+            .map(|&(k0, k1, _)| stretch((k0, k1), width, (draw.outline, false)))
             .collect();
         let Some(h) = hidden.filter(|_| draw.hidden) else {
             return (visible, Vec::new());
@@ -482,7 +479,7 @@ impl Visibility<'_> {
             .iter()
             .filter(|r| r.2 == Class::Hidden)
             .flat_map(|&(k0, k1, _)| dashes((k0, k1), full, anchor, (dash, period)))
-            .map(|run| stretch(run, f64::from(h.width), false))
+            .map(|run| stretch(run, f64::from(h.width), (false, h.behind_host)))
             .collect();
         (visible, hidden)
     }
@@ -501,12 +498,20 @@ impl Visibility<'_> {
         }
     }
 
-    /// What the edge's point at screen point `x` (near row and w) is: hidden by the host where
-    /// [`HostMap::hides_point`] says so, hidden by a triangle other than `t` and `n` of the
-    /// object (first id `first`) that covers `x` nearer than that point, else visible.
-    fn class(&self, x: DVec2, (near, w): (f64, f64), first: u32, (t, n): (u32, u32)) -> Class {
+    /// What the edge's point at screen point `x` (near row and w) is: where
+    /// [`HostMap::hides_point`] says so hidden by the host (`behind_host`: counted as hidden,
+    /// else neither drawn), hidden by a triangle other than `t` and `n` of the object (first
+    /// id `first`) that covers `x` nearer than that point, else visible.
+    fn class(
+        &self,
+        x: DVec2,
+        (near, w): (f64, f64),
+        first: u32,
+        (t, n): (u32, u32),
+        behind_host: bool,
+    ) -> Class {
         if self.host.is_some_and(|h| h.hides_point(x, 1.0 - near / w)) {
-            return if self.behind_host {
+            return if behind_host {
                 Class::Hidden
             } else {
                 Class::Neither
@@ -884,7 +889,6 @@ mod tests {
             rays: &rays,
             fade_row: view.view_depth_row(),
             host: None,
-            behind_host: false,
         };
         // Triangle 0's edge 1 runs from (1, -1) to (1, 1): visible only above y = 0, i.e. on
         // screen from the middle row up, ending where the near quad's top edge crosses it.

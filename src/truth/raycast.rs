@@ -190,8 +190,6 @@ struct Shading {
     background: Color,
     ambient: f64,
     fade: [f64; 2],
-    /// The hidden lines' colour, where they are drawn.
-    hidden: Option<[f64; 4]>,
     fill_opacity: f64,
 }
 
@@ -205,7 +203,6 @@ impl Shading {
             background: s.background,
             ambient: f64::from(s.ambient),
             fade: s.fade_range().map(f64::from),
-            hidden: s.hidden.map(|h| h.color.0.map(f64::from)),
             fill_opacity: f64::from(s.fill_opacity),
         }
     }
@@ -245,9 +242,13 @@ impl Truth<'_> {
         let sh = self.shading;
         // The hidden line goes over what is below, under the visible line (twin of
         // `store_pixel` in edge_pass.wgsl).
-        let (h, hidden_rgb) = match (hidden, sh.hidden) {
-            (Some(l), Some(c)) => (l.intensity * c[3], [c[0], c[1], c[2]]),
-            _ => (0.0, [0.0; 3]),
+        let hidden_color = |l: &Line| self.styles[l.object as usize].hidden.map(|h| h.color.0);
+        let (h, hidden_rgb) = match hidden.and_then(|l| Some((l, hidden_color(&l)?))) {
+            Some((l, c)) => {
+                let c = c.map(f64::from);
+                (l.intensity * c[3], [c[0], c[1], c[2]])
+            }
+            None => (0.0, [0.0; 3]),
         };
         let under = |base: [f64; 3]| [0, 1, 2].map(|k| base[k] + (hidden_rgb[k] - base[k]) * h);
         let world = self.caster.world();

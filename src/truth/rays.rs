@@ -295,6 +295,8 @@ pub(crate) struct ObjectStyle {
     pub width: f64,
     pub edges: bool,
     pub outlines: bool,
+    /// Its hidden lines, where it draws any lines.
+    pub hidden: Option<style::HiddenLines>,
     /// Model → world normal matrix.
     pub normal: DMat3,
 }
@@ -320,6 +322,9 @@ impl ObjectStyle {
                 width: f64::from(o.style.line_width.unwrap_or(style.line_width)),
                 edges: o.style.edges.unwrap_or(true),
                 outlines: o.style.outlines.unwrap_or(style.silhouettes),
+                hidden: o.style.hidden_in(style).filter(|_| {
+                    o.style.edges.unwrap_or(true) || o.style.outlines.unwrap_or(style.silhouettes)
+                }),
                 normal: DMat3::from_mat4(o.transform).inverse().transpose(),
             })
             .collect()
