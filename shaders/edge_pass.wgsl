@@ -98,6 +98,18 @@ struct Pixel {
     surface: vec3<f32>,
     // Reverse depth of the visible point (0 where none).
     depth: f32,
+    // The line's class: 0 none, LINE_CLASS_EDGE, LINE_CLASS_OUTLINE.
+    kind: u32,
+}
+
+// Line classes of the diagnostic map's a channel (src/world/offscreen.rs, LineClass).
+const LINE_CLASS_EDGE: u32 = 1u;
+const LINE_CLASS_OUTLINE: u32 = 2u;
+const LINE_CLASS_HIDDEN: u32 = 3u;
+
+// The class of the outline pass's line with owner word `owner` (COLORS; an edge without).
+fn owner_kind(owner: u32) -> u32 {
+    return select(LINE_CLASS_EDGE, LINE_CLASS_OUTLINE, (owner & OWNER_OUTLINE) != 0u);
 }
 
 // The line the outline pass left in target pixel `xy`: its key (0 for none) and its owner
@@ -146,10 +158,12 @@ fn empty_pixel(xy: vec2<u32>, inst: u32, outline: vec2<u32>) -> Pixel {
         p.distance = NO_EDGE;
         p.line = 0.0;
         p.wire = instances[slot(min(inst, frame.instances - 1u))].wire_color;
+        p.kind = 0u;
     } else {
         p.distance = key_distance(outline.x);
         p.line = key_intensity(outline.x);
         p.wire = owner_color(outline.y);
+        p.kind = owner_kind(outline.y);
     }
     return p;
 }
@@ -454,10 +468,12 @@ fn surface_pixel(xy: vec2<u32>, s: Sample, own: f32) -> Pixel {
         p.distance = own;
         p.line = own_line;
         p.wire = instances[slot(inst)].wire_color;
+        p.kind = LINE_CLASS_EDGE;
     } else {
         p.distance = key_distance(outline.x);
         p.line = key_intensity(outline.x);
         p.wire = owner_color(outline.y);
+        p.kind = owner_kind(outline.y);
     }
     return p;
 }
@@ -525,8 +541,13 @@ fn store_pixel(xy: vec2<u32>, p: Pixel) {
     textureStore(out_color, out, color);
 #endif
 #if MODE_DIAGNOSTIC
-    // b: the distance to the hidden line that colours the pixel (NO_EDGE for none).
-    textureStore(out_diagnostic, out, vec4<f32>(p.distance, p.depth, key_distance(hidden_key.x), 0.0));
+    // b: the distance to the hidden line that colours the pixel (NO_EDGE for none); a: the
+    // class of the line that colours it most (the visible one where they tie).
+    var kind = select(0u, p.kind, i > 0.0);
+#if HIDDEN
+    kind = select(kind, LINE_CLASS_HIDDEN, h > i);
+#endif
+    textureStore(out_diagnostic, out, vec4<f32>(p.distance, p.depth, key_distance(hidden_key.x), f32(kind)));
     textureStore(out_ids, out, vec4<u32>(p.inst, p.tri, 0u, 0u));
 #endif
 }

@@ -230,4 +230,22 @@ pub struct Rendering {
     ///
     /// [`Style::hidden`]: crate::Style::hidden
     pub hidden_distance: Vec<f32>,
+    /// The class of the line that colours each pixel most ([`LineClass`] as a byte; the
+    /// visible line where a visible and a hidden one colour it alike); empty for methods
+    /// that do not tell line classes apart (the baselines).
+    pub line_class: Vec<u8>,
+}
+
+/// The class of a pixel's line in [`Rendering::line_class`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u8)]
+pub enum LineClass {
+    /// No line colours the pixel.
+    None = 0,
+    /// A drawn edge (the edges the selection draws).
+    Edge = 1,
+    /// An outline: a silhouette or a boundary.
+    Outline = 2,
+    /// A hidden line ([`Style::hidden`](crate::Style::hidden)).
+    Hidden = 3,
 }

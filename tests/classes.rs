@@ -191,3 +191,51 @@ fn outline_styles_that_cannot_make_an_image_are_errors() {
     };
     assert!(instance.validate(0).is_err());
 }
+
+/// The line-class map (`Rendering::line_class`, `--dump`'s `line_class.npy`): which class of
+/// line colours each pixel most, drawn edge, outline or hidden line, as the ground truth
+/// says.
+#[test]
+fn line_class_maps_match_the_ground_truth() {
+    use wirepass::world::LineClass;
+    let world = world();
+    let view = view(&world);
+    let style = Style {
+        outline_color: Some(Color([0.05, 0.1, 0.9, 1.0])),
+        hidden: Some(wirepass::HiddenLines::default()),
+        ..Style::default()
+    };
+    let truth = shoot_world(&world, view, &style, SIZE, Method::Raycast);
+    let frame = shoot_world(&world, view, &style, SIZE, Method::Deferred);
+    assert_eq!(frame.line_class.len(), frame.ids.len());
+    let (mut lined, mut agree) = (0, 0);
+    let mut counts = [0usize; 4];
+    for i in 0..truth.ids.len() {
+        let (t, f) = (truth.line_class[i], frame.line_class[i]);
+        if truth.ids[i] != frame.ids[i] || (t == 0 && f == 0) {
+            continue;
+        }
+        lined += 1;
+        counts[usize::from(t)] += 1;
+        agree += usize::from(t == f);
+        if t != f {
+            println!(
+                "  ({}, {}): truth {t} frame {f}, distances {} / {}, hidden {} / {}",
+                i % SIZE.0 as usize,
+                i / SIZE.0 as usize,
+                truth.edge_distance[i],
+                frame.edge_distance[i],
+                truth.hidden_distance[i],
+                frame.hidden_distance[i]
+            );
+        }
+    }
+    let share = agree as f64 / lined as f64;
+    let measured = wirepass::truth::accuracy::line_class_agreement(&truth, &frame).unwrap();
+    assert_eq!(measured, Some(share));
+    println!("{agree} of {lined} line pixels agree ({share:.5}); truth classes {counts:?}");
+    for class in [LineClass::Edge, LineClass::Outline, LineClass::Hidden] {
+        assert!(counts[class as usize] > 300, "{class:?}: {counts:?}");
+    }
+    assert!(share >= 0.999, "{share}");
+}

@@ -204,8 +204,9 @@ struct RenderArgs {
     #[arg(short, long, default_value = "wireframe.png")]
     output: PathBuf,
     /// Also write ids.npy (global triangle ids), depth.npy, edge_distance.npy,
-    /// hidden_distance.npy and camera.json (the view and projection matrices used) into this
-    /// directory.
+    /// hidden_distance.npy, line_class.npy (deferred and raycast: 0 no line, 1 drawn edge, 2
+    /// outline, 3 hidden line) and camera.json (the view and projection matrices used) into
+    /// this directory.
     #[arg(long)]
     dump: Option<PathBuf>,
 }

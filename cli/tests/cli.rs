@@ -40,6 +40,7 @@ fn renders_the_built_in_scene_and_dumps_numpy_files() {
         ("depth.npy", "<f4"),
         ("edge_distance.npy", "<f4"),
         ("hidden_distance.npy", "<f4"),
+        ("line_class.npy", "|u1"),
     ] {
         let bytes = std::fs::read(dump.join(name)).unwrap();
         assert_eq!(&bytes[..6], b"\x93NUMPY", "{name}");
@@ -49,7 +50,8 @@ fn renders_the_built_in_scene_and_dumps_numpy_files() {
             "{name}: {header}"
         );
         let payload = bytes.len() - (10 + u16::from_le_bytes([bytes[8], bytes[9]]) as usize);
-        assert_eq!(payload, 48 * 64 * 4, "{name}");
+        let bytes_per_pixel = if descr == "|u1" { 1 } else { 4 };
+        assert_eq!(payload, 48 * 64 * bytes_per_pixel, "{name}");
     }
     let camera: serde_json::Value =
         serde_json::from_slice(&std::fs::read(dump.join("camera.json")).unwrap()).unwrap();

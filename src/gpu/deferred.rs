@@ -385,7 +385,10 @@ impl DeferredPass {
             style
         };
         let records = FrameRecords::new(device, store, scene, style, region, true)?;
-        let data = FrameData::new(device, store, records);
+        let mut data = FrameData::new(device, store, records);
+        // The diagnostic map names the class of each pixel's line, which the outline pass's
+        // owner words tell apart (the image is the same with them).
+        data.mixed_colors |= self.diagnostics;
         let host = match &canvas.host_depth {
             Some(h) => Some(self.host.prepare(device, h, &scene.view, region.image)?),
             None => None,

@@ -43,6 +43,10 @@ pub struct Metrics {
     /// Hidden-line distance error ([`Rendering::hidden_distance`]); no pixels where the
     /// reference draws no hidden lines.
     pub hidden_distance_error_px: DistanceError,
+    /// Agreement of the line-class maps
+    /// ([`accuracy::line_class_agreement`](crate::truth::accuracy::line_class_agreement));
+    /// `None` for methods that report no classes.
+    pub line_class_agreement: Option<f64>,
     /// FLIP difference of the final images.
     pub image_difference: ImageDifference,
 }
@@ -63,6 +67,7 @@ pub fn metrics(reference: &Rendering, frame: &Rendering) -> Result<Metrics> {
         coverage_agreement,
         distance_error_px,
         hidden_distance_error_px,
+        line_class_agreement: crate::truth::accuracy::line_class_agreement(reference, frame)?,
         image_difference: ImageDifference {
             flip_mean,
             flip_p99: percentile(&flip, 0.99).unwrap_or(0.0),
@@ -471,6 +476,22 @@ pub fn table(report: &Report) -> String {
             ));
         }
     }
+    // How often each method's line class (edge, outline, hidden) is the reference's.
+    let classes: Vec<_> = report
+        .rows
+        .iter()
+        .filter_map(|(m, r)| match r {
+            MethodReport::Measured { metrics, .. } => Some((m, metrics.line_class_agreement?)),
+            MethodReport::Skipped { .. } => None,
+        })
+        .collect();
+    if !classes.is_empty() {
+        lines.push(String::new());
+        lines.push(format!("{:<10} {:>12}", "classes", "class agree"));
+        for (m, a) in classes {
+            lines.push(format!("{:<10} {:>12.5}", m.name(), a));
+        }
+    }
     lines.join("\n")
 }
 
@@ -487,6 +508,7 @@ mod tests {
             depth: vec![0.5; n],
             edge_distance: d,
             hidden_distance: vec![f32::INFINITY; n],
+            line_class: Vec::new(),
         }
     }
 

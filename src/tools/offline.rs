@@ -128,7 +128,11 @@ fn read_frame(
         device, queue, shot, out, order, output, maps,
     ));
     ctx.finish()?;
-    read
+    // The baselines tell no line classes apart.
+    read.map(|r| Rendering {
+        line_class: Vec::new(),
+        ..r
+    })
 }
 
 /// The forward baselines render to an sRGB render attachment: the hardware blends in linear
@@ -248,8 +252,9 @@ impl Rendering {
         crate::tools::regression::save_rgba_png(path, &self.rgba, self.size)
     }
 
-    /// Writes `ids.npy`, `depth.npy`, `edge_distance.npy`, `hidden_distance.npy` and
-    /// `camera.json` into `dir`.
+    /// Writes `ids.npy`, `depth.npy`, `edge_distance.npy`, `hidden_distance.npy`,
+    /// `line_class.npy` (for methods that report it: [`crate::world::LineClass`] per pixel)
+    /// and `camera.json` into `dir`.
     pub fn dump(&self, dir: &Path, view: &View) -> Result<()> {
         std::fs::create_dir_all(dir).map_err(|source| Error::Io {
             path: dir.to_owned(),
@@ -264,6 +269,9 @@ impl Rendering {
             &shape,
             &self.hidden_distance,
         )?;
+        if !self.line_class.is_empty() {
+            write_npy(&dir.join("line_class.npy"), &shape, &self.line_class)?;
+        }
         let path = dir.join("camera.json");
         let text = camera_json(view, self.size);
         std::fs::write(&path, text).map_err(|source| Error::Io { path, source })

@@ -88,6 +88,25 @@ fn summarise(errors: Vec<Option<f64>>) -> DistanceError {
     }
 }
 
+/// Among pixels whose ids agree and where either side has a line, the fraction whose
+/// [`Rendering::line_class`] (the class of the line that colours the pixel most) equals the
+/// reference's; `None` where a side reports no classes or no pixel qualifies.
+pub fn line_class_agreement(reference: &Rendering, frame: &Rendering) -> Result<Option<f64>> {
+    check_same_shape(reference, frame)?;
+    let (t, f) = (&reference.line_class, &frame.line_class);
+    if t.len() != reference.ids.len() || f.len() != frame.ids.len() {
+        return Ok(None);
+    }
+    let (mut lined, mut agree) = (0usize, 0usize);
+    for i in 0..t.len() {
+        if reference.ids[i] == frame.ids[i] && (t[i] != 0 || f[i] != 0) {
+            lined += 1;
+            agree += usize::from(t[i] == f[i]);
+        }
+    }
+    Ok((lined > 0).then(|| agree as f64 / lined as f64))
+}
+
 /// Nearest-rank percentile of sorted values.
 pub fn percentile(sorted: &[f64], q: f64) -> Option<f64> {
     if sorted.is_empty() {

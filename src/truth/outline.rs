@@ -269,15 +269,32 @@ fn splat(
                     let depth = (s.depth_w[0] + (s.depth_w[1] - s.depth_w[0]) * at) / inv_w;
                     let intensity = line_intensity(d, s.width) * depth_fade(depth, fade);
                     let key = line_key(intensity, d);
-                    if out.is_none_or(|l| key > l.key) {
-                        *out = Some(Line {
-                            key,
-                            distance: d,
-                            intensity,
-                            object: s.object,
-                            outline: s.outline,
-                        });
-                    }
+                    let line = Line {
+                        key,
+                        distance: d,
+                        intensity,
+                        object: s.object,
+                        outline: s.outline,
+                    };
+                    // The greatest key gives the distance and intensity; whose line it is
+                    // (object and class) goes, as the GPU's owner word does, to the greatest
+                    // (intensity level, outline), the greatest key among equals.
+                    let owner = |l: &Line| (l.key >> 20, l.outline);
+                    *out = Some(match *out {
+                        None => line,
+                        Some(l) => {
+                            let (keep, other) = if key > l.key { (line, l) } else { (l, line) };
+                            if owner(&other) > owner(&keep) {
+                                Line {
+                                    object: other.object,
+                                    outline: other.outline,
+                                    ..keep
+                                }
+                            } else {
+                                keep
+                            }
+                        }
+                    });
                 }
             }
         });

@@ -26,7 +26,7 @@ use crate::error::{Error, Result};
 use crate::gpu::light_world_dir;
 use crate::mesh::{patches::Patches, ALL_EDGES};
 use crate::style::{self, Color};
-use crate::world::{Rendering, Shot, BACKGROUND, HOST};
+use crate::world::{LineClass, Rendering, Shot, BACKGROUND, HOST};
 use glam::{DVec2, DVec3, DVec4};
 use rayon::prelude::*;
 
@@ -38,6 +38,29 @@ struct Sample {
     distance: f32,
     hidden: Option<Line>,
     rgba: [u8; 4],
+    class: LineClass,
+}
+
+/// The class of the line that colours a pixel most: the visible one (of class `visible`) at
+/// intensity `i`, or the hidden one at `h` where it is stronger (twin of `store_pixel`'s
+/// diagnostic in edge_pass.wgsl).
+fn line_class(visible: LineClass, i: f64, h: f64) -> LineClass {
+    if h > i {
+        LineClass::Hidden
+    } else if i > 0.0 {
+        visible
+    } else {
+        LineClass::None
+    }
+}
+
+/// The class of a line of the outline map.
+fn class_of(l: &Line) -> LineClass {
+    if l.outline {
+        LineClass::Outline
+    } else {
+        LineClass::Edge
+    }
 }
 
 /// Renders `shot` by ray casting on the CPU in f64: the reference every GPU method is
@@ -138,6 +161,7 @@ pub fn draw_raycast_over(shot: &Shot<'_>, host: Option<&HostOccluders<'_>>) -> R
         depth: Vec::with_capacity(n),
         edge_distance: Vec::with_capacity(n),
         hidden_distance: Vec::with_capacity(n),
+        line_class: Vec::with_capacity(n),
     };
     for s in rows.iter().flatten() {
         frame.rgba.extend_from_slice(&s.rgba);
@@ -147,6 +171,7 @@ pub fn draw_raycast_over(shot: &Shot<'_>, host: Option<&HostOccluders<'_>>) -> R
         frame
             .hidden_distance
             .push(s.hidden.map_or(f32::INFINITY, |l| l.distance as f32));
+        frame.line_class.push(s.class as u8);
     }
     Ok(frame)
 }
@@ -264,6 +289,7 @@ impl Truth<'_> {
                 let w = self.line_color(&l);
                 (l.intensity * w[3], w)
             });
+            let visible = outline.as_ref().map_or(LineClass::None, class_of);
             let mix = |k: usize| (bg[k] + (wire[k] - bg[k]) * i) as f32;
             return Sample {
                 id: if host >= 0.0 { HOST } else { BACKGROUND },
@@ -275,6 +301,7 @@ impl Truth<'_> {
                 distance: outline.map_or(f64::INFINITY, |l| l.distance) as f32,
                 hidden,
                 rgba: Color([mix(0), mix(1), mix(2), bg4[3].max(h).max(i) as f32]).to_srgb8(),
+                class: line_class(visible, i, h),
             };
         };
         let object = &world.objects[hit.object as usize];
@@ -343,9 +370,11 @@ impl Truth<'_> {
                 (under(s), 1.0)
             }
         };
-        let (line, distance, wire) = match outline {
-            Some(l) if l.key > own_key => (l.intensity, l.distance, self.line_color(&l)),
-            _ => (own_line, own, st.wire),
+        let (line, distance, wire, visible) = match outline {
+            Some(l) if l.key > own_key => {
+                (l.intensity, l.distance, self.line_color(&l), class_of(&l))
+            }
+            _ => (own_line, own, st.wire, LineClass::Edge),
         };
         let i = line * wire[3];
         let mix = |k: usize| (surface[k] + (wire[k] - surface[k]) * i) as f32;
@@ -355,6 +384,7 @@ impl Truth<'_> {
             distance: distance as f32,
             hidden,
             rgba: Color([mix(0), mix(1), mix(2), alpha.max(i) as f32]).to_srgb8(),
+            class: line_class(visible, i, h),
         }
     }
 }

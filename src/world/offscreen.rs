@@ -179,8 +179,8 @@ pub async fn read_deferred(
 /// Reads a rendered frame back: the 8-bit output, the `Rg32Uint` (slot, triangle) ids and
 /// the diagnostic map, four f32 per pixel (`Rgba32Float`, or their bits in `Rgba32Uint` for
 /// the forward passes; r = distance in pixels, ≥ 1e38 meaning none; g = reverse depth; b =
-/// distance to the hidden line, ≥ 1e38 meaning none),
-/// converted to [`Rendering`]'s conventions.
+/// distance to the hidden line, ≥ 1e38 meaning none; a = the line's class, as the deferred
+/// pass writes it), converted to [`Rendering`]'s conventions.
 pub async fn read_rendering(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
@@ -203,7 +203,13 @@ pub async fn read_rendering(
         .chunks_exact(per_pixel / 4)
         .map(|w| [w[0], w[1]])
         .collect();
-    maps_rendering(shot, (size, up), order, rgba, &raw, &diagnostic)
+    let mut r = maps_rendering(shot, (size, up), order, rgba, &raw, &diagnostic)?;
+    // The a channel: 0..=3 as `LineClass`.
+    r.line_class = diagnostic
+        .iter()
+        .map(|t| t[3].clamp(0.0, 3.0) as u8)
+        .collect();
+    Ok(r)
 }
 
 /// A frame read back as the forward passes' maps hold it (the 8-bit output, (slot,
@@ -234,5 +240,6 @@ pub fn maps_rendering(
             .iter()
             .map(|t| if t[2] >= 1e38 { f32::INFINITY } else { t[2] })
             .collect(),
+        line_class: Vec::new(),
     })
 }
