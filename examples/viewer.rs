@@ -4,7 +4,8 @@
 //!
 //! Mouse: left drag orbits, right or middle drag pans, the wheel zooms, a left click picks
 //! (the window title says what the pixel shows: the triangle, its polygon, the exact point,
-//! and the nearest drawn edge and vertex).
+//! and the nearest drawn edge and vertex) and selects the mesh (a `Highlight`: its outline
+//! in orange, dashed where it hides itself; a click on the background clears it).
 //! Keys: `E` cycles the edges (polygon, all, feature), `O` toggles outlines, `H` cycles the
 //! hidden lines (off, dashed, dotted, solid; deferred only), `M` switches the method, `+`/`-`
 //! change the line width, `Esc` quits.
@@ -16,7 +17,8 @@
 //! With `--frames N` the viewer orbits a little each frame and closes after N frames; with
 //! `--screenshot` it reads the last frame back from the surface, checks that it shows the
 //! background, the shaded mesh and its lines, and writes it as a PNG (CI runs it so under
-//! Xvfb). With `--pick X,Y` it prints what pixel X,Y of the last frame shows.
+//! Xvfb). With `--pick X,Y` it prints what pixel X,Y of the last frame shows, selecting
+//! the mesh there as a click does, and draws one more frame so.
 
 use std::sync::Arc;
 use winit::application::ApplicationHandler;
@@ -31,7 +33,10 @@ use wirepass::gpu::{
     Composite, DeferredPass, ForwardPass, MeshId, MeshStore, OutputTarget, PassOptions,
     RenderTarget,
 };
-use wirepass::{wgpu, EdgeSelection, HiddenLines, Instance, LinePattern, Mesh, Scene, Style};
+use wirepass::{
+    wgpu, EdgeSelection, HiddenLines, Highlight, Instance, InstanceStyle, LinePattern, Mesh, Scene,
+    Style,
+};
 
 type AnyError = Box<dyn std::error::Error>;
 
@@ -166,6 +171,8 @@ struct Viewer {
     mesh: Mesh,
     /// The last deferred frame and its scene, which a click picks from.
     last: Option<(wirepass::PreparedFrame, Scene<'static>)>,
+    /// Whether a click selected the mesh.
+    selected: bool,
 }
 
 impl Viewer {
@@ -265,6 +272,7 @@ impl Viewer {
             press: None,
             mesh: mesh.clone(),
             last: None,
+            selected: false,
         };
         viewer.title();
         Ok(viewer)
@@ -377,7 +385,12 @@ impl Viewer {
         });
         let size = (self.config.width, self.config.height);
         let aspect = f64::from(size.0) / f64::from(size.1);
-        let instances = [Instance::new(self.meshes[self.edges], DMat4::IDENTITY)];
+        let mut instance = Instance::new(self.meshes[self.edges], DMat4::IDENTITY);
+        if self.selected {
+            instance.style =
+                InstanceStyle::default().highlighted(&Highlight::default(), &self.style);
+        }
+        let instances = [instance];
         let scene = Scene::borrowed(self.orbit.camera().to_view(aspect), &instances);
         let mut encoder = self.device.create_command_encoder(&Default::default());
         let clear = {
@@ -433,14 +446,17 @@ impl Viewer {
         Ok(())
     }
 
-    /// What pixel `at` of the last deferred frame shows, in words.
-    fn pick(&self, at: (u32, u32)) -> Result<String, AnyError> {
+    /// What pixel `at` of the last deferred frame shows, in words; selects the mesh there,
+    /// or clears the selection on the background.
+    fn pick(&mut self, at: (u32, u32)) -> Result<String, AnyError> {
         use wirepass::gpu::{PickView, Picked};
         let (frame, scene) = self
             .last
             .as_ref()
             .ok_or("picking needs the deferred method")?;
-        let hit = match frame.pick(&self.device, &self.queue, &self.store, scene, at)? {
+        let picked = frame.pick(&self.device, &self.queue, &self.store, scene, at)?;
+        self.selected = matches!(picked, Picked::Instance(_));
+        let hit = match picked {
             Picked::Background => return Ok("background".into()),
             Picked::Host => return Ok("the host's geometry".into()),
             Picked::Instance(hit) => hit,
@@ -646,6 +662,18 @@ impl App {
         }
         if let Some(at) = self.options.pick {
             println!("pick {},{}: {}", at.0, at.1, viewer.pick(at)?);
+            // The selection drawn: the mesh's outline in the highlight's colour.
+            let rgba = viewer.draw_offscreen()?;
+            if viewer.selected {
+                let orange = rgba
+                    .chunks_exact(4)
+                    .filter(|p| p[0] > 200 && p[1] > 90 && p[1] < 190 && p[2] < 90)
+                    .count();
+                println!("selected: {orange} pixels of its outline");
+                if orange == 0 {
+                    return Err("the selected mesh shows no highlighted outline".into());
+                }
+            }
         }
         event_loop.exit();
         Ok(())

@@ -101,9 +101,11 @@ struct Instance {
 
 const INSTANCE_EDGES: u32 = 1u;
 const INSTANCE_OUTLINES: u32 = 2u;
-// Its hidden lines are drawn (HIDDEN); those the host's depth hides count as hidden.
+// Its hidden lines are drawn (HIDDEN); those the host's depth hides count as hidden; its
+// drawn edges' too, not only its outline's.
 const INSTANCE_HIDDEN: u32 = 4u;
 const INSTANCE_BEHIND_HOST: u32 = 8u;
+const INSTANCE_HIDDEN_EDGES: u32 = 16u;
 
 // A colour packed as two pairs of f16 (src/gpu/frame.rs, pack_color).
 fn unpack_color(c: vec2<u32>) -> vec4<f32> {

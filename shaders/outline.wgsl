@@ -114,7 +114,8 @@ fn outline_cull(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     let splats = (flags & INSTANCE_EDGES) != 0u && cluster_splats(cluster);
 #if HIDDEN
     // Every drawn edge in view has a hidden part to find.
-    let draws_hidden = (flags & (INSTANCE_EDGES | INSTANCE_HIDDEN)) == (INSTANCE_EDGES | INSTANCE_HIDDEN);
+    let hidden_edges = INSTANCE_EDGES | INSTANCE_HIDDEN | INSTANCE_HIDDEN_EDGES;
+    let draws_hidden = (flags & hidden_edges) == hidden_edges;
     let hidden = draws_hidden && cluster_draws(cluster) && cluster_in_view(instances[slot(inst)].clip, cluster);
 #else
     let hidden = false;
@@ -209,7 +210,8 @@ fn outline_triangle(inst: u32, t: u32) {
 #if HIDDEN
     // Drawn edges: their hidden parts, wherever they are.
     let hidden_lines = (flags & INSTANCE_HIDDEN) != 0u;
-    let drawn = select(0u, bits & 7u, (flags & INSTANCE_EDGES) != 0u && hidden_lines);
+    let hidden_edges = INSTANCE_EDGES | INSTANCE_HIDDEN_EDGES;
+    let drawn = select(0u, bits & 7u, (flags & hidden_edges) == hidden_edges && hidden_lines);
 #else
     let drawn = 0u;
 #endif
@@ -277,8 +279,9 @@ fn comes_first(a: vec3<f32>, b: vec3<f32>) -> bool {
 fn pattern_anchor(inst: u32, t: u32, i: u32, a: vec3<f32>, b: vec3<f32>, mode: u32) -> vec2<f32> {
 #if HIDDEN
     let chained = (info[instances[slot(inst)].triangle_base + t] >> (INFO_CHAINED_SHIFT + i)) & 1u;
-    let edges = instances[slot(inst)].flags & INSTANCE_EDGES;
-    if (mode & DRAW_HIDDEN) != 0u && frame.chain_work.x != 0u && chained != 0u && edges != 0u {
+    let edges = INSTANCE_EDGES | INSTANCE_HIDDEN_EDGES;
+    let chains = (instances[slot(inst)].flags & edges) == edges;
+    if (mode & DRAW_HIDDEN) != 0u && frame.chain_work.x != 0u && chained != 0u && chains {
         return chain_anchor(inst, phase_key(t, i));
     }
 #endif

@@ -124,6 +124,9 @@ pub struct HiddenLines {
     /// Also draw, as hidden, the parts the host's depth hides (a frame prepared with the
     /// host's depth); otherwise those are not drawn at all.
     pub behind_host: bool,
+    /// The hidden parts of the drawn edges too (the default); `false` draws only the
+    /// outline's (silhouettes and boundaries): a selected part seen through what hides it.
+    pub edges: bool,
 }
 
 impl Default for HiddenLines {
@@ -136,6 +139,7 @@ impl Default for HiddenLines {
             color: Color([0.2, 0.22, 0.25, 0.8]),
             width: 1.0,
             behind_host: false,
+            edges: true,
         }
     }
 }

@@ -24,6 +24,7 @@ fn style(pattern: LinePattern, width: f32) -> Style {
             color: Color([0.8, 0.1, 0.1, 1.0]),
             width,
             behind_host: false,
+            edges: true,
         }),
         ..Style::default()
     }
@@ -348,6 +349,7 @@ fn hidden_line_styles_per_instance() {
         color: Color([0.1, 0.3, 0.9, 1.0]),
         width: 2.5,
         behind_host: false,
+        edges: true,
     };
     let dashed = style(
         LinePattern::Dashed {

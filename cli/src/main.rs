@@ -10,7 +10,7 @@ use wirepass::tools::bench::Timed;
 use wirepass::tools::load::{load_world, parse_size, parse_vec3, CameraPlacement, WorldOptions};
 use wirepass::tools::offline::{draw, Method};
 use wirepass::world::{Shot, World};
-use wirepass::{Color, EdgeSelection, HiddenLines, LinePattern, Result, Style, View};
+use wirepass::{Color, EdgeSelection, HiddenLines, Highlight, LinePattern, Result, Style, View};
 
 #[derive(Parser)]
 #[command(
@@ -103,6 +103,11 @@ struct SceneArgs {
     /// surface, with --hidden lines showing through it [default: 1, or the scene file's].
     #[arg(long, allow_hyphen_values = true)]
     fill_opacity: Option<f32>,
+    /// Draw object N (its place in the scene: a scene file's objects in order, a glTF
+    /// scene's nodes) selected: its outline in orange, 3 px, dashed where other surfaces
+    /// hide it, its fill tinted; repeat it, or give a list (0,2), for several.
+    #[arg(long, value_name = "N", value_delimiter = ',')]
+    highlight: Vec<usize>,
     #[command(flatten)]
     camera: CameraArgs,
 }
@@ -123,6 +128,23 @@ fn parse_fade(s: &str) -> std::result::Result<DepthFade, String> {
         start: number(start)?,
         end: number(end)?,
     })
+}
+
+/// `world` with objects `selected` drawn highlighted in `style` (`--highlight`, a scene
+/// file's `"highlight": true`); an object the world has not is an error.
+fn highlighted(mut world: World, selected: &[usize], style: &Style) -> Result<World> {
+    let objects = world.objects.len();
+    for &n in selected {
+        let object = world.objects.get_mut(n).ok_or_else(|| {
+            wirepass::Error::InvalidSetting(format!(
+                "--highlight {n}: the scene has {objects} object{}, 0 to {}",
+                if objects == 1 { "" } else { "s" },
+                objects.saturating_sub(1)
+            ))
+        })?;
+        object.style = object.style.highlighted(&Highlight::default(), style);
+    }
+    Ok(world)
 }
 
 /// Prints the loader's notes, one line each.
@@ -171,10 +193,18 @@ impl SceneArgs {
                     .unwrap_or(HiddenLines::default().color),
                 width: self.hidden_width.or(file.hidden_width).unwrap_or(1.0),
                 behind_host: false,
+                edges: true,
             }),
             ..style
         };
         style.validate()?;
+        let selected: Vec<usize> = self
+            .highlight
+            .iter()
+            .chain(&loaded.highlight)
+            .copied()
+            .collect();
+        let world = highlighted(loaded.world, &selected, &style)?;
         let placement = self.camera.placement();
         let file_camera = loaded.camera.filter(|_| placement.is_empty());
         if let Some(wirepass::tools::scene_file::FileCamera::Gltf(c)) = &file_camera {
@@ -186,8 +216,8 @@ impl SceneArgs {
                 )]);
             }
         }
-        let view = placement.view(&loaded.world, file_camera.as_ref(), size)?;
-        Ok((loaded.world, view, style, size))
+        let view = placement.view(&world, file_camera.as_ref(), size)?;
+        Ok((world, view, style, size))
     }
 }
 
@@ -391,7 +421,7 @@ fn bench_command(args: &BenchArgs) -> Result<()> {
         };
         let loaded = load_world(spec, &options)?;
         print_notes(&loaded.notes);
-        let world = loaded.world;
+        let (world, selected) = (loaded.world, loaded.highlight);
         for &size in &sizes {
             for (k, &silhouettes) in args.silhouettes.iter().enumerate() {
                 let switch = if silhouettes { "on" } else { "off" };
@@ -409,6 +439,7 @@ fn bench_command(args: &BenchArgs) -> Result<()> {
                     ..Style::default()
                 };
                 style.validate()?;
+                let world = highlighted(world.clone(), &selected, &style)?;
                 // Only the deferred methods draw outlines: the others once.
                 let mut methods = args.methods.clone();
                 if k > 0 {

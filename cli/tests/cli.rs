@@ -128,6 +128,7 @@ fn bad_settings_give_one_clear_line() {
             "outline width",
         ),
         (&["render", "--outline-color", "blue", "-o", o], "colour"),
+        (&["render", "--highlight", "7", "-o", o], "--highlight 7"),
     ];
     for (args, expect) in cases {
         let (ok, err) = wirepass(args);
@@ -359,6 +360,8 @@ fn renders_a_scene_file_with_global_ids_in_the_dump() {
     };
     assert!(hidden_pixels(&[]) > 50, "the file's hidden lines");
     assert_eq!(hidden_pixels(&["--hidden", "off"]), 0);
+    // The sphere behind the torus, highlighted: its outline shows through, hidden lines off.
+    assert!(hidden_pixels(&["--hidden", "off", "--highlight", "1"]) > 20);
     // A bad field in the file is one line naming the file and the field.
     let bad = temp("bad.json");
     std::fs::write(

@@ -78,6 +78,8 @@ const INSTANCE_OUTLINES: u32 = 2;
 const INSTANCE_HIDDEN: u32 = 4;
 /// `Instance.flags`: the parts of its lines the host's depth hides are drawn as hidden.
 const INSTANCE_BEHIND_HOST: u32 = 8;
+/// `Instance.flags`: the hidden parts of its drawn edges are drawn, not only its outline's.
+const INSTANCE_HIDDEN_EDGES: u32 = 16;
 
 /// A linear RGBA colour as WGSL's `unpack2x16float` reads it from two words.
 fn pack_color(c: [f32; 4]) -> [u32; 2] {
@@ -282,6 +284,11 @@ impl FrameRecords {
                     INSTANCE_BEHIND_HOST
                 } else {
                     0
+                }
+                | if hidden.is_some_and(|h| h.edges) {
+                    INSTANCE_HIDDEN_EDGES
+                } else {
+                    0
                 };
             let wire = s.wire_color.unwrap_or(style.wire_color);
             let width = s.line_width.unwrap_or(style.line_width);
@@ -333,7 +340,7 @@ impl FrameRecords {
         let (mut phase_words, mut chains) = (0u64, 0u64);
         for (slot, record) in records.iter_mut().enumerate() {
             let mesh = store.record(scene.instances[order[slot] as usize].mesh)?;
-            let wanted = INSTANCE_EDGES | INSTANCE_HIDDEN;
+            let wanted = INSTANCE_EDGES | INSTANCE_HIDDEN | INSTANCE_HIDDEN_EDGES;
             if record.hidden_period == 0.0 || record.flags & wanted != wanted || mesh.chains == 0 {
                 continue;
             }

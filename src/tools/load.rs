@@ -57,6 +57,8 @@ pub struct Loaded {
     pub notes: Vec<String>,
     /// A scene file's frame style (empty for other files).
     pub style: FileStyle,
+    /// The objects a scene file highlights (`"highlight": true`), in order.
+    pub highlight: Vec<usize>,
 }
 
 /// Loads what `spec` names as a world: a scene file (`.json`, with its camera if it has
@@ -67,6 +69,7 @@ pub fn load_world(spec: Option<&str>, options: &WorldOptions) -> Result<Loaded> 
     let edges = options.edges;
     let lower = spec.map(str::to_ascii_lowercase).unwrap_or_default();
     let mut style = FileStyle::default();
+    let mut highlight = Vec::new();
     let (world, cameras, notes) = match spec {
         None => (
             crate::world::default_world(edges.unwrap_or_default()),
@@ -76,6 +79,7 @@ pub fn load_world(spec: Option<&str>, options: &WorldOptions) -> Result<Loaded> 
         Some(s) if lower.ends_with(".json") => {
             let file = crate::tools::scene_file::load(Path::new(s), edges, &mesh_spec)?;
             style = file.style;
+            highlight = file.highlight;
             (file.world, file.camera.into_iter().collect(), Vec::new())
         }
         Some(s) if lower.ends_with(".gltf") || lower.ends_with(".glb") => {
@@ -111,6 +115,7 @@ pub fn load_world(spec: Option<&str>, options: &WorldOptions) -> Result<Loaded> 
         camera,
         notes,
         style,
+        highlight,
     })
 }
 

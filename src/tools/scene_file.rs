@@ -30,7 +30,8 @@
 //! - `hidden` (`off`, `solid`, `dashed[:DASH,GAP]`, `dotted[:SPACING]`), `hidden_color` and
 //!   `hidden_width`: the object's own hidden lines (drawn whatever the frame's), what it
 //!   leaves out taken from the file's `style`, else the defaults; `"hidden": "off"` draws
-//!   none of its hidden lines.
+//!   none of its hidden lines. `highlight` (`true`): the object is drawn selected (its
+//!   outline in orange, dashed where hidden, its fill tinted: `wirepass::Highlight`).
 //! - `style` (optional): the frame's `hidden` (`off`, `solid`, `dashed[:DASH,GAP]`,
 //!   `dotted[:SPACING]`), `hidden_color`, `hidden_width`, `fill_opacity`, `outline_color` and
 //!   `outline_width`, where the command line does not set them.
@@ -145,6 +146,7 @@ pub fn load(
     let base = path.parent().unwrap_or(Path::new("."));
     let mut world = World::default();
     let mut loaded: HashMap<(String, String), usize> = HashMap::new();
+    let mut highlight = Vec::new();
     for (i, o) in objects.iter().enumerate() {
         let field = |name: &str| format!("objects[{i}].{name}");
         let o = o
@@ -164,13 +166,14 @@ pub fn load(
                 "hidden",
                 "hidden_color",
                 "hidden_width",
+                "highlight",
             ]
             .contains(&key.as_str())
             {
                 return Err(fail(format!(
                     "{}: unknown field (mesh, transform, edges, outlines, wire_color, \
                      fill_color, line_width, outline_color, outline_width, hidden, \
-                     hidden_color, hidden_width)",
+                     hidden_color, hidden_width, highlight)",
                     field(key)
                 )));
             }
@@ -276,12 +279,21 @@ pub fn load(
                         .or(file_style.hidden_width)
                         .unwrap_or(crate::style::HiddenLines::default().width),
                     behind_host: false,
+                    edges: true,
                 }
             }));
         }
         style
             .validate(i)
             .map_err(|e| fail(format!("objects[{i}]: {e}")))?;
+        if let Some(v) = o.get("highlight") {
+            let on = v
+                .as_bool()
+                .ok_or_else(|| fail(format!("{}: not true or false", field("highlight"))))?;
+            if on {
+                highlight.push(i);
+            }
+        }
         world.objects.push(Object {
             mesh,
             transform,
@@ -297,6 +309,7 @@ pub fn load(
         world,
         camera,
         style: file_style,
+        highlight,
     })
 }
 
@@ -309,6 +322,9 @@ pub struct SceneFile {
     pub camera: Option<FileCamera>,
     /// The frame's style settings the file gives.
     pub style: FileStyle,
+    /// The objects marked `"highlight": true`, which the tools draw with a
+    /// [`Highlight`](crate::Highlight).
+    pub highlight: Vec<usize>,
 }
 
 /// The frame's style as a scene file's `style` gives it; `None` where it says nothing (the
@@ -578,7 +594,7 @@ mod tests {
                 {"mesh": "sphere:200", "edges": "all", "outlines": false},
                 {"mesh": "sphere:200", "outline_color": "#0000ff", "outline_width": 4,
                  "hidden": "dashed:5,2", "hidden_width": 2},
-                {"mesh": "sphere:200", "hidden": "off"}
+                {"mesh": "sphere:200", "hidden": "off", "highlight": true}
             ],
             "camera": {"eye": [0, 0, 5], "orthographic": {"height": 4, "near": 0.1, "far": 20}},
             "style": {"hidden": "dotted:3", "fill_opacity": 0.25, "outline_width": 2}}"##,
@@ -587,7 +603,9 @@ mod tests {
             world,
             camera,
             style,
+            highlight,
         } = load(&path, Some(EdgeSelection::Polygon), &procedural).unwrap();
+        assert_eq!(highlight, vec![4]);
         assert_eq!(
             style,
             FileStyle {
@@ -659,6 +677,10 @@ mod tests {
             (
                 r#"{"objects": [{"mesh": "sphere:100", "hidden": "wavy"}]}"#,
                 "objects[0].hidden",
+            ),
+            (
+                r#"{"objects": [{"mesh": "sphere:100", "highlight": 1}]}"#,
+                "objects[0].highlight",
             ),
             (
                 r#"{"objects": [{"mesh": "sphere:100", "hidden_width": -1}]}"#,

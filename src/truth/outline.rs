@@ -135,6 +135,7 @@ pub(crate) fn outline_map(
         .filter(|(o, _)| styles[*o].outlines || styles[*o].edges)
         .flat_map(|(o, object)| {
             let hidden = styles[o].hidden;
+            let hidden_edges = hidden.is_some_and(|h| h.edges);
             let mesh = &world.meshes[object.mesh].mesh;
             let local = edge_math::local_eye(object.transform, eye);
             let first = caster.first_ids()[o];
@@ -161,7 +162,7 @@ pub(crate) fn outline_map(
                         .filter(move |i| bits & (1 << i) != 0)
                         .map(move |i| ((t as u32, i), both))
                 }));
-                if hidden.is_some() {
+                if hidden_edges {
                     // Every drawn edge has hidden parts to find; a shared one is drawn by the
                     // lower id only.
                     let mask = &masks[object.mesh];
@@ -196,7 +197,7 @@ pub(crate) fn outline_map(
                 }
             }
             let period = hidden.map_or(0.0, |h| f64::from(h.pattern.dash_period()[1]));
-            let chained = if styles[o].edges && period > 0.0 {
+            let chained = if styles[o].edges && hidden_edges && period > 0.0 {
                 view.chain_anchors(mesh, first, &masks[object.mesh], period)
             } else {
                 HashMap::new()
