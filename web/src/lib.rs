@@ -3,7 +3,8 @@
 //! drawn by the deferred pass straight into a WebGPU canvas. Mouse and touch: drag orbits,
 //! right or middle drag (or shift-drag, or two fingers) pans, the wheel (or a pinch) zooms,
 //! a click (or tap) picks: the toolbar says what the pixel shows.
-//! Keys: `E` cycles the edges, `O` toggles outlines, `+`/`-` change the line width.
+//! Keys: `E` cycles the edges, `O` toggles outlines, `H` cycles the hidden lines (off,
+//! dashed, dotted, solid), `+`/`-` change the line width.
 //!
 //! `?adapter=high-performance|low-power|fallback` asks the browser for another adapter.
 //! [`Viewer`] is what the page's script gets from [`start`]; its `snapshot` and `model_name`
@@ -32,6 +33,8 @@ struct App {
     orbit: Orbit,
     style: Style,
     edges: usize,
+    /// Which of [`HIDDEN`] the style draws.
+    hidden: usize,
     /// Pointers down on the canvas: id, position, button.
     pointers: Vec<(i32, f64, f64, i16)>,
     /// Where the primary button went down, to tell a click (a pick) from a drag.
@@ -128,6 +131,11 @@ impl Viewer {
         self.app.borrow().picked.clone()
     }
 
+    /// The hidden-line style the page draws: off, dashed, dotted or solid.
+    pub fn hidden(&self) -> String {
+        HIDDEN[self.app.borrow().hidden].0.into()
+    }
+
     /// The adapter the page runs on, as the browser names it.
     pub fn adapter(&self) -> String {
         self.app.borrow().gpu.adapter.clone()
@@ -217,6 +225,7 @@ impl App {
             model,
             style: Style::default(),
             edges: 0,
+            hidden: 0,
             pointers: Vec::new(),
             press: None,
             picked: None,
@@ -253,11 +262,12 @@ impl App {
     fn show_status(&self) {
         let (w, h) = self.gpu.size();
         self.status.set_text_content(Some(&format!(
-            "{}: {} triangles, {} edges, outlines {}, width {:.1}; {w}×{h} on {}",
+            "{}: {} triangles, {} edges, outlines {}, hidden {}, width {:.1}; {w}×{h} on {}",
             self.model.name,
             self.model.triangles(),
             EDGES[self.edges].0,
             if self.style.silhouettes { "on" } else { "off" },
+            HIDDEN[self.hidden].0,
             self.style.line_width,
             self.gpu.adapter,
         )));
@@ -267,6 +277,14 @@ impl App {
         web_sys::console::error_1(&message.into());
         self.status.set_text_content(Some(message));
         self.error = Some(message.into());
+    }
+
+    fn set_hidden(&mut self, hidden: usize) {
+        self.hidden = hidden % HIDDEN.len();
+        self.style.hidden = HIDDEN[self.hidden].1.map(|pattern| wirepass::HiddenLines {
+            pattern,
+            ..wirepass::HiddenLines::default()
+        });
     }
 
     fn set_edges(&mut self, edges: usize) {
@@ -334,7 +352,24 @@ async fn browser_adapter_name(gpu: &JsValue, choice: Option<&str>) -> Option<Str
     (!words.is_empty()).then(|| words.join(" "))
 }
 
-/// The toolbar: edges, outlines, width, a file picker, and the status line.
+/// The hidden-line styles the toolbar and `H` offer.
+const HIDDEN: [(&str, Option<wirepass::LinePattern>); 4] = [
+    ("off", None),
+    (
+        "dashed",
+        Some(wirepass::LinePattern::Dashed {
+            dash: 6.0,
+            gap: 4.0,
+        }),
+    ),
+    (
+        "dotted",
+        Some(wirepass::LinePattern::Dotted { spacing: 4.0 }),
+    ),
+    ("solid", Some(wirepass::LinePattern::Solid)),
+];
+
+/// The toolbar: edges, outlines, hidden lines, width, a file picker, and the status line.
 fn controls(doc: &web_sys::Document) -> Result<(HtmlElement, HtmlElement), JsValue> {
     let bar: HtmlElement = doc.create_element("div")?.unchecked_into();
     bar.set_class_name("wirepass-controls");
@@ -342,9 +377,14 @@ fn controls(doc: &web_sys::Document) -> Result<(HtmlElement, HtmlElement), JsVal
         .iter()
         .map(|(name, _)| format!("<option value=\"{name}\">{name}</option>"))
         .collect();
+    let hidden: String = HIDDEN
+        .iter()
+        .map(|(name, _)| format!("<option value=\"{name}\">{name}</option>"))
+        .collect();
     bar.set_inner_html(&format!(
         "<label>Edges <select name=\"edges\">{options}</select></label> \
          <label><input type=\"checkbox\" name=\"outlines\" checked> Outlines</label> \
+         <label>Hidden <select name=\"hidden\">{hidden}</select></label> \
          <label>Width <input type=\"range\" name=\"width\" min=\"0.5\" max=\"8\" step=\"0.5\" \
          value=\"{}\"></label> \
          <label>Open <input type=\"file\" name=\"file\" \
@@ -607,6 +647,19 @@ fn wire_events(app: &Shared, root: &HtmlElement) -> Result<(), JsValue> {
         },
     )?;
     listen(
+        &find("hidden")?.into(),
+        "change",
+        app,
+        |app, e: web_sys::Event| {
+            let select: Option<HtmlSelectElement> = e.target().and_then(|t| t.dyn_into().ok());
+            if let Some(select) = select {
+                app.borrow_mut()
+                    .set_hidden(select.selected_index().max(0) as usize);
+                schedule(app);
+            }
+        },
+    )?;
+    listen(
         &find("outlines")?.into(),
         "change",
         app,
@@ -654,6 +707,15 @@ fn wire_events(app: &Shared, root: &HtmlElement) -> Result<(), JsValue> {
                         a.set_edges(next);
                         let i = a.edges as i32;
                         sync("edges", &|el| {
+                            el.unchecked_ref::<HtmlSelectElement>()
+                                .set_selected_index(i)
+                        });
+                    }
+                    "h" | "H" => {
+                        let next = a.hidden + 1;
+                        a.set_hidden(next);
+                        let i = a.hidden as i32;
+                        sync("hidden", &|el| {
                             el.unchecked_ref::<HtmlSelectElement>()
                                 .set_selected_index(i)
                         });

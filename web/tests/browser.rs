@@ -626,6 +626,32 @@ async fn the_viewer_page_draws_turns_and_shows_a_dropped_glb() {
     // Back to the built-in scene.
     viewer.load_builtin().unwrap();
     assert_eq!(viewer.model_name(), "the built-in scene");
+
+    // `H` cycles the hidden lines: dashed ones show through the surfaces.
+    let frames = viewer.frames();
+    until("a frame of the built-in scene", 30.0, || {
+        viewer.frames() > frames
+    })
+    .await;
+    let plain = viewer.snapshot().await.unwrap();
+    let init = web_sys::KeyboardEventInit::new();
+    init.set_key("h");
+    let key = web_sys::KeyboardEvent::new_with_keyboard_event_init_dict("keydown", &init).unwrap();
+    let frames = viewer.frames();
+    let window: web_sys::EventTarget = web_sys::window().unwrap().into();
+    window.dispatch_event(&key).unwrap();
+    assert_eq!(viewer.hidden(), "dashed");
+    until("a frame with hidden lines", 30.0, || {
+        viewer.frames() > frames
+    })
+    .await;
+    let hidden = viewer.snapshot().await.unwrap();
+    let shown = changed(&plain, &hidden);
+    console_log!(
+        "dashed hidden lines changed {:.2} % of the pixels",
+        100.0 * shown
+    );
+    assert!(shown > 0.005, "the hidden lines are not shown ({shown})");
 }
 
 /// A frame's time in the page (the README quotes it beside the native one): not a test of
