@@ -44,6 +44,17 @@ pub struct Object {
     pub style: InstanceStyle,
 }
 
+impl Object {
+    /// World mesh `mesh` at `transform`, in the frame's style.
+    pub fn new(mesh: usize, transform: DMat4) -> Object {
+        Object {
+            mesh,
+            transform,
+            style: InstanceStyle::default(),
+        }
+    }
+}
+
 /// Meshes and their placements: what tools render, compare and time.
 #[derive(Clone, Debug, Default)]
 pub struct World {

@@ -13,7 +13,7 @@ use wirepass::truth::accuracy::{
     distance_error, hidden_distance_error, hidden_distance_errors, id_agreement,
 };
 use wirepass::world::{Object, Rendering, World, WorldMesh};
-use wirepass::{Color, EdgeSelection, HiddenLines, InstanceStyle, LinePattern, Style, View};
+use wirepass::{Color, EdgeSelection, HiddenLines, LinePattern, Style, View};
 
 const SIZE: (u32, u32) = (320, 240);
 
@@ -33,11 +33,6 @@ fn style(pattern: LinePattern, width: f32) -> Style {
 /// A torus behind and through a cube, both with feature edges: the cube hides much of the
 /// torus's rings, and its own back edges.
 fn cube_and_torus() -> World {
-    let object = |mesh: usize, transform: DMat4| Object {
-        mesh,
-        transform,
-        style: InstanceStyle::default(),
-    };
     World {
         meshes: vec![
             WorldMesh {
@@ -52,8 +47,8 @@ fn cube_and_torus() -> World {
             },
         ],
         objects: vec![
-            object(0, DMat4::from_scale(DVec3::splat(0.6))),
-            object(
+            Object::new(0, DMat4::from_scale(DVec3::splat(0.6))),
+            Object::new(
                 1,
                 DMat4::from_translation(DVec3::new(0.4, 0.2, -0.8))
                     * DMat4::from_rotation_x(1.1)
@@ -317,18 +312,17 @@ fn dashes_run_on_along_a_chain_of_short_edges() {
     }
     // Three instances, one mirrored: each instance's chains in its own phase table.
     let mut world = world;
-    let object = |transform| Object {
-        mesh: 0,
-        transform,
-        style: InstanceStyle::default(),
-    };
     world.objects = vec![
-        object(DMat4::from_translation(DVec3::new(-1.2, 0.0, -0.5))),
-        object(
+        Object::new(0, DMat4::from_translation(DVec3::new(-1.2, 0.0, -0.5))),
+        Object::new(
+            0,
             DMat4::from_translation(DVec3::new(1.2, 0.1, -0.3))
                 * DMat4::from_scale(DVec3::new(-1.0, 1.0, 1.0)),
         ),
-        object(DMat4::from_translation(DVec3::new(0.0, -0.2, -2.5)) * DMat4::from_rotation_z(0.4)),
+        Object::new(
+            0,
+            DMat4::from_translation(DVec3::new(0.0, -0.2, -2.5)) * DMat4::from_rotation_z(0.4),
+        ),
     ];
     let view = perspective(&world, DVec3::new(0.8, 3.0, 4.5));
     let pixels = check("three cylinders", &world, view, &dashed);

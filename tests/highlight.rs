@@ -19,11 +19,6 @@ const SIZE: (u32, u32) = (320, 240);
 
 /// A torus in front of a sphere, which it hides in part; both with polygon edges.
 fn world() -> World {
-    let object = |mesh: usize, transform: DMat4| Object {
-        mesh,
-        transform,
-        style: InstanceStyle::default(),
-    };
     World {
         meshes: vec![
             WorldMesh {
@@ -38,8 +33,8 @@ fn world() -> World {
             },
         ],
         objects: vec![
-            object(0, DMat4::from_translation(DVec3::new(0.3, 0.1, -1.5))),
-            object(1, DMat4::from_rotation_x(1.2)),
+            Object::new(0, DMat4::from_translation(DVec3::new(0.3, 0.1, -1.5))),
+            Object::new(1, DMat4::from_rotation_x(1.2)),
         ],
     }
 }

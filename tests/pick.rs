@@ -17,7 +17,7 @@ use wirepass::gpu::{
 use wirepass::truth::draw_raycast;
 use wirepass::world::offscreen::{encode_shaded, Uploaded};
 use wirepass::world::{Object, Shot, World, WorldMesh, BACKGROUND};
-use wirepass::{wgpu, Camera, EdgeSelection, Error, InstanceStyle, Scene, Style};
+use wirepass::{wgpu, Camera, EdgeSelection, Error, Scene, Style};
 
 const SIZE: (u32, u32) = (240, 180);
 
@@ -26,11 +26,6 @@ fn world() -> World {
     let torus = std::sync::Arc::new(wirepass::mesh::torus(800).unwrap());
     let sphere = std::sync::Arc::new(wirepass::mesh::sphere(600).unwrap());
     let tilt = DQuat::from_rotation_x(0.8);
-    let object = |mesh, transform| Object {
-        mesh,
-        transform,
-        style: InstanceStyle::default(),
-    };
     World {
         meshes: vec![
             WorldMesh {
@@ -45,16 +40,16 @@ fn world() -> World {
             },
         ],
         objects: vec![
-            object(
+            Object::new(
                 0,
                 DMat4::from_rotation_translation(tilt, DVec3::new(-1.4, 0.0, 0.0)),
             ),
-            object(
+            Object::new(
                 0,
                 DMat4::from_scale(DVec3::new(-1.0, 1.0, 1.0))
                     * DMat4::from_rotation_translation(tilt, DVec3::new(-1.4, 0.0, 0.0)),
             ),
-            object(1, DMat4::from_translation(DVec3::new(0.0, 1.1, -0.5))),
+            Object::new(1, DMat4::from_translation(DVec3::new(0.0, 1.1, -0.5))),
         ],
     }
 }

@@ -633,32 +633,26 @@ fn wire_events(app: &Shared, root: &HtmlElement) -> Result<(), JsValue> {
             }
         },
     )?;
-    listen(
-        &find("edges")?.into(),
-        "change",
-        app,
-        |app, e: web_sys::Event| {
-            let select: Option<HtmlSelectElement> = e.target().and_then(|t| t.dyn_into().ok());
-            if let Some(select) = select {
-                app.borrow_mut()
-                    .set_edges(select.selected_index().max(0) as usize);
-                schedule(app);
-            }
-        },
-    )?;
-    listen(
-        &find("hidden")?.into(),
-        "change",
-        app,
-        |app, e: web_sys::Event| {
-            let select: Option<HtmlSelectElement> = e.target().and_then(|t| t.dyn_into().ok());
-            if let Some(select) = select {
-                app.borrow_mut()
-                    .set_hidden(select.selected_index().max(0) as usize);
-                schedule(app);
-            }
-        },
-    )?;
+    // A select of the toolbar sets what `apply` sets to its selected index.
+    let on_select = |name: &str, apply: fn(&mut App, usize)| {
+        listen(
+            &find(name)?.into(),
+            "change",
+            app,
+            move |app, e: web_sys::Event| {
+                let select: Option<HtmlSelectElement> = e.target().and_then(|t| t.dyn_into().ok());
+                if let Some(select) = select {
+                    apply(
+                        &mut app.borrow_mut(),
+                        select.selected_index().max(0) as usize,
+                    );
+                    schedule(app);
+                }
+            },
+        )
+    };
+    on_select("edges", App::set_edges)?;
+    on_select("hidden", App::set_hidden)?;
     listen(
         &find("outlines")?.into(),
         "change",
