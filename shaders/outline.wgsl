@@ -280,7 +280,8 @@ fn pattern_anchor(inst: u32, t: u32, i: u32, a: vec3<f32>, b: vec3<f32>, mode: u
 #if HIDDEN
     let chained = (info[instances[slot(inst)].triangle_base + t] >> (INFO_CHAINED_SHIFT + i)) & 1u;
     let edges = INSTANCE_EDGES | INSTANCE_HIDDEN_EDGES;
-    let chains = (instances[slot(inst)].flags & edges) == edges;
+    // Only instances with a dashed or dotted pattern have a phase table.
+    let chains = (instances[slot(inst)].flags & edges) == edges && instances[slot(inst)].hidden_period > 0.0;
     if (mode & DRAW_HIDDEN) != 0u && frame.chain_work.x != 0u && chained != 0u && chains {
         return chain_anchor(inst, phase_key(t, i));
     }

@@ -408,7 +408,6 @@ impl FrameRecords {
             _pad: 0,
             fill_opacity: style.fill_opacity,
             hidden_color: hidden_color.map_or([0.0; 4], |c| c.0),
-
             chain_work: [
                 if chain_work.is_empty() {
                     0
