@@ -42,7 +42,7 @@ fn a_mesh_split_over_two_bindings_renders_as_if_whole() {
     let mesh = Procedural::Sphere(8000).build().unwrap();
     assert!(mesh.triangle_count() as u32 * 12 > SMALL);
     assert!(mesh.positions().len() as u32 * 12 <= SMALL);
-    let size = (128, 96);
+    let size = (96, 64);
     // From below, where the triangles past the split lie.
     let below = CameraPlacement {
         eye: Some(Vec3::new(0.6, -2.5, 1.2)),
@@ -59,7 +59,7 @@ fn a_mesh_split_over_two_bindings_renders_as_if_whole() {
     let style = Style::default();
     let shot = Shot {
         world: &world,
-        view: camera.to_view(128.0 / 96.0),
+        view: camera.to_view(96.0 / 64.0),
         style: &style,
         size,
     };
@@ -114,7 +114,7 @@ fn the_pulled_visibility_pass_reads_both_halves() {
     let (small, _turn) = small_device();
     let device = &small.device;
     let mesh = Procedural::Sphere(8000).build().unwrap();
-    let size = (128, 96);
+    let size = (96, 64);
     let (store, scene) = stored(&small, &mesh, size);
     let ids = |pulled: bool| {
         let mut pass = common::diagnostic_pass(device, pulled);

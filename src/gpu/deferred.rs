@@ -340,8 +340,10 @@ impl DeferredPass {
         })
     }
 
-    /// Enables [`OutputTarget::Diagnostic`], which needs 24 more bytes of targets per pixel;
-    /// tools and tests use it, a renderer does not need it.
+    /// Enables [`OutputTarget::Diagnostic`], which needs 24 more bytes of targets per pixel
+    /// (and, where the outline pass runs, a second word per pixel in its buffer, which tells
+    /// outlines from edges for the line-class map); tools and tests use it, a renderer does
+    /// not need it.
     #[cfg(feature = "diagnostics")]
     pub fn with_diagnostics(mut self) -> Self {
         self.diagnostics = true;
@@ -387,8 +389,9 @@ impl DeferredPass {
         let records = FrameRecords::new(device, store, scene, style, region, true)?;
         let mut data = FrameData::new(device, store, records);
         // The diagnostic map names the class of each pixel's line, which the outline pass's
-        // owner words tell apart (the image is the same with them).
-        data.mixed_colors |= self.diagnostics;
+        // owner words tell apart (the image is the same with them; the outline buffer takes
+        // twice the memory).
+        data.mixed_colors |= self.diagnostics && data.outlines;
         let host = match &canvas.host_depth {
             Some(h) => Some(self.host.prepare(device, h, &scene.view, region.image)?),
             None => None,
