@@ -14,7 +14,7 @@
 //! that draw their edges, by the same definition: the pixels of a large patch near an
 //! undrawn edge find their lines here.
 //!
-//! A hidden-line pattern runs along each chain of drawn edges ([`crate::mesh::chains`]): an
+//! A hidden-line pattern runs along each chain of drawn edges (`src/mesh/chains.rs`): an
 //! edge's dashes start where the chain's projected length before it leaves the pattern.
 //!
 //! Visibility along an edge is found by casting a ray through points every 1/8 pixel of its
