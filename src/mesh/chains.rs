@@ -50,9 +50,14 @@ pub fn comes_first(a: Vec3, b: Vec3) -> bool {
 }
 
 /// The chains of `listed`, each listed edge `(t, i)` of the triangles `triangles` over
-/// `positions` drawn once (the caller lists each shared edge from one side).
-pub fn chains(positions: &[Vec3], triangles: &[[u32; 3]], listed: &[(u32, u8)]) -> Chains {
-    let weld = super::adjacency::weld_by_position(positions);
+/// `positions` drawn once (the caller lists each shared edge from one side); `weld` maps
+/// each vertex to its welded one ([`weld_by_position`](super::adjacency::weld_by_position)).
+pub fn chains(
+    positions: &[Vec3],
+    weld: &[u32],
+    triangles: &[[u32; 3]],
+    listed: &[(u32, u8)],
+) -> Chains {
     let at = |v: u32| positions[v as usize];
     // Edge e's ends 2e (corner i) and 2e + 1 (corner i + 1), as welded vertices.
     let end_vertex = |end: usize| {
@@ -194,6 +199,10 @@ mod tests {
         out
     }
 
+    fn weld_of(mesh: &Mesh) -> Vec<u32> {
+        crate::mesh::adjacency::weld_by_position(mesh.positions())
+    }
+
     /// The chain's vertices in order, by position.
     fn walk_of(mesh: &Mesh, chain: &[ChainEdge]) -> Vec<Vec3> {
         let p = |e: &ChainEdge, end: usize| {
@@ -226,6 +235,7 @@ mod tests {
             let mesh = disc(48, first);
             let c = chains(
                 mesh.positions(),
+                &weld_of(&mesh),
                 mesh.triangles(),
                 &listed(&mesh, EdgeSelection::Feature(30.0)),
             );
@@ -240,6 +250,7 @@ mod tests {
             let other = disc(48, 0);
             let o = chains(
                 other.positions(),
+                &weld_of(&other),
                 other.triangles(),
                 &listed(&other, EdgeSelection::Feature(30.0)),
             );
@@ -257,6 +268,7 @@ mod tests {
         let mesh = crate::mesh::cube(12).unwrap();
         let c = chains(
             mesh.positions(),
+            &weld_of(&mesh),
             mesh.triangles(),
             &listed(&mesh, EdgeSelection::Feature(30.0)),
         );
@@ -279,7 +291,7 @@ mod tests {
         let far: Vec<(u32, u8)> = (0..5).map(|t| (t, 1)).collect();
         // Listed in any order, the chain is the same.
         for order in [far.clone(), far.iter().rev().copied().collect()] {
-            let c = chains(mesh.positions(), mesh.triangles(), &order);
+            let c = chains(mesh.positions(), &weld_of(&mesh), mesh.triangles(), &order);
             assert_eq!(c.starts, vec![0]);
             let w = walk_of(&mesh, &c.edges);
             assert_eq!(w.len(), 6);

@@ -197,12 +197,12 @@ pub(crate) fn outline_map(
                 }
             }
             let period = hidden.map_or(0.0, |h| f64::from(h.pattern.dash_period()[1]));
-            let chained = if styles[o].edges && hidden_edges && period > 0.0 {
-                view.chain_anchors(mesh, first, &masks[object.mesh], period)
-            } else {
-                HashMap::new()
-            };
-            let weld = crate::mesh::adjacency::weld_by_position(mesh.positions());
+            // Welded vertices and the chains' anchors, where a pattern runs along them.
+            let chained = (styles[o].edges && hidden_edges && period > 0.0).then(|| {
+                let weld = crate::mesh::adjacency::weld_by_position(mesh.positions());
+                let anchors = view.chain_anchors(mesh, &weld, first, &masks[object.mesh], period);
+                (weld, anchors)
+            });
             merged
                 .into_par_iter()
                 .map(move |((t, i), draw)| {
@@ -210,11 +210,13 @@ pub(crate) fn outline_map(
                     let corners = tris[t as usize];
                     let p = mesh.positions();
                     let (a, b) = (corners[i as usize], corners[(i as usize + 1) % 3]);
-                    let (wa, wb) = (weld[a as usize], weld[b as usize]);
-                    let anchor = match chained.get(&(wa.min(wb), wa.max(wb))) {
-                        Some(&(position, entry)) => (position, entry == wa),
-                        None => (0.0, comes_first(p[a as usize], p[b as usize])),
-                    };
+                    let on_chain = chained.as_ref().and_then(|(weld, anchors)| {
+                        let (wa, wb) = (weld[a as usize], weld[b as usize]);
+                        let &(position, entry) = anchors.get(&(wa.min(wb), wa.max(wb)))?;
+                        Some((position, entry == wa))
+                    });
+                    let anchor = on_chain
+                        .unwrap_or_else(|| (0.0, comes_first(p[a as usize], p[b as usize])));
                     view.stretches(first, (t, i, n, anchor), (o as u32, widths), draw, hidden)
                 })
                 .collect::<Vec<_>>()
@@ -361,6 +363,7 @@ impl Visibility<'_> {
     fn chain_anchors(
         &self,
         mesh: &crate::Mesh,
+        weld: &[u32],
         first: u32,
         mask: &[u8],
         period: f64,
@@ -375,8 +378,7 @@ impl Visibility<'_> {
             })
             .map(|(t, i)| (t as u32, i))
             .collect();
-        let weld = crate::mesh::adjacency::weld_by_position(mesh.positions());
-        let chains = crate::mesh::chains::chains(mesh.positions(), tris, &listed);
+        let chains = crate::mesh::chains::chains(mesh.positions(), weld, tris, &listed);
         let mut out = HashMap::new();
         for chain in chains.iter().filter(|c| c.len() > 1) {
             let mut position = 0.0;
