@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{framing, load, shoot_world, worst_of};
+use common::{channel_difference, framing, load, shoot_world, worst_of};
 use glam::{DMat4, DVec3};
 use std::sync::Arc;
 use wirepass::mesh::Procedural;
@@ -234,10 +234,7 @@ fn see_through_surfaces_blend_like_the_ground_truth() {
             continue;
         }
         compared += 1;
-        let d = (0..4)
-            .map(|c| (i32::from(truth.rgba[4 * i + c]) - i32::from(frame.rgba[4 * i + c])).abs())
-            .max()
-            .unwrap();
+        let d = channel_difference(&truth, &frame, i);
         worst = worst.max(d);
         // The background's yellow shows through: more red than blue, unlike the opaque
         // grey-blue surface.
@@ -376,12 +373,7 @@ fn hidden_line_styles_per_instance() {
                 continue;
             }
             compared += 1;
-            let d = (0..4)
-                .map(|c| {
-                    (i32::from(truth.rgba[4 * i + c]) - i32::from(deferred.rgba[4 * i + c])).abs()
-                })
-                .max()
-                .unwrap();
+            let d = channel_difference(&truth, &deferred, i);
             worst = worst.max(d);
         }
         println!("{name}: {compared} hidden-line pixels, worst channel difference {worst}");

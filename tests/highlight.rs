@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{shoot_world, worst_of};
+use common::{channel_difference, shoot_world, worst_of};
 use glam::{DMat4, DVec3};
 use std::sync::Arc;
 use wirepass::mesh::Procedural;
@@ -94,10 +94,7 @@ fn a_highlighted_instance_shows_its_outline_through_what_hides_it() {
             continue;
         }
         compared += 1;
-        let d = (0..4)
-            .map(|c| (i32::from(truth.rgba[4 * i + c]) - i32::from(frame.rgba[4 * i + c])).abs())
-            .max()
-            .unwrap();
+        let d = channel_difference(&truth, &frame, i);
         worst_channel = worst_channel.max(d);
         changed += usize::from(frame.rgba[4 * i..4 * i + 4] != plain.rgba[4 * i..4 * i + 4]);
     }

@@ -146,6 +146,14 @@ impl TestScene {
     }
 }
 
+/// The largest difference of pixel `i`'s four 8-bit channels between two renderings.
+pub fn channel_difference(a: &Rendering, b: &Rendering, i: usize) -> u8 {
+    (0..4)
+        .map(|c| a.rgba[4 * i + c].abs_diff(b.rgba[4 * i + c]))
+        .max()
+        .unwrap_or(0)
+}
+
 /// The `n` pixels with the largest distance errors over `bound`, for failure messages.
 pub fn worst_pixels(truth: &Rendering, frame: &Rendering, bound: f64, n: usize) -> String {
     let errors =

@@ -693,26 +693,24 @@ fn wire_events(app: &Shared, root: &HtmlElement) -> Result<(), JsValue> {
                     apply(&el);
                 }
             };
+            let select = |name: &str, index: usize| {
+                sync(name, &|el| {
+                    el.unchecked_ref::<HtmlSelectElement>()
+                        .set_selected_index(index as i32)
+                })
+            };
             {
                 let mut a = app.borrow_mut();
                 match e.key().as_str() {
                     "e" | "E" => {
                         let next = a.edges + 1;
                         a.set_edges(next);
-                        let i = a.edges as i32;
-                        sync("edges", &|el| {
-                            el.unchecked_ref::<HtmlSelectElement>()
-                                .set_selected_index(i)
-                        });
+                        select("edges", a.edges);
                     }
                     "h" | "H" => {
                         let next = a.hidden + 1;
                         a.set_hidden(next);
-                        let i = a.hidden as i32;
-                        sync("hidden", &|el| {
-                            el.unchecked_ref::<HtmlSelectElement>()
-                                .set_selected_index(i)
-                        });
+                        select("hidden", a.hidden);
                     }
                     "o" | "O" => {
                         a.style.silhouettes = !a.style.silhouettes;
