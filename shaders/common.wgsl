@@ -97,6 +97,10 @@ struct Instance {
     phase_table: u32,
     table_log2: u32,
     _pad: u32,
+    // The visible lines' patterns, (dash, period) in pixels, period 0 for solid
+    // (`dash_nearest`): the drawn edges', the outline's.
+    edge_pattern: vec2<f32>,
+    outline_pattern: vec2<f32>,
 }
 
 const INSTANCE_EDGES: u32 = 1u;
@@ -106,6 +110,10 @@ const INSTANCE_OUTLINES: u32 = 2u;
 const INSTANCE_HIDDEN: u32 = 4u;
 const INSTANCE_BEHIND_HOST: u32 = 8u;
 const INSTANCE_HIDDEN_EDGES: u32 = 16u;
+// Its drawn edges are patterned: the outline pass draws them, the edge pass leaves them.
+const INSTANCE_PATTERNED_EDGES: u32 = 32u;
+// It has a phase table (`chain_phases`).
+const INSTANCE_PHASES: u32 = 64u;
 
 // A colour packed as two pairs of f16 (src/gpu/frame.rs, pack_color).
 fn unpack_color(c: vec2<u32>) -> vec4<f32> {

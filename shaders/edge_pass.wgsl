@@ -425,13 +425,15 @@ struct Own {
 fn own_lines(s: Sample) -> Own {
     let flags = instances[slot(s.inst)].flags;
     let bits = info[instances[slot(s.inst)].triangle_base + s.tri];
-    let mask = select(0u, bits & 7u, (flags & INSTANCE_EDGES) != 0u);
+    // Patterned edges are drawn by the outline pass.
+    let edges = (flags & (INSTANCE_EDGES | INSTANCE_PATTERNED_EDGES)) == INSTANCE_EDGES;
+    let mask = select(0u, bits & 7u, edges);
     let near = vec3<f32>(s.clip0.z, s.clip1.z, s.clip2.z);
     let d = drawn_distances(s.lines, near, mask);
     var own = Own(min(d.x, min(d.y, d.z)), false, false, bits);
     let u = drawn_distances(s.lines, near, ~mask & 7u);
     let reach = line_reach(instances[slot(s.inst)].line_width);
-    let beyond = (flags & INSTANCE_EDGES) != 0u && min(u.x, min(u.y, u.z)) < min(own.distance, reach);
+    let beyond = edges && min(u.x, min(u.y, u.z)) < min(own.distance, reach);
     let large = (bits & INFO_LARGE_PATCH) != 0u;
     if beyond && large {
         own.distance = NO_EDGE;

@@ -60,6 +60,8 @@ struct Instance {
     uint pad0;
     uint pad1;
     uint pad2;
+    vec2 edge_pattern;
+    vec2 outline_pattern;
 };
 
 // The records of one instanced draw's instances, gl_InstanceID first.

@@ -26,11 +26,17 @@
 // listed too, and the pixels within reach of the hidden runs of each (where the same test
 // finds a surface in front) get the key of the nearest point of a dash of the hidden-line
 // pattern (`dash_nearest`) in their own word (`hidden_lines`). The pattern's phase runs
-// along the edge's projection from its end that comes first in (x, y, z) order.
+// along the edge's projection from its end that comes first in (x, y, z) order, or on
+// along its chain of drawn edges (`chain_phases`).
+//
+// Patterned edges (INSTANCE_PATTERNED_EDGES): an instance whose drawn edges are dashed or
+// dotted has all of them in view listed here too, their visible runs drawn in dashes; the
+// edge pass then leaves its own triangles' edges.
 //
 // Flags: COLORS (instances differ in line colour, or an outline's colour differs from the
 // edges': each pixel also keeps the greatest (intensity level, class, instance) word,
-// `OWNER_OUTLINE`, so the edge pass knows whose line it holds and of which class), HIDDEN.
+// `OWNER_OUTLINE`, so the edge pass knows whose line it holds and of which class), HIDDEN,
+// PATTERNS (a line is dashed or dotted: phase tables, and dashes in `splat_runs`).
 
 @group(0) @binding(9) var<storage, read> clusters: array<Cluster>;
 // The outline buffer (`outline_tile_marks` in scene.wgsl): the lines, and the output tiles
@@ -112,15 +118,14 @@ fn outline_cull(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     let cluster = clusters[instances[slot(inst)].cluster_base + c];
     let outlines = (flags & INSTANCE_OUTLINES) != 0u && cluster_may_fold(cluster, instances[slot(inst)].eye);
     let splats = (flags & INSTANCE_EDGES) != 0u && cluster_splats(cluster);
+    // Every drawn edge in view has a hidden part to find (HIDDEN), or a pattern to draw.
+    var listed = (flags & INSTANCE_PATTERNED_EDGES) != 0u;
 #if HIDDEN
-    // Every drawn edge in view has a hidden part to find.
     let hidden_edges = INSTANCE_EDGES | INSTANCE_HIDDEN | INSTANCE_HIDDEN_EDGES;
-    let draws_hidden = (flags & hidden_edges) == hidden_edges;
-    let hidden = draws_hidden && cluster_draws(cluster) && cluster_in_view(instances[slot(inst)].clip, cluster);
-#else
-    let hidden = false;
+    listed = listed || (flags & hidden_edges) == hidden_edges;
 #endif
-    if !outlines && !splats && !hidden {
+    let drawn = listed && cluster_draws(cluster) && cluster_in_view(instances[slot(inst)].clip, cluster);
+    if !outlines && !splats && !drawn {
         return;
     }
     let k = atomicAdd(&cull_rw.count, 1u);
@@ -205,15 +210,17 @@ fn outline_triangle(inst: u32, t: u32) {
     let outlines = (flags & INSTANCE_OUTLINES) != 0u;
     let boundary = outlines && (bits & 8u) != 0u;
     let allowed = select(0u, (bits >> 8u) & 7u, outlines);
-    // Drawn edges of a large patch, drawn here like outlines (mesh_store::EdgeData).
-    let splat = select(0u, (bits >> 12u) & 7u, (flags & INSTANCE_EDGES) != 0u);
+    // Drawn edges of a large patch, drawn here like outlines (mesh_store::EdgeData); all
+    // drawn edges where they are patterned.
+    let patterned = select(0u, bits & 7u, (flags & INSTANCE_PATTERNED_EDGES) != 0u);
+    let splat = select(0u, (bits >> 12u) & 7u, (flags & INSTANCE_EDGES) != 0u && patterned == 0u);
 #if HIDDEN
     // Drawn edges: their hidden parts, wherever they are.
     let hidden_lines = (flags & INSTANCE_HIDDEN) != 0u;
     let hidden_edges = INSTANCE_EDGES | INSTANCE_HIDDEN_EDGES;
-    let drawn = select(0u, bits & 7u, (flags & hidden_edges) == hidden_edges && hidden_lines);
+    let drawn = patterned | select(0u, bits & 7u, (flags & hidden_edges) == hidden_edges && hidden_lines);
 #else
-    let drawn = 0u;
+    let drawn = patterned;
 #endif
     // Decoded as adjacency::fold_bound: 0 flat, 2^(q - 14) with a margin, 15 never skip.
     let q = (bits >> 4u) & 15u;
@@ -251,11 +258,12 @@ fn outline_triangle(inst: u32, t: u32) {
             let d = (q.q0.xyz + q.q1.xyz + q.q2.xyz) / 3.0;
             outline = is_silhouette(a, b, p[(i + 2u) % 3u], d, eye);
         }
-        let splats = (splat & (1u << i)) != 0u;
+        // A shared drawn edge is drawn by the lower id only.
+        let lower = n == BACKGROUND_ID || t < n;
+        let splats = (splat & (1u << i)) != 0u || ((patterned & (1u << i)) != 0u && lower);
         var mode = select(0u, DRAW_VISIBLE, outline || splats) | select(0u, DRAW_OUTLINE, outline);
 #if HIDDEN
-        // A shared drawn edge is drawn by the lower id only.
-        let hidden = (outline && hidden_lines) || ((drawn & (1u << i)) != 0u && (n == BACKGROUND_ID || t < n));
+        let hidden = (outline && hidden_lines) || ((drawn & (1u << i)) != 0u && lower);
         mode |= select(0u, DRAW_HIDDEN, hidden);
 #endif
         if mode != 0u {
@@ -271,25 +279,34 @@ fn comes_first(a: vec3<f32>, b: vec3<f32>) -> bool {
     return a.x < b.x || (a.x == b.x && (a.y < b.y || (a.y == b.y && a.z < b.z)));
 }
 
-// Where the hidden-line pattern of edge i (a -> b) of triangle t of `inst` stands: its
-// position at the edge's start along the pattern (at a, or at b), and +1 as it runs from a
-// towards b, -1 from b towards a. An edge in a chain of drawn edges (src/mesh/chains.rs)
-// takes the position `chain_phases` found for it this frame; any other edge starts the
-// pattern at its end that comes first.
-fn pattern_anchor(inst: u32, t: u32, i: u32, a: vec3<f32>, b: vec3<f32>, mode: u32) -> vec2<f32> {
-#if HIDDEN
+// Where the line patterns of edge i (a -> b) of triangle t of `inst` stand: the visible
+// line's position at the edge's start along its pattern (at a, or at b), and +1 as it runs
+// from a towards b, -1 from b towards a; then the hidden line's. A drawn edge in a chain of
+// drawn edges (src/mesh/chains.rs) takes the positions `chain_phases` found for it this
+// frame, where its instance's edges (for the visible line) or their hidden parts (for the
+// hidden line) are patterned; an outline's visible line, and any other edge, start the
+// pattern at the edge's end that comes first.
+fn pattern_anchor(inst: u32, t: u32, i: u32, a: vec3<f32>, b: vec3<f32>, mode: u32) -> vec4<f32> {
+    let first = select(-1.0, 1.0, comes_first(a, b));
+    var anchor = vec4<f32>(0.0, first, 0.0, first);
+#if PATTERNS
+    let flags = instances[slot(inst)].flags;
     let chained = (info[instances[slot(inst)].triangle_base + t] >> (INFO_CHAINED_SHIFT + i)) & 1u;
-    let edges = INSTANCE_EDGES | INSTANCE_HIDDEN_EDGES;
-    // Only instances with a dashed or dotted pattern have a phase table.
-    let chains = (instances[slot(inst)].flags & edges) == edges && instances[slot(inst)].hidden_period > 0.0;
-    if (mode & DRAW_HIDDEN) != 0u && frame.chain_work.x != 0u && chained != 0u && chains {
-        return chain_anchor(inst, phase_key(t, i));
+    if frame.chain_work.x != 0u && chained != 0u && (flags & INSTANCE_PHASES) != 0u {
+        let e = chain_anchor(inst, phase_key(t, i));
+        let hidden_edges = INSTANCE_EDGES | INSTANCE_HIDDEN | INSTANCE_HIDDEN_EDGES;
+        if (flags & INSTANCE_PATTERNED_EDGES) != 0u && (mode & DRAW_OUTLINE) == 0u {
+            anchor = vec4<f32>(e.y, e.z, anchor.zw);
+        }
+        if (flags & hidden_edges) == hidden_edges && instances[slot(inst)].hidden_period > 0.0 {
+            anchor = vec4<f32>(anchor.xy, e.x, e.z);
+        }
     }
 #endif
-    return vec2<f32>(0.0, select(-1.0, 1.0, comes_first(a, b)));
+    return anchor;
 }
 
-#if HIDDEN
+#if PATTERNS
 // First of the triangle info bits marking the drawn edges in chains (mesh_records.rs).
 const INFO_CHAINED_SHIFT: u32 = 26u;
 
@@ -317,11 +334,11 @@ fn phase_slot(key: u32, log2: u32) -> u32 {
 }
 
 // One invocation per chain of every instance in `chain_work`: walks the chain from its
-// start, writing into the instance's phase table, for each edge, its key and the pattern's
-// position where the chain enters it: the summed length of the projections of the edges
-// before it (each in front of the near plane and not beyond the far one, as `edge_span`
-// clips them), reduced modulo the pattern's period (the pattern repeats, and small
-// positions keep f32's precision).
+// start, writing into the instance's phase table, for each edge, its key and the patterns'
+// positions where the chain enters it (the hidden lines', the edges'): the summed length of
+// the projections of the edges before it (each in front of the near plane and not beyond
+// the far one, as `edge_span` clips them), reduced modulo each pattern's period (the
+// pattern repeats, and small positions keep f32's precision).
 @compute @workgroup_size(64)
 fn chain_phases(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let g = gid.x + gid.y * groups.x * 64u;
@@ -343,35 +360,44 @@ fn chain_phases(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     let head = chains[work.chain_base + g - work.before];
     let table = phase_tables() + instances[slot(inst)].phase_table;
     let vbase = instances[slot(inst)].vertex_base;
-    let period = instances[slot(inst)].hidden_period;
-    var position = 0.0;
+    let periods = vec2<f32>(instances[slot(inst)].hidden_period, instances[slot(inst)].edge_pattern.y);
+    var position = vec2<f32>(0.0);
     for (var k = 0u; k < head.y; k++) {
         let e = chains[work.chain_base + head.x + k];
-        atomicStore(&acc_rw[table + 2u * e.w], e.z);
-        atomicStore(&acc_rw[table + 2u * e.w + 1u], bitcast<u32>(position));
+        let at = table + PHASE_ENTRY_WORDS * e.w;
+        atomicStore(&acc_rw[at], e.z);
+        atomicStore(&acc_rw[at + 1u], bitcast<u32>(position.x));
+        atomicStore(&acc_rw[at + 2u], bitcast<u32>(position.y));
         let span = edge_span(inst, vertex_at(vbase + e.x).xyz, vertex_at(vbase + e.y).xyz);
         position += select(0.0, length(span.p1.xy - span.p0.xy), span.s.x <= span.s.y);
-        position -= period * floor(position / period);
+        position = select(vec2<f32>(0.0), position - periods * floor(position / periods), periods > vec2<f32>(0.0));
     }
 }
 
-// The pattern's position and direction (`pattern_anchor`) of the chained edge `key` of
-// `inst`, from its phase table: probed from `phase_slot` on, every slot up to the key's was
-// written this frame (the table's layout is fixed at upload).
-fn chain_anchor(inst: u32, key: u32) -> vec2<f32> {
+// Words of a phase table entry: key | forward << 31, the hidden lines' position, the
+// edges' (src/gpu/frame.rs).
+const PHASE_ENTRY_WORDS: u32 = 3u;
+
+// The patterns' positions (the hidden lines', the edges') and their direction
+// (`pattern_anchor`) on the chained edge `key` of `inst`, from its phase table: probed from
+// `phase_slot` on, every slot up to the key's was written this frame (the table's layout is
+// fixed at upload).
+fn chain_anchor(inst: u32, key: u32) -> vec3<f32> {
     let log2 = instances[slot(inst)].table_log2;
     let table = phase_tables() + instances[slot(inst)].phase_table;
     let mask = (1u << log2) - 1u;
     var at = phase_slot(key, log2);
     for (var probe = 0u; probe <= mask; probe++) {
-        let word = atomicLoad(&acc_rw[table + 2u * at]);
+        let entry = table + PHASE_ENTRY_WORDS * at;
+        let word = atomicLoad(&acc_rw[entry]);
         if (word & 0x7fffffffu) == key {
-            let position = bitcast<f32>(atomicLoad(&acc_rw[table + 2u * at + 1u]));
-            return vec2<f32>(position, select(-1.0, 1.0, (word >> 31u) != 0u));
+            let hidden = bitcast<f32>(atomicLoad(&acc_rw[entry + 1u]));
+            let edges = bitcast<f32>(atomicLoad(&acc_rw[entry + 2u]));
+            return vec3<f32>(hidden, edges, select(-1.0, 1.0, (word >> 31u) != 0u));
         }
         at = (at + 1u) & mask;
     }
-    return vec2<f32>(0.0, 1.0);
+    return vec3<f32>(0.0, 0.0, 1.0);
 }
 #endif
 
@@ -434,10 +460,13 @@ struct Segment {
     inst: u32,
     t: u32,
     n: u32,
-    // Position of `start` along the line pattern (pixels from the pattern's anchor), and
-    // +1 or -1 as the pattern runs towards `end` or away from it.
+    // Position of `start` along the visible line's pattern (pixels from the pattern's
+    // anchor), and +1 or -1 as the pattern runs towards `end` or away from it; then the
+    // hidden line's.
     phase: f32,
     phase_dir: f32,
+    hidden_phase: f32,
+    hidden_dir: f32,
 }
 
 fn seg_at(s: Segment, k: f32) -> Projected {
@@ -495,15 +524,16 @@ fn edge_span(inst: u32, a: vec3<f32>, b: vec3<f32>) -> Span {
 // the near plane, not beyond the far one, and inside the image and its guard band (not the
 // targets: a tile then samples and bisects the same points as the whole image, and computes
 // exactly what the whole image does), its length, and the pieces it is drawn in (0 when
-// nothing is left of it). The line pattern stands at `anchor` (`pattern_anchor`) where the
-// near or far plane leaves the edge's start (a when anchor.y is +1, b when -1).
+// nothing is left of it). The line patterns stand at `anchor` (`pattern_anchor`: visible,
+// hidden) where the near or far plane leaves the edge's start (a when the direction is +1,
+// b when -1).
 struct Clipped {
     seg: Segment,
     length_px: f32,
     pieces: u32,
 }
 
-fn clip_outline(inst: u32, t: u32, n: u32, a: vec3<f32>, b: vec3<f32>, anchor: vec2<f32>) -> Clipped {
+fn clip_outline(inst: u32, t: u32, n: u32, a: vec3<f32>, b: vec3<f32>, anchor: vec4<f32>) -> Clipped {
     var c: Clipped;
     c.pieces = 0u;
     let span = edge_span(inst, a, b);
@@ -526,9 +556,10 @@ fn clip_outline(inst: u32, t: u32, n: u32, a: vec3<f32>, b: vec3<f32>, anchor: v
     c.seg.t = t;
     c.seg.n = n;
     let full = length(d);
-    let a_first = anchor.y > 0.0;
-    c.seg.phase = anchor.x + select((1.0 - u.x) * full, u.x * full, a_first);
+    c.seg.phase = anchor.x + select((1.0 - u.x) * full, u.x * full, anchor.y > 0.0);
     c.seg.phase_dir = anchor.y;
+    c.seg.hidden_phase = anchor.z + select((1.0 - u.x) * full, u.x * full, anchor.w > 0.0);
+    c.seg.hidden_dir = anchor.w;
     c.length_px = length(c.seg.end.xy - c.seg.start.xy);
     c.pieces = max(u32(ceil(c.length_px / PIECE_PX)), 1u);
     return c;
@@ -540,7 +571,7 @@ fn clip_outline(inst: u32, t: u32, n: u32, a: vec3<f32>, b: vec3<f32>, anchor: v
 fn list_outline(inst: u32, t: u32, i: u32, n: u32, a: vec3<f32>, b: vec3<f32>, mode: u32) {
     // The pattern's anchor only matters where a piece is drawn here (the piece pass finds it
     // for the pieces it draws): looking it up for every listed edge would cost every lane.
-    let c = clip_outline(inst, t, n, a, b, vec2<f32>(0.0, 1.0));
+    let c = clip_outline(inst, t, n, a, b, vec4<f32>(0.0, 1.0, 0.0, 1.0));
     let visible_width = select(instances[slot(inst)].line_width, instances[slot(inst)].outline_width, (mode & DRAW_OUTLINE) != 0u);
     var reach = select(0.0, line_reach(visible_width), (mode & DRAW_VISIBLE) != 0u);
 #if HIDDEN
@@ -683,13 +714,22 @@ fn push_run(runs: ptr<function, array<vec2<f32>, MAX_RUNS>>, count: ptr<function
 fn splat_runs(seg: Segment, k0: f32, k1: f32, runs: ptr<function, array<vec2<f32>, MAX_RUNS>>, count: u32, kind: u32) {
     var width = select(instances[slot(seg.inst)].line_width, instances[slot(seg.inst)].outline_width, kind == LINE_OUTLINE);
     var pattern = vec2<f32>(0.0);
+    var phase = seg.phase;
+    var phase_dir = seg.phase_dir;
     var behind_host = false;
     let hidden = kind == LINE_HIDDEN;
+#if PATTERNS
+    pattern = select(instances[slot(seg.inst)].edge_pattern, instances[slot(seg.inst)].outline_pattern, kind == LINE_OUTLINE);
+#endif
 #if HIDDEN
     if hidden {
         let inst = instances[slot(seg.inst)];
         width = inst.hidden_width;
+#if PATTERNS
         pattern = vec2<f32>(inst.hidden_dash, inst.hidden_period);
+        phase = seg.hidden_phase;
+        phase_dir = seg.hidden_dir;
+#endif
         behind_host = (inst.flags & INSTANCE_BEHIND_HOST) != 0u;
     }
 #endif
@@ -701,7 +741,7 @@ fn splat_runs(seg: Segment, k0: f32, k1: f32, runs: ptr<function, array<vec2<f32
     let len2 = dot(along, along);
     // Pattern positions: phase + phase_dir * k * seg_length.
     let seg_length = sqrt(len2);
-    let scale = seg.phase_dir * seg_length;
+    let scale = phase_dir * seg_length;
     // Walk the pixels along the piece's major axis; across it, the band within reach of the
     // line is at most reach × √2 wide on either side (slope <= 1), plus a pixel for rounding.
     // Pixels are addressed in target coordinates.
@@ -740,13 +780,13 @@ fn splat_runs(seg: Segment, k0: f32, k1: f32, runs: ptr<function, array<vec2<f32
                 let run = (*runs)[r];
                 var kr = clamp(k, run.x, run.y);
                 if pattern.y > 0.0 && scale != 0.0 {
-                    let sa = seg.phase + scale * run.x;
-                    let sb = seg.phase + scale * run.y;
-                    let sr = dash_nearest(seg.phase + scale * k, min(sa, sb), max(sa, sb), pattern.x, pattern.y);
+                    let sa = phase + scale * run.x;
+                    let sb = phase + scale * run.y;
+                    let sr = dash_nearest(phase + scale * k, min(sa, sb), max(sa, sb), pattern.x, pattern.y);
                     if sr == NO_EDGE {
                         continue;
                     }
-                    kr = clamp((sr - seg.phase) / scale, run.x, run.y);
+                    kr = clamp((sr - phase) / scale, run.x, run.y);
                 }
                 let dr = distance(pixel, seg.start.xy + kr * along);
                 if dr < best {

@@ -37,6 +37,12 @@ pub struct InstanceStyle {
     /// Width of this instance's outline, in pixels; otherwise the style's
     /// [`outline_width`](crate::Style::outline_width), else this instance's line width.
     pub outline_width: Option<f32>,
+    /// The pattern of this instance's drawn edges; otherwise the style's
+    /// [`edge_pattern`](crate::Style::edge_pattern).
+    pub edge_pattern: Option<LinePattern>,
+    /// The pattern of this instance's outline; otherwise the style's
+    /// [`outline_pattern`](crate::Style::outline_pattern).
+    pub outline_pattern: Option<LinePattern>,
     /// This instance's hidden lines: `Some(Some(h))` draws them in `h` (also in a frame whose
     /// style draws none, as for a selected part), `Some(None)` draws none of them; otherwise
     /// the style's [`hidden`](crate::Style::hidden).
@@ -134,6 +140,16 @@ impl InstanceStyle {
             .unwrap_or(self.line_width.unwrap_or(style.line_width))
     }
 
+    /// The pattern of the instance's drawn edges in `style`: its own, or the style's.
+    pub fn edge_pattern_in(&self, style: &crate::Style) -> LinePattern {
+        self.edge_pattern.unwrap_or(style.edge_pattern)
+    }
+
+    /// The pattern of the instance's outline in `style`: its own, or the style's.
+    pub fn outline_pattern_in(&self, style: &crate::Style) -> LinePattern {
+        self.outline_pattern.unwrap_or(style.outline_pattern)
+    }
+
     /// The instance's hidden lines in `style`: its own, or the style's.
     pub fn hidden_in(&self, style: &crate::Style) -> Option<HiddenLines> {
         self.hidden.unwrap_or(style.hidden)
@@ -183,6 +199,14 @@ impl InstanceStyle {
         let bad = |m: String| Err(Error::InvalidScene(format!("instance {index}: {m}")));
         if let Some(Some(h)) = self.hidden {
             if let Err(e) = h.validate() {
+                return bad(e.to_string());
+            }
+        }
+        for (what, p) in [
+            ("edge", self.edge_pattern),
+            ("outline", self.outline_pattern),
+        ] {
+            if let Err(e) = p.map_or(Ok(()), |p| p.validate(what)) {
                 return bad(e.to_string());
             }
         }

@@ -82,6 +82,16 @@ pub struct Style {
     /// [`line_width`](Self::line_width)
     /// ([`InstanceStyle::outline_width`](crate::InstanceStyle::outline_width) overrides it).
     pub outline_width: Option<f32>,
+    /// The pattern of the drawn edges' visible lines
+    /// ([`InstanceStyle::edge_pattern`](crate::InstanceStyle::edge_pattern) overrides it).
+    /// Patterned edges are drawn by the outline pass (their visible runs, like an
+    /// outline's), so their cost follows the number of drawn edges in view; solid edges
+    /// cost nothing more. Only the deferred pass and the ground truth draw patterns.
+    pub edge_pattern: LinePattern,
+    /// The pattern of the outlines' visible lines
+    /// ([`InstanceStyle::outline_pattern`](crate::InstanceStyle::outline_pattern) overrides
+    /// it). An outline runs its pattern from its end that comes first (see [`LinePattern`]).
+    pub outline_pattern: LinePattern,
     /// Draw the outline (silhouette and boundary edges) at full width, over the background
     /// and farther surfaces too, and always, whatever the edge selection. Only the deferred
     /// pass and the ground truth can; the forward baselines draw each edge inside its own
@@ -144,7 +154,9 @@ impl Default for HiddenLines {
     }
 }
 
-/// A line pattern along an edge's projection, in pixels.
+/// A line pattern along an edge's projection, in pixels: of the hidden lines
+/// ([`HiddenLines::pattern`]), the drawn edges ([`Style::edge_pattern`]) or the outlines
+/// ([`Style::outline_pattern`]).
 ///
 /// Patterns are anchored to the geometry, not to the screen, and run on along chains of
 /// drawn edges (edges joined where exactly two drawn edges meet): a chain starts at its end
@@ -152,8 +164,9 @@ impl Default for HiddenLines {
 /// that comes first), and the pattern stands on each edge where the projected length of the
 /// chain before it leaves it (where an edge's start lies behind the near plane, at the
 /// plane). So a circle of many short edges dashes evenly, and the pattern does not crawl
-/// over the image as the camera moves. Outlines that are not drawn edges (silhouettes) run
-/// their pattern from their end that comes first.
+/// over the image as the camera moves. An outline's visible line, and the hidden part of an
+/// outline that is not a drawn edge, run their pattern from the edge's end that comes first
+/// (silhouettes change with the view).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum LinePattern {
     /// The whole line.
@@ -241,20 +254,71 @@ impl HiddenLines {
                 self.color.0
             )));
         }
+        self.pattern.validate("hidden line")
+    }
+}
+
+impl LinePattern {
+    /// Rejects lengths that cannot produce a sensible line; `what` names the line in the
+    /// error.
+    pub fn validate(&self, what: &str) -> Result<()> {
         let ok = |v: f32| (0.0..=MAX_PATTERN_LENGTH).contains(&v);
-        let fine = match self.pattern {
+        let fine = match *self {
             LinePattern::Solid => true,
             LinePattern::Dashed { dash, gap } => ok(dash) && ok(gap) && dash > 0.0 && gap > 0.0,
             LinePattern::Dotted { spacing } => ok(spacing) && spacing >= 1.0,
         };
         if !fine {
             return Err(Error::InvalidSetting(format!(
-                "hidden line pattern {:?}: dashes and gaps must be in (0, {MAX_PATTERN_LENGTH}] \
-                 pixels, dot spacing in [1, {MAX_PATTERN_LENGTH}]",
-                self.pattern
+                "{what} pattern {self:?}: dashes and gaps must be in (0, {MAX_PATTERN_LENGTH}] \
+                 pixels, dot spacing in [1, {MAX_PATTERN_LENGTH}]"
             )));
         }
         Ok(())
+    }
+
+    /// Parses a visible line's pattern: `solid`, `dashed[:DASH,GAP]` or `dotted[:SPACING]`
+    /// (as [`parse`](Self::parse), without `off`).
+    pub fn parse_visible(s: &str) -> Result<LinePattern> {
+        match Self::parse(s)? {
+            Some(p) => Ok(p),
+            None => Err(Error::InvalidSetting(format!(
+                "line pattern {s:?} is not solid, dashed[:DASH,GAP] or dotted[:SPACING]"
+            ))),
+        }
+    }
+
+    /// The pattern of a glTF `BENTLEY_materials_line_style` 16-bit `pattern` (bit 0 first,
+    /// one bit a pixel, repeating): its lit bits as dashes. The bits reduce to their shortest
+    /// repeat; one lit run in it is a dash of the run's length and a gap of the rest (a
+    /// single lit pixel, a dot). `None` where the repeat holds more than one lit run or none,
+    /// which this pattern model cannot draw.
+    pub fn from_bits(bits: u16) -> Option<LinePattern> {
+        if bits == 0xffff {
+            return Some(LinePattern::Solid);
+        }
+        let bit = |i: u32| (bits >> (i % 16)) & 1 == 1;
+        let period = [1u32, 2, 4, 8, 16]
+            .into_iter()
+            .find(|&p| (0..16).all(|i| bit(i) == bit(i + p)))?;
+        let lit = (0..period).filter(|&i| bit(i)).count() as u32;
+        // Lit runs: places where a lit bit follows an unlit one, cyclically.
+        let starts: Vec<u32> = (0..period)
+            .filter(|&i| bit(i) && !bit(i + period - 1))
+            .collect();
+        if lit == 0 || starts.len() != 1 {
+            return None;
+        }
+        Some(if lit == 1 {
+            LinePattern::Dotted {
+                spacing: period as f32,
+            }
+        } else {
+            LinePattern::Dashed {
+                dash: lit as f32,
+                gap: (period - lit) as f32,
+            }
+        })
     }
 }
 
@@ -317,6 +381,8 @@ impl Default for Style {
             light_view_dir: Vec3::new(-0.4, 0.6, 1.0),
             outline_color: None,
             outline_width: None,
+            edge_pattern: LinePattern::Solid,
+            outline_pattern: LinePattern::Solid,
             silhouettes: true,
             depth_fade: None,
             hidden: None,
@@ -357,6 +423,8 @@ impl Style {
                 self.ambient
             )));
         }
+        self.edge_pattern.validate("edge")?;
+        self.outline_pattern.validate("outline")?;
         if let Some(hidden) = &self.hidden {
             hidden.validate()?;
         }

@@ -535,6 +535,7 @@ impl DeferredPass {
             patches: frame.data.patches,
             colors: frame.data.outlines && frame.data.mixed_colors,
             hidden: frame.data.hidden,
+            patterns: frame.data.outlines && frame.data.patterns,
             host: frame.host.is_some(),
             uniform_instances: frame.data.uniform_instances,
             one_instance: frame.data.uniforms.instances() == 1,

@@ -92,6 +92,7 @@ impl EdgePass {
         mode: Mode,
         v: Variant,
     ) -> Result<Arc<EdgePipelines>> {
+        let v = v.for_edges();
         let mut cache = self
             .cache
             .lock()

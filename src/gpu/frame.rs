@@ -68,6 +68,10 @@ pub(crate) struct InstanceRecord {
     phase_table: u32,
     table_log2: u32,
     _pad: u32,
+    /// The visible lines' patterns, (dash, period) in pixels (period 0: solid): the drawn
+    /// edges', then the outline's.
+    edge_pattern: [f32; 2],
+    outline_pattern: [f32; 2],
 }
 
 /// `Instance.flags`: the instance's edges are drawn.
@@ -80,6 +84,11 @@ const INSTANCE_HIDDEN: u32 = 4;
 const INSTANCE_BEHIND_HOST: u32 = 8;
 /// `Instance.flags`: the hidden parts of its drawn edges are drawn, not only its outline's.
 const INSTANCE_HIDDEN_EDGES: u32 = 16;
+/// `Instance.flags`: its drawn edges are patterned, so the outline pass draws them (their
+/// visible runs) and the edge pass leaves them.
+const INSTANCE_PATTERNED_EDGES: u32 = 32;
+/// `Instance.flags`: it has a phase table (`chain_phases`).
+const INSTANCE_PHASES: u32 = 64;
 
 /// A linear RGBA colour as WGSL's `unpack2x16float` reads it from two words.
 fn pack_color(c: [f32; 4]) -> [u32; 2] {
@@ -89,8 +98,9 @@ fn pack_color(c: [f32; 4]) -> [u32; 2] {
 
 /// Instance records a uniform buffer holds (`scene.wgsl`, `UNIFORM_INSTANCES`): frames with
 /// up to this many bind them as uniforms, which software rasterizers read many times faster
-/// than storage buffers; 256 records are 64 KiB, `Limits::default()`'s largest uniform binding.
-pub(crate) const UNIFORM_INSTANCE_CAPACITY: u32 = 256;
+/// than storage buffers; 240 records fit in 64 KiB, `Limits::default()`'s largest uniform
+/// binding.
+pub(crate) const UNIFORM_INSTANCE_CAPACITY: u32 = 240;
 
 /// Byte offset of `InstanceRecord::index`, read as an instance-rate vertex attribute.
 pub(crate) const INSTANCE_INDEX_OFFSET: u64 = 220;
@@ -175,6 +185,9 @@ pub(crate) struct FrameData {
     pub patches: bool,
     /// Whether hidden lines are drawn (by the outline pass, with `outlines`).
     pub hidden: bool,
+    /// Whether a line is dashed or dotted (the outline pass then finds the patterns'
+    /// positions along chains and draws dashes, with `outlines`).
+    pub patterns: bool,
     /// Whether instances differ in line colour (the outline pass then keeps, per pixel,
     /// which instance's line it holds).
     pub mixed_colors: bool,
@@ -202,6 +215,7 @@ pub(crate) struct FrameRecords {
     pub outlines: bool,
     pub patches: bool,
     pub hidden: bool,
+    pub patterns: bool,
     pub mixed_colors: bool,
     pub chain_work: Vec<ChainWork>,
 }
@@ -265,6 +279,7 @@ impl FrameRecords {
         let mut outlines = false;
         let mut patches = false;
         let mut hidden_styles = Vec::with_capacity(order.len());
+        let mut patterns = false;
         for (slot, &i) in order.iter().enumerate() {
             let instance = &scene.instances[i as usize];
             let mesh = store.record(instance.mesh)?;
@@ -274,9 +289,16 @@ impl FrameRecords {
             // The outline pass also draws the edges of large patches.
             outlines |= draws_outline || (draws_edges && mesh.lines.splat);
             patches |= draws_edges && mesh.lines.small_patches;
-            // Hidden lines are drawn by the outline pass, from every drawn line in view.
+            // Hidden lines are drawn by the outline pass, from every drawn line in view; so
+            // are patterned edges.
             let hidden = s.hidden_in(style).filter(|_| draws_outline || draws_edges);
-            outlines |= hidden.is_some();
+            let edge_pattern = s.edge_pattern_in(style).dash_period();
+            let outline_pattern = s.outline_pattern_in(style).dash_period();
+            let patterned_edges = draws_edges && edge_pattern[1] > 0.0;
+            outlines |= hidden.is_some() || patterned_edges;
+            patterns |= patterned_edges
+                || (draws_outline && outline_pattern[1] > 0.0)
+                || hidden.is_some_and(|h| h.pattern.dash_period()[1] > 0.0);
             let flags = if draws_edges { INSTANCE_EDGES } else { 0 }
                 | if draws_outline { INSTANCE_OUTLINES } else { 0 }
                 | if hidden.is_some() { INSTANCE_HIDDEN } else { 0 }
@@ -287,6 +309,11 @@ impl FrameRecords {
                 }
                 | if hidden.is_some_and(|h| h.edges) {
                     INSTANCE_HIDDEN_EDGES
+                } else {
+                    0
+                }
+                | if patterned_edges {
+                    INSTANCE_PATTERNED_EDGES
                 } else {
                     0
                 };
@@ -308,7 +335,11 @@ impl FrameRecords {
                 ),
                 (slot as u32, clusters as u32),
             );
-            let record = with_hidden(record, hidden);
+            let record = InstanceRecord {
+                edge_pattern,
+                outline_pattern,
+                ..with_hidden(record, hidden)
+            };
             hidden_styles.push(hidden);
             clusters += u64::from(mesh.clusters);
             records.push(record);
@@ -333,17 +364,20 @@ impl FrameRecords {
         let clusters = u32::try_from(clusters)
             .map_err(|_| Error::InvalidScene(format!("{clusters} clusters over all instances")))?;
         let hidden_color = hidden_styles.iter().flatten().map(|h| h.color).next();
-        // A pattern runs along chains of drawn edges: each instance drawing patterned hidden
-        // lines along the edges of a mesh with chains gets a phase table in the outline
-        // buffer.
+        // A pattern runs along chains of drawn edges: each instance drawing its edges, or
+        // their hidden parts, in a dashed or dotted pattern gets a phase table in the
+        // outline buffer, if its mesh has chains.
         let mut chain_work = Vec::new();
         let (mut phase_words, mut chains) = (0u64, 0u64);
         for (slot, record) in records.iter_mut().enumerate() {
             let mesh = store.record(scene.instances[order[slot] as usize].mesh)?;
             let wanted = INSTANCE_EDGES | INSTANCE_HIDDEN | INSTANCE_HIDDEN_EDGES;
-            if record.hidden_period == 0.0 || record.flags & wanted != wanted || mesh.chains == 0 {
+            let hidden = record.hidden_period > 0.0 && record.flags & wanted == wanted;
+            let visible = record.flags & INSTANCE_PATTERNED_EDGES != 0;
+            if !(hidden || visible) || mesh.chains == 0 {
                 continue;
             }
+            record.flags |= INSTANCE_PHASES;
             record.phase_table = u32::try_from(phase_words).map_err(|_| too_many_chains())?;
             chain_work.push(ChainWork {
                 slot: slot as u32,
@@ -351,7 +385,7 @@ impl FrameRecords {
                 chains: mesh.chains,
                 before: u32::try_from(chains).map_err(|_| too_many_chains())?,
             });
-            phase_words += 2 << mesh.table_log2;
+            phase_words += u64::from(PHASE_ENTRY_WORDS) << mesh.table_log2;
             chains += u64::from(mesh.chains);
         }
         let phase_words = u32::try_from(phase_words.next_power_of_two())
@@ -430,11 +464,16 @@ impl FrameRecords {
             outlines,
             patches,
             hidden,
+            patterns,
             mixed_colors,
             chain_work,
         })
     }
 }
+
+/// Words of a phase table entry: the edge's key, the hidden-line pattern's position and the
+/// edge pattern's (`chain_phases`).
+const PHASE_ENTRY_WORDS: u32 = 3;
 
 fn too_many_chains() -> Error {
     Error::InvalidScene(
@@ -455,6 +494,7 @@ impl FrameData {
             outlines,
             patches,
             hidden,
+            patterns,
             region,
             mixed_colors,
             chain_work,
@@ -507,6 +547,7 @@ impl FrameData {
             outlines,
             patches,
             hidden,
+            patterns,
             mixed_colors,
             uniform_instances,
         }
@@ -612,6 +653,8 @@ fn instance_record(
         phase_table: 0,
         table_log2: mesh.table_log2,
         _pad: 0,
+        edge_pattern: [0.0; 2],
+        outline_pattern: [0.0; 2],
     }
 }
 
@@ -643,7 +686,8 @@ mod tests {
 
     #[test]
     fn records_match_their_wgsl_layout() {
-        assert_eq!(std::mem::size_of::<InstanceRecord>(), 256);
+        assert_eq!(std::mem::size_of::<InstanceRecord>(), 272);
+        assert!(u64::from(UNIFORM_INSTANCE_CAPACITY) * INSTANCE_BYTES <= 65536);
         assert_eq!(std::mem::size_of::<FrameUniforms>(), 176);
         let r = InstanceRecord::zeroed_for_test();
         let base = &r as *const _ as usize;

@@ -2,8 +2,8 @@
 //! boundaries) and the drawn edges of large patches, drawn from the triangles into every
 //! pixel within reach of their visible runs. Three dispatches: a cull of the clusters that
 //! may hold such an edge, one invocation per listed triangle listing the edges' pieces, one
-//! per piece drawing it; before them, for dashed or dotted hidden lines, one invocation per
-//! chain of drawn edges finding where the pattern stands along it.
+//! per piece drawing it; before them, for dashed or dotted lines, one invocation per chain
+//! of drawn edges finding where the patterns stand along it.
 
 use super::bindings::{self, dispatch, store_resources, Compute, Res, Size, Sources};
 use super::frame::FrameData;
@@ -23,7 +23,7 @@ struct OutlinePipelines {
     draw: Compute,
     /// Draws the listed pieces, one a lane.
     pieces: Compute,
-    /// Finds the pattern's position along every chain (HIDDEN).
+    /// Finds the patterns' positions along every chain (PATTERNS).
     phases: Option<Compute>,
 }
 
@@ -99,7 +99,7 @@ impl OutlinePass {
         )?;
         draw_res.push(Res::Cull);
         let draw = Compute::new(device, &module, "outline_main", draw_res, self.format)?;
-        let phases = if v.hidden {
+        let phases = if v.patterns {
             let mut res = vec![
                 Res::Frame,
                 bindings::instances(v.uniform_instances),

@@ -60,6 +60,8 @@ pub(crate) struct Variant {
     pub colors: bool,
     /// Hidden lines are drawn (by the outline pass); only with outlines.
     pub hidden: bool,
+    /// A line is dashed or dotted; only with outlines, and only the outline pass reads it.
+    pub patterns: bool,
     pub host: bool,
     /// The instance records are bound as a uniform array.
     pub uniform_instances: bool,
@@ -68,7 +70,16 @@ pub(crate) struct Variant {
 }
 
 impl Variant {
-    /// Every variant a frame can select: `colors` and `hidden` need `outlines`,
+    /// This variant as the edge pass's pipelines are specialised: without the settings only
+    /// the outline pass reads.
+    pub(crate) fn for_edges(self) -> Variant {
+        Variant {
+            patterns: false,
+            ..self
+        }
+    }
+
+    /// Every variant a frame can select: `colors`, `hidden` and `patterns` need `outlines`,
     /// `one_instance` needs `uniform_instances`.
     pub(crate) fn all() -> Vec<Variant> {
         let mut all = Vec::new();
@@ -85,16 +96,19 @@ impl Variant {
                         for (uniform_instances, one_instance) in
                             [(false, false), (true, false), (true, true)]
                         {
-                            all.push(Variant {
-                                split,
-                                outlines,
-                                patches,
-                                colors,
-                                hidden,
-                                host,
-                                uniform_instances,
-                                one_instance,
-                            });
+                            for patterns in [false, true].into_iter().filter(|&p| outlines || !p) {
+                                all.push(Variant {
+                                    split,
+                                    outlines,
+                                    patches,
+                                    colors,
+                                    hidden,
+                                    patterns,
+                                    host,
+                                    uniform_instances,
+                                    one_instance,
+                                });
+                            }
                         }
                     }
                 }
@@ -111,6 +125,7 @@ impl Variant {
             (self.patches, "PATCHES"),
             (self.colors, "COLORS"),
             (self.hidden, "HIDDEN"),
+            (self.patterns, "PATTERNS"),
             (self.host, "HOST"),
             (self.uniform_instances, "UNIFORM_INSTANCES"),
             (self.one_instance, "ONE_INSTANCE"),
@@ -156,7 +171,7 @@ pub fn shader_modules() -> Vec<(String, String)> {
             edge_source(format, FLOOR_FLAGS),
         ));
         for mode in Mode::all() {
-            for v in &variants {
+            for v in variants.iter().filter(|v| !v.patterns) {
                 let mut flags = v.flags();
                 flags.extend_from_slice(mode.flags());
                 out.push((

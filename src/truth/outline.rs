@@ -14,7 +14,9 @@
 //! that draw their edges, by the same definition: the pixels of a large patch near an
 //! undrawn edge find their lines here.
 //!
-//! A hidden-line pattern runs along each chain of drawn edges (`src/mesh/chains.rs`): an
+//! The drawn edges of an object whose edges are patterned are all here, their visible parts
+//! in dashes (the per-pixel own-edge distance leaves them). A pattern of drawn edges or of
+//! their hidden parts runs along each chain of drawn edges (`src/mesh/chains.rs`): an
 //! edge's dashes start where the chain's projected length before it leaves the pattern.
 //!
 //! Visibility along an edge is found by casting a ray through points every 1/8 pixel of its
@@ -139,49 +141,50 @@ pub(crate) fn outline_map(
             let mesh = &world.meshes[object.mesh].mesh;
             let local = edge_math::local_eye(object.transform, eye);
             let first = caster.first_ids()[o];
+            let patterned = styles[o].patterned_edges();
             let widths = (styles[o].width, styles[o].outline_width);
+            let patterns = (styles[o].edge_pattern, styles[o].outline_pattern);
             let tris = mesh.triangles();
             let neighbours = mesh.edge_neighbours();
             let mut edges: Vec<((u32, u32), Draw)> = Vec::new();
-            let both = Draw {
-                visible: true,
-                hidden: hidden.is_some(),
-                outline: false,
-            };
             if styles[o].outlines {
                 let outline = Draw {
+                    visible: true,
+                    hidden: hidden.is_some(),
                     outline: true,
-                    ..both
                 };
                 edges.extend(outline_edges(mesh, local).into_iter().map(|e| (e, outline)));
             }
-            if styles[o].edges {
+            if styles[o].edges && !patterned {
                 let splat = &patches[object.mesh].splat;
+                let draw = Draw {
+                    visible: true,
+                    hidden: hidden_edges,
+                    outline: false,
+                };
                 edges.extend(splat.iter().enumerate().flat_map(|(t, &bits)| {
                     (0..3u32)
                         .filter(move |i| bits & (1 << i) != 0)
-                        .map(move |i| ((t as u32, i), both))
+                        .map(move |i| ((t as u32, i), draw))
                 }));
-                if hidden_edges {
-                    // Every drawn edge has hidden parts to find; a shared one is drawn by the
-                    // lower id only.
-                    let mask = &masks[object.mesh];
-                    edges.extend((0..tris.len() as u32).flat_map(|t| {
-                        (0..3u32)
-                            .filter(move |&i| {
-                                let n = neighbours[t as usize][i as usize];
-                                mask[t as usize] & (1 << i) != 0 && (n == NO_NEIGHBOUR || t < n)
-                            })
-                            .map(move |i| {
-                                let only = Draw {
-                                    visible: false,
-                                    hidden: true,
-                                    outline: false,
-                                };
-                                ((t, i), only)
-                            })
-                    }));
-                }
+            }
+            if styles[o].edges && (hidden_edges || patterned) {
+                // Every drawn edge has hidden parts to find, or visible ones to draw in
+                // their pattern; a shared one is drawn by the lower id only.
+                let mask = &masks[object.mesh];
+                let draw = Draw {
+                    visible: patterned,
+                    hidden: hidden_edges,
+                    outline: false,
+                };
+                edges.extend((0..tris.len() as u32).flat_map(|t| {
+                    (0..3u32)
+                        .filter(move |&i| {
+                            let n = neighbours[t as usize][i as usize];
+                            mask[t as usize] & (1 << i) != 0 && (n == NO_NEIGHBOUR || t < n)
+                        })
+                        .map(move |i| ((t, i), draw))
+                }));
             }
             // One entry per edge, drawing all that any of its entries asks.
             edges.sort_unstable();
@@ -196,11 +199,16 @@ pub(crate) fn outline_map(
                     _ => merged.push((e, d)),
                 }
             }
-            let period = hidden.map_or(0.0, |h| f64::from(h.pattern.dash_period()[1]));
+            // The periods of the patterns that run along chains (0 where none does): the
+            // hidden parts' of drawn edges, the drawn edges'.
+            let hidden_period = hidden
+                .filter(|_| hidden_edges)
+                .map_or(0.0, |h| f64::from(h.pattern.dash_period()[1]));
+            let periods = [hidden_period, if patterned { patterns.0[1] } else { 0.0 }];
             // Welded vertices and the chains' anchors, where a pattern runs along them.
-            let chained = (styles[o].edges && hidden_edges && period > 0.0).then(|| {
+            let chained = (styles[o].edges && periods.iter().any(|&p| p > 0.0)).then(|| {
                 let weld = crate::mesh::adjacency::weld_by_position(mesh.positions());
-                let anchors = view.chain_anchors(mesh, &weld, first, &masks[object.mesh], period);
+                let anchors = view.chain_anchors(mesh, &weld, first, &masks[object.mesh], periods);
                 (weld, anchors)
             });
             merged
@@ -212,12 +220,24 @@ pub(crate) fn outline_map(
                     let (a, b) = (corners[i as usize], corners[(i as usize + 1) % 3]);
                     let on_chain = chained.as_ref().and_then(|(weld, anchors)| {
                         let (wa, wb) = (weld[a as usize], weld[b as usize]);
-                        let &(position, entry) = anchors.get(&(wa.min(wb), wa.max(wb)))?;
-                        Some((position, entry == wa))
+                        let &(positions, entry) = anchors.get(&(wa.min(wb), wa.max(wb)))?;
+                        Some((positions, entry == wa))
                     });
-                    let anchor = on_chain
-                        .unwrap_or_else(|| (0.0, comes_first(p[a as usize], p[b as usize])));
-                    view.stretches(first, (t, i, n, anchor), (o as u32, widths), draw, hidden)
+                    // Where each pattern stands: along its chain where it runs along chains;
+                    // an outline's visible line, and any other edge, from the end that comes
+                    // first.
+                    let own = (0.0, comes_first(p[a as usize], p[b as usize]));
+                    let along = |k: usize| match on_chain {
+                        Some((positions, forward)) if periods[k] > 0.0 => (positions[k], forward),
+                        _ => own,
+                    };
+                    let visible = if draw.outline {
+                        (patterns.1, own)
+                    } else {
+                        (patterns.0, along(1))
+                    };
+                    let lines = (visible, along(0));
+                    view.stretches(first, (t, i, n), (o as u32, widths), draw, (lines, hidden))
                 })
                 .collect::<Vec<_>>()
         })
@@ -355,9 +375,9 @@ impl Visibility<'_> {
         Some((s, at(s.0), at(s.1)))
     }
 
-    /// Where the hidden-line pattern (of period `period`) stands on each chained drawn edge
+    /// Where the patterns (of periods `periods`; 0 for none) stand on each chained drawn edge
     /// (`mask`) of `mesh`, the object whose first global id is `first`: by the edge's welded
-    /// ends (lower, higher), the pattern's position where the chain enters it (modulo the
+    /// ends (lower, higher), each pattern's position where the chain enters it (modulo its
     /// period) and the welded vertex it enters at. The position is the summed length of the
     /// projections ([`Self::span`]) of the chain's edges before it.
     fn chain_anchors(
@@ -366,8 +386,8 @@ impl Visibility<'_> {
         weld: &[u32],
         first: u32,
         mask: &[u8],
-        period: f64,
-    ) -> HashMap<(u32, u32), (f64, u32)> {
+        periods: [f64; 2],
+    ) -> HashMap<(u32, u32), ([f64; 2], u32)> {
         let neighbours = mesh.edge_neighbours();
         let tris = mesh.triangles();
         let listed: Vec<(u32, u8)> = (0..tris.len())
@@ -381,7 +401,7 @@ impl Visibility<'_> {
         let chains = crate::mesh::chains::chains(mesh.positions(), weld, tris, &listed);
         let mut out = HashMap::new();
         for chain in chains.iter().filter(|c| c.len() > 1) {
-            let mut position = 0.0;
+            let mut position = [0.0; 2];
             for e in chain {
                 let i = usize::from(e.i);
                 let (a, b) = (tris[e.t as usize][i], tris[e.t as usize][(i + 1) % 3]);
@@ -390,25 +410,37 @@ impl Visibility<'_> {
                 out.insert((wa.min(wb), wa.max(wb)), (position, entry));
                 let corners = self.caster.corners(first + e.t);
                 if let Some((_, p0, p1)) = self.span(corners[i], corners[(i + 1) % 3]) {
-                    position = (position + p0.xy.distance(p1.xy)).rem_euclid(period);
+                    let length = p0.xy.distance(p1.xy);
+                    for (s, &period) in position.iter_mut().zip(&periods) {
+                        *s = if period > 0.0 {
+                            (*s + length).rem_euclid(period)
+                        } else {
+                            0.0
+                        };
+                    }
                 }
             }
         }
         out
     }
 
-    /// The visible stretches (where `draw.visible`) and the dashes of the hidden stretches
-    /// (where `draw.hidden`, in `hidden`'s pattern and width) of edge `i` of triangle `t`
-    /// (neighbour `n`) of the object whose first global id is `first`; its pattern stands at
-    /// `anchor.0` at corner `i` when `anchor.1`, else at `i + 1` (or where a clip plane cuts
-    /// the edge short of that end), and runs towards the other end.
+    /// The dashes of the visible stretches (where `draw.visible`, in the visible pattern
+    /// (dash, period)) and of the hidden stretches (where `draw.hidden`, in `hidden`'s pattern
+    /// and width) of edge `i` of triangle `t` (neighbour `n`) of the object whose first
+    /// global id is `first`. Each pattern stands at its anchor's position at corner `i` when
+    /// the anchor's flag is set, else at `i + 1` (or where a clip plane cuts the edge short
+    /// of that end), and runs towards the other end.
+    #[allow(clippy::type_complexity)]
     fn stretches(
         &self,
         first: u32,
-        (t, i, n, anchor): (u32, u32, u32, (f64, bool)),
+        (t, i, n): (u32, u32, u32),
         (object, (edge_width, outline_width)): (u32, (f64, f64)),
         draw: Draw,
-        hidden: Option<crate::HiddenLines>,
+        (((visible_pattern, visible_anchor), hidden_anchor), hidden): (
+            (([f64; 2], (f64, bool)), (f64, bool)),
+            Option<crate::HiddenLines>,
+        ),
     ) -> (Vec<Stretch>, Vec<Stretch>) {
         let none = (Vec::new(), Vec::new());
         let corners = self.caster.corners(first + t);
@@ -483,22 +515,24 @@ impl Visibility<'_> {
                 over_host,
             }
         };
+        // The patterns' positions at parameter k: pixels along the projection from the
+        // anchored end (or where a clip plane cuts the edge short of it).
+        let full = d.length();
+        let [dash, period] = visible_pattern;
         let visible = runs
             .iter()
             .filter(|r| draw.visible && r.2 == Class::Visible)
-            .map(|&(k0, k1, _)| stretch((k0, k1), width, (draw.outline, false)))
+            .flat_map(|&(k0, k1, _)| dashes((k0, k1), full, visible_anchor, (dash, period)))
+            .map(|run| stretch(run, width, (draw.outline, false)))
             .collect();
         let Some(h) = hidden.filter(|_| draw.hidden) else {
             return (visible, Vec::new());
         };
-        // The pattern's position at parameter k: pixels along the projection from the
-        // anchored end (or where a clip plane cuts the edge short of it).
-        let full = d.length();
         let [dash, period] = h.pattern.dash_period().map(f64::from);
         let hidden = runs
             .iter()
             .filter(|r| r.2 == Class::Hidden)
-            .flat_map(|&(k0, k1, _)| dashes((k0, k1), full, anchor, (dash, period)))
+            .flat_map(|&(k0, k1, _)| dashes((k0, k1), full, hidden_anchor, (dash, period)))
             .map(|run| stretch(run, f64::from(h.width), (false, h.behind_host)))
             .collect();
         (visible, hidden)
@@ -924,8 +958,9 @@ mod tests {
             },
             ..crate::HiddenLines::default()
         };
-        let edge = (0, 1, NO_NEIGHBOUR, (0.0, true));
-        let (s, h) = vis.stretches(0, edge, (0, (1.5, 1.5)), draw, Some(hidden));
+        let edge = (0, 1, NO_NEIGHBOUR);
+        let lines = (([0.0; 2], (0.0, true)), (0.0, true));
+        let (s, h) = vis.stretches(0, edge, (0, (1.5, 1.5)), draw, (lines, Some(hidden)));
         assert_eq!(s.len(), 1, "{s:?}");
         let top_of_near = {
             let c = cam.view_projection(64, 64) * DVec4::new(1.0, 0.0, 1.0, 1.0);

@@ -310,7 +310,9 @@ impl Truth<'_> {
         let tri = wm.mesh.triangles()[hit.tri as usize];
         let corners = self.caster.corners(hit.id);
         let clip: [DVec4; 3] = corners.map(|p| self.rays.clip(p));
-        let mask = if st.edges {
+        // Patterned edges are in the outline map, drawn where they are visible.
+        let own_edges = st.edges && !st.patterned_edges();
+        let mask = if own_edges {
             self.masks[object.mesh][hit.tri as usize]
         } else {
             0
@@ -323,7 +325,7 @@ impl Truth<'_> {
         // it: in a small patch, the search finds it; a large patch's lines are in the outline
         // map.
         let undrawn = edge_math::edge_eval(clip, !mask & ALL_EDGES, pixel, size).min_distance();
-        if st.edges && undrawn < style::line_reach(st.width).min(own) {
+        if own_edges && undrawn < style::line_reach(st.width).min(own) {
             own = if self.patches[object.mesh].large[hit.tri as usize] {
                 edge_math::NO_EDGE
             } else {

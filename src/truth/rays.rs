@@ -295,6 +295,10 @@ pub(crate) struct ObjectStyle {
     pub width: f64,
     pub edges: bool,
     pub outlines: bool,
+    /// The visible lines' patterns, (dash, period) in pixels (period 0: solid): the drawn
+    /// edges', the outline's.
+    pub edge_pattern: [f64; 2],
+    pub outline_pattern: [f64; 2],
     /// Its hidden lines, where it draws any lines.
     pub hidden: Option<style::HiddenLines>,
     /// Model → world normal matrix.
@@ -302,6 +306,12 @@ pub(crate) struct ObjectStyle {
 }
 
 impl ObjectStyle {
+    /// Whether the object draws its edges in a dashed or dotted pattern (the outline map
+    /// then holds them).
+    pub fn patterned_edges(&self) -> bool {
+        self.edges && self.edge_pattern[1] > 0.0
+    }
+
     pub fn of(world: &World, style: &style::Style) -> Vec<ObjectStyle> {
         world
             .objects
@@ -322,6 +332,12 @@ impl ObjectStyle {
                 width: f64::from(o.style.line_width.unwrap_or(style.line_width)),
                 edges: o.style.edges.unwrap_or(true),
                 outlines: o.style.outlines.unwrap_or(style.silhouettes),
+                edge_pattern: o.style.edge_pattern_in(style).dash_period().map(f64::from),
+                outline_pattern: o
+                    .style
+                    .outline_pattern_in(style)
+                    .dash_period()
+                    .map(f64::from),
                 hidden: o.style.hidden_in(style).filter(|_| {
                     o.style.edges.unwrap_or(true) || o.style.outlines.unwrap_or(style.silhouettes)
                 }),

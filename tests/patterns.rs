@@ -1,0 +1,223 @@
+//! Patterned visible lines (`Style::edge_pattern`, `Style::outline_pattern` and their
+//! per-instance overrides): the deferred pass dashes the visible drawn edges and outlines
+//! where the ground truth does, the edges' dashes running on along chains of drawn edges,
+//! beside hidden lines of another pattern.
+
+mod common;
+
+use common::{load, shoot_world, worst_pixels};
+use glam::{DMat4, DVec3, Vec3};
+use std::sync::Arc;
+use wirepass::mesh::Procedural;
+use wirepass::tools::offline::Method;
+use wirepass::truth::accuracy::{distance_error, hidden_distance_error, id_agreement};
+use wirepass::world::{Object, World, WorldMesh};
+use wirepass::{Color, EdgeSelection, HiddenLines, LinePattern, Mesh, Style, View};
+
+const SIZE: (u32, u32) = (320, 240);
+
+const DASHED: LinePattern = LinePattern::Dashed {
+    dash: 6.0,
+    gap: 4.0,
+};
+const DOTTED: LinePattern = LinePattern::Dotted { spacing: 5.0 };
+
+/// fandisk (feature edges: long creases of many short edges) beside a torus with polygon
+/// edges.
+fn part_and_torus() -> World {
+    World {
+        meshes: vec![
+            WorldMesh {
+                mesh: Arc::new(load("fandisk.obj")),
+                edges: EdgeSelection::Feature(30.0),
+                name: "fandisk".into(),
+            },
+            WorldMesh {
+                mesh: Arc::new(Procedural::Torus(600).build().unwrap()),
+                edges: EdgeSelection::All,
+                name: "torus".into(),
+            },
+        ],
+        objects: vec![
+            Object::new(0, DMat4::IDENTITY),
+            Object::new(
+                1,
+                DMat4::from_translation(DVec3::new(0.2, -0.1, -0.6))
+                    * DMat4::from_rotation_x(1.1)
+                    * DMat4::from_scale(DVec3::splat(0.5)),
+            ),
+        ],
+    }
+}
+
+fn perspective(world: &World, eye: DVec3) -> View {
+    let (lo, hi) = world.bounds();
+    wirepass::Camera {
+        eye: eye.as_vec3(),
+        target: (0.5 * (lo + hi)).as_vec3(),
+        up: Vec3::Y,
+        fov_y_deg: 45.0,
+        near: 0.05,
+        far: 100.0,
+    }
+    .to_view(f64::from(SIZE.0) / f64::from(SIZE.1))
+}
+
+/// The deferred frame against the ground truth; returns the visible-line pixels measured.
+fn check(name: &str, world: &World, view: View, style: &Style) -> usize {
+    let truth = shoot_world(world, view, style, SIZE, Method::Raycast);
+    let frame = shoot_world(world, view, style, SIZE, Method::Deferred);
+    let (ids, _) = id_agreement(&truth, &frame).unwrap();
+    let visible = distance_error(&truth, &frame).unwrap();
+    let hidden = hidden_distance_error(&truth, &frame).unwrap();
+    println!("{name}: id {ids:.5}, visible {visible:?}, hidden {hidden:?}");
+    let worst = || worst_pixels(&truth, &frame, 0.01, 8);
+    assert!(ids >= 0.999, "{name}: id agreement {ids}");
+    assert!(
+        visible.p99.unwrap() <= 0.01,
+        "{name}: {visible:?}\n{}",
+        worst()
+    );
+    assert!(
+        visible.max.unwrap() <= 0.1,
+        "{name}: {visible:?}\n{}",
+        worst()
+    );
+    if style.hidden.is_some() {
+        assert!(hidden.p99.unwrap() <= 0.01, "{name}: hidden {hidden:?}");
+        assert!(hidden.max.unwrap() <= 0.1, "{name}: hidden {hidden:?}");
+    }
+    // Where the truth's dashes leave a gap, the pass draws no line either (but at the very
+    // edge of a line's reach).
+    let extra = (0..truth.ids.len())
+        .filter(|&i| truth.ids[i] == frame.ids[i])
+        .filter(|&i| truth.edge_distance[i] > 2.5 && frame.edge_distance[i] < 1.5)
+        .count();
+    assert_eq!(
+        extra,
+        0,
+        "{name}: line pixels the truth has not\n{}",
+        worst()
+    );
+    visible.pixels
+}
+
+#[test]
+fn dashed_edges_and_dotted_outlines_match_the_ground_truth() {
+    let world = part_and_torus();
+    let style = Style {
+        line_width: 1.5,
+        edge_pattern: DASHED,
+        outline_pattern: DOTTED,
+        outline_width: Some(2.0),
+        ..Style::default()
+    };
+    let view = perspective(&world, DVec3::new(1.6, 1.2, 2.4));
+    let pixels = check("perspective", &world, view, &style);
+    assert!(pixels > 1500, "{pixels} line pixels");
+    let aspect = f64::from(SIZE.0) / f64::from(SIZE.1);
+    let at = (DVec3::new(-3.0, 2.0, 3.0), DVec3::ZERO, DVec3::Y);
+    let ortho = View::orthographic(at, 2.5, aspect, (0.1, 20.0));
+    check("orthographic", &world, ortho, &style);
+    // The eye close to the part, its edges crossing the near plane.
+    let close = perspective(&world, DVec3::new(0.35, 0.3, 0.45));
+    check("close", &world, close, &style);
+    // Visible lines dotted, hidden ones dashed: two patterns of different periods along the
+    // same chains.
+    let both = Style {
+        edge_pattern: LinePattern::Dotted { spacing: 4.0 },
+        hidden: Some(HiddenLines {
+            pattern: LinePattern::Dashed {
+                dash: 5.0,
+                gap: 3.0,
+            },
+            color: Color([0.8, 0.1, 0.1, 1.0]),
+            ..HiddenLines::default()
+        }),
+        ..style
+    };
+    check("with hidden lines", &world, view, &both);
+}
+
+/// A closed cylinder of `n` sides, radius 1, from y = -0.5 to 0.5: its rims are circles of
+/// `n` short feature edges each, chains of drawn edges.
+fn cylinder(n: u32) -> Mesh {
+    let mut p = Vec::new();
+    for y in [-0.5f32, 0.5] {
+        p.extend((0..n).map(|k| {
+            let a = k as f32 / n as f32 * std::f32::consts::TAU;
+            Vec3::new(a.cos(), y, a.sin())
+        }));
+    }
+    p.extend([Vec3::new(0.0, -0.5, 0.0), Vec3::new(0.0, 0.5, 0.0)]);
+    let mut tris = Vec::new();
+    for k in 0..n {
+        let j = (k + 1) % n;
+        tris.extend([
+            [k, n + k, j],
+            [j, n + k, n + j],
+            [2 * n, k, j],
+            [2 * n + 1, n + j, n + k],
+        ]);
+    }
+    Mesh::new(p, None, tris, None).unwrap()
+}
+
+/// A rim of edges shorter than a dash dashes evenly (its pattern's share of the solid
+/// line's core, not a dash restarted at every vertex), where the ground truth puts the
+/// dashes; and each instance, one mirrored, in its own phase.
+#[test]
+fn edge_dashes_run_on_along_chains() {
+    let world = World::single(cylinder(160), EdgeSelection::Feature(30.0));
+    let view = perspective(&world, DVec3::new(0.6, 2.2, 2.6));
+    let dashed = Style {
+        edge_pattern: LinePattern::Dashed {
+            dash: 6.0,
+            gap: 6.0,
+        },
+        silhouettes: false,
+        ..Style::default()
+    };
+    check("cylinder", &world, view, &dashed);
+    let core = |style: &Style, method| {
+        let r = shoot_world(&world, view, style, SIZE, method);
+        r.edge_distance.iter().filter(|&&d| d <= 0.5).count() as f64
+    };
+    let solid = Style {
+        edge_pattern: LinePattern::Solid,
+        ..dashed.clone()
+    };
+    for method in [Method::Raycast, Method::Deferred] {
+        let share = core(&dashed, method) / core(&solid, method);
+        println!("{method:?}: {share:.3} of the solid line's core is dashed");
+        // A 6 px dash and its round caps' 0.5 px each, every 12 px: 0.583 (restarted at every
+        // vertex of the 3 px edges, it would be 1).
+        assert!((0.52..0.65).contains(&share), "{method:?}: {share}");
+    }
+    let mut world = world;
+    world.objects = vec![
+        Object::new(0, DMat4::from_translation(DVec3::new(-1.2, 0.0, -0.5))),
+        Object::new(
+            0,
+            DMat4::from_translation(DVec3::new(1.2, 0.1, -0.3))
+                * DMat4::from_scale(DVec3::new(-1.0, 1.0, 1.0)),
+        ),
+    ];
+    let view = perspective(&world, DVec3::new(0.8, 3.0, 4.5));
+    check("two cylinders", &world, view, &dashed);
+}
+
+/// Per instance: one dotted, one solid (the frame's) and one with dashed outlines only.
+#[test]
+fn patterns_per_instance() {
+    let mut world = part_and_torus();
+    world.objects.push(Object::new(
+        1,
+        DMat4::from_translation(DVec3::new(-0.6, 0.3, 0.2)) * DMat4::from_scale(DVec3::splat(0.4)),
+    ));
+    world.objects[0].style.edge_pattern = Some(LinePattern::Dotted { spacing: 3.0 });
+    world.objects[2].style.outline_pattern = Some(DASHED);
+    world.objects[2].style.edges = Some(false);
+    let view = perspective(&world, DVec3::new(1.6, 1.2, 2.4));
+    check("per instance", &world, view, &Style::default());
+}
