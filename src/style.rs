@@ -280,12 +280,12 @@ impl LinePattern {
     /// Parses a visible line's pattern: `solid`, `dashed[:DASH,GAP]` or `dotted[:SPACING]`
     /// (as [`parse`](Self::parse), without `off`).
     pub fn parse_visible(s: &str) -> Result<LinePattern> {
-        match Self::parse(s)? {
-            Some(p) => Ok(p),
-            None => Err(Error::InvalidSetting(format!(
+        let bad = || {
+            Error::InvalidSetting(format!(
                 "line pattern {s:?} is not solid, dashed[:DASH,GAP] or dotted[:SPACING]"
-            ))),
-        }
+            ))
+        };
+        Self::parse(s).map_err(|_| bad())?.ok_or_else(bad)
     }
 
     /// The pattern of a glTF `BENTLEY_materials_line_style` 16-bit `pattern` (bit 0 first,
@@ -319,6 +319,33 @@ impl LinePattern {
                 gap: (period - lit) as f32,
             }
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::LinePattern;
+
+    #[test]
+    fn bit_patterns_become_one_dash_a_repeat() {
+        let dashed = |dash, gap| Some(LinePattern::Dashed { dash, gap });
+        assert_eq!(LinePattern::from_bits(0xffff), Some(LinePattern::Solid));
+        assert_eq!(LinePattern::from_bits(0xf0f0), dashed(4.0, 4.0));
+        // Lit bits 0, 1, 6 and 7 of each byte: one run of 4 across the repeat's end.
+        assert_eq!(LinePattern::from_bits(0xc3c3), dashed(4.0, 4.0));
+        assert_eq!(LinePattern::from_bits(0x00ff), dashed(8.0, 8.0));
+        assert_eq!(LinePattern::from_bits(0x3fff), dashed(14.0, 2.0));
+        assert_eq!(
+            LinePattern::from_bits(0xaaaa),
+            Some(LinePattern::Dotted { spacing: 2.0 })
+        );
+        assert_eq!(
+            LinePattern::from_bits(0x0001),
+            Some(LinePattern::Dotted { spacing: 16.0 })
+        );
+        // Two runs in the repeat, or none.
+        assert_eq!(LinePattern::from_bits(0x0505), None);
+        assert_eq!(LinePattern::from_bits(0x0000), None);
     }
 }
 

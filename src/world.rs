@@ -151,7 +151,15 @@ impl World {
         doc: crate::mesh::formats::gltf::Document,
         edges: Option<EdgeSelection>,
     ) -> World {
-        let widths: Vec<Option<f32>> = doc.meshes.iter().map(|m| m.line_width).collect();
+        let styles: Vec<InstanceStyle> = doc
+            .meshes
+            .iter()
+            .map(|m| InstanceStyle {
+                line_width: m.line_width,
+                edge_pattern: m.line_pattern,
+                ..InstanceStyle::default()
+            })
+            .collect();
         let meshes = doc
             .meshes
             .into_iter()
@@ -170,10 +178,7 @@ impl World {
             .map(|(mesh, transform)| Object {
                 mesh,
                 transform,
-                style: InstanceStyle {
-                    line_width: widths[mesh],
-                    ..InstanceStyle::default()
-                },
+                style: styles[mesh],
             })
             .collect();
         World { meshes, objects }

@@ -897,7 +897,8 @@ fn hidden_boundary_edges_have_no_outline() {
 
 /// Code 3 alone is a hard edge too ("already encoded as 2" elsewhere, but drawn all the
 /// same), and lineStrings add hard edges; BENTLEY_materials_line_style's width on the
-/// edges' material becomes the object's line width, unless the command line gives one.
+/// edges' material becomes the object's line width, unless the command line gives one, and
+/// its pattern (0xf0f0: 4 px on, 4 off) the pattern of the object's edges.
 #[test]
 fn repeated_codes_line_strings_and_line_style() {
     let p = vec![
@@ -923,13 +924,30 @@ fn repeated_codes_line_strings_and_line_style() {
         vec![0b100, 0b011]
     );
     assert_eq!(doc.meshes[0].line_width, Some(4.0));
+    let dashes = wirepass::LinePattern::Dashed {
+        dash: 4.0,
+        gap: 4.0,
+    };
+    assert_eq!(doc.meshes[0].line_pattern, Some(dashes));
+    assert!(doc.notes.is_empty(), "{:?}", doc.notes);
+    let world = World::from_gltf(doc, None);
+    assert_eq!(world.objects[0].style.line_width, Some(4.0));
+    assert_eq!(world.objects[0].style.edge_pattern, Some(dashes));
+
+    // Two dashes in a repeat: drawn solid, and said so.
+    let mut file = GltfFile::new();
+    let mut prim = file.triangles(&p, &[0, 1, 2, 0, 2, 3], None);
+    let material = file.material(json!({"extensions":
+        {"BENTLEY_materials_line_style": {"width": 2, "pattern": 0x0505}}}));
+    prim["material"] = json!(material);
+    one_mesh(&mut file, vec![prim]);
+    let doc = load(&write("line-style-two.gltf", &file.embedded()));
+    assert_eq!(doc.meshes[0].line_pattern, None);
     assert!(
-        doc.notes.iter().any(|n| n.contains("dash pattern")),
+        doc.notes.iter().any(|n| n.contains("line pattern 1285")),
         "{:?}",
         doc.notes
     );
-    let world = World::from_gltf(doc, None);
-    assert_eq!(world.objects[0].style.line_width, Some(4.0));
 
     let options = wirepass::tools::load::WorldOptions {
         line_width: Some(2.0),

@@ -72,6 +72,15 @@ struct SceneArgs {
     /// Outline width in pixels [default: the line width, or the scene file's].
     #[arg(long, allow_hyphen_values = true)]
     outline_width: Option<f32>,
+    /// Pattern of the visible drawn edges: solid, dashed[:DASH,GAP] or dotted[:SPACING],
+    /// lengths in pixels, running on along chains of drawn edges. Only deferred and raycast
+    /// draw patterns [default: solid, or the scene file's].
+    #[arg(long, value_name = "PATTERN")]
+    edge_pattern: Option<String>,
+    /// Pattern of the visible outlines, as --edge-pattern [default: solid, or the scene
+    /// file's].
+    #[arg(long, value_name = "PATTERN")]
+    outline_pattern: Option<String>,
     /// Background colour, #rrggbb (sRGB).
     #[arg(long, default_value = "#ffffff")]
     background: String,
@@ -164,6 +173,11 @@ impl SceneArgs {
         let (outline_color, hidden_color) =
             (color(&self.outline_color)?, color(&self.hidden_color)?);
         let hidden = self.hidden.as_deref().map(LinePattern::parse).transpose()?;
+        let pattern = |p: &Option<String>| p.as_deref().map(LinePattern::parse_visible).transpose();
+        let (edge_pattern, outline_pattern) = (
+            pattern(&self.edge_pattern)?,
+            pattern(&self.outline_pattern)?,
+        );
         let style = Style {
             line_width: self.line_width.unwrap_or(DEFAULT_LINE_WIDTH),
             wire_color: Color::from_hex(&self.wire_color)?,
@@ -185,6 +199,12 @@ impl SceneArgs {
         let style = Style {
             outline_color: outline_color.or(file.outline_color),
             outline_width: self.outline_width.or(file.outline_width),
+            edge_pattern: edge_pattern
+                .or(file.edge_pattern)
+                .unwrap_or(LinePattern::Solid),
+            outline_pattern: outline_pattern
+                .or(file.outline_pattern)
+                .unwrap_or(LinePattern::Solid),
             fill_opacity: self.fill_opacity.or(file.fill_opacity).unwrap_or(1.0),
             hidden: hidden.or(file.hidden).flatten().map(|pattern| HiddenLines {
                 pattern,

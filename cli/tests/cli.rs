@@ -129,6 +129,14 @@ fn bad_settings_give_one_clear_line() {
         ),
         (&["render", "--outline-color", "blue", "-o", o], "colour"),
         (&["render", "--highlight", "7", "-o", o], "--highlight 7"),
+        (
+            &["render", "--edge-pattern", "off", "-o", o],
+            "line pattern",
+        ),
+        (
+            &["render", "--outline-pattern", "dotted:0", "-o", o],
+            "outline pattern",
+        ),
     ];
     for (args, expect) in cases {
         let (ok, err) = wirepass(args);
@@ -336,7 +344,8 @@ fn renders_a_scene_file_with_global_ids_in_the_dump() {
             "style": {"hidden": "solid", "hidden_width": 2}}"#,
     )
     .unwrap();
-    let hidden_pixels = |extra: &[&str]| {
+    // Pixels of a dumped distance map within `within` px of a line.
+    let line_pixels = |map: &str, within: f32, extra: &[&str]| {
         let dir = temp(&format!("styled-dump{}", extra.len()));
         let mut args = vec![
             "render",
@@ -351,13 +360,14 @@ fn renders_a_scene_file_with_global_ids_in_the_dump() {
         args.extend_from_slice(extra);
         let (ok, err) = wirepass(&args);
         assert!(ok, "{err}");
-        let bytes = std::fs::read(dir.join("hidden_distance.npy")).unwrap();
+        let bytes = std::fs::read(dir.join(map)).unwrap();
         let header = u16::from_le_bytes([bytes[8], bytes[9]]) as usize + 10;
         bytes[header..]
             .chunks_exact(4)
-            .filter(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]).is_finite())
+            .filter(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]) <= within)
             .count()
     };
+    let hidden_pixels = |extra: &[&str]| line_pixels("hidden_distance.npy", f32::MAX, extra);
     assert!(hidden_pixels(&[]) > 50, "the file's hidden lines");
     assert_eq!(hidden_pixels(&["--hidden", "off"]), 0);
     // The sphere behind the torus, highlighted: its outline shows through, hidden lines off.
@@ -537,4 +547,44 @@ fn bench_times_outlines_on_and_off_in_one_run() {
     }
     assert_eq!(cells[10], "–", "{row}");
     assert_eq!(cells[11].matches('×').count(), 2, "{row}");
+}
+
+/// `--edge-pattern` and `--outline-pattern` dash the visible lines: a cube's feature edges
+/// dashed 2 px every 10 px keep about (2 + 1) / 10 of the solid lines' cores.
+#[test]
+fn patterns_dash_the_visible_lines() {
+    let core = |extra: &[&str]| {
+        let dir = temp(&format!("pattern-dump{}", extra.len()));
+        let png = temp(&format!("pattern{}.png", extra.len()));
+        let mut args = vec![
+            "render",
+            "cube:300",
+            "--edges",
+            "feature:30",
+            "--size",
+            "160x120",
+            "-o",
+            png.to_str().unwrap(),
+            "--dump",
+            dir.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let (ok, err) = wirepass(&args);
+        assert!(ok, "{err}");
+        let bytes = std::fs::read(dir.join("edge_distance.npy")).unwrap();
+        let header = u16::from_le_bytes([bytes[8], bytes[9]]) as usize + 10;
+        bytes[header..]
+            .chunks_exact(4)
+            .filter(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]) <= 0.5)
+            .count() as f64
+    };
+    let solid = core(&[]);
+    let dashed = core(&[
+        "--edge-pattern",
+        "dashed:2,8",
+        "--outline-pattern",
+        "dashed:2,8",
+    ]);
+    let share = dashed / solid;
+    assert!((0.2..0.45).contains(&share), "{dashed} of {solid} pixels");
 }

@@ -25,16 +25,18 @@
 //!   own coordinates. Default: the command line's `--edges`, else the mesh file's own edges
 //!   where it has them (glTF), else `polygon`.
 //! - `outlines`, `wire_color`, `outline_color` and `fill_color` (`#rrggbb[aa]`, sRGB; the
-//!   fill's alpha is unused), `line_width` and `outline_width` (pixels): per-object overrides
-//!   of the command line's style.
+//!   fill's alpha is unused), `line_width` and `outline_width` (pixels), `edge_pattern` and
+//!   `outline_pattern` (`solid`, `dashed[:DASH,GAP]`, `dotted[:SPACING]`): per-object
+//!   overrides of the command line's style.
 //! - `hidden` (`off`, `solid`, `dashed[:DASH,GAP]`, `dotted[:SPACING]`), `hidden_color` and
 //!   `hidden_width`: the object's own hidden lines (drawn whatever the frame's), what it
 //!   leaves out taken from the file's `style`, else the defaults; `"hidden": "off"` draws
 //!   none of its hidden lines. `highlight` (`true`): the object is drawn selected (its
 //!   outline in orange, dashed where hidden, its fill tinted: `wirepass::Highlight`).
 //! - `style` (optional): the frame's `hidden` (`off`, `solid`, `dashed[:DASH,GAP]`,
-//!   `dotted[:SPACING]`), `hidden_color`, `hidden_width`, `fill_opacity`, `outline_color` and
-//!   `outline_width`, where the command line does not set them.
+//!   `dotted[:SPACING]`), `hidden_color`, `hidden_width`, `fill_opacity`, `outline_color`,
+//!   `outline_width`, `edge_pattern` and `outline_pattern`, where the command line does not
+//!   set them.
 //! - `camera`: `{"eye", "target", "up", "fov", "near", "far"}` (a perspective look-at;
 //!   `far` may be `null` for an infinite far plane), or `{"view": [16], "projection": [16],
 //!   "depth": "standard"|"reversed"}` (column-major matrices as a renderer has them), or
@@ -163,6 +165,8 @@ pub fn load(
                 "line_width",
                 "outline_color",
                 "outline_width",
+                "edge_pattern",
+                "outline_pattern",
                 "hidden",
                 "hidden_color",
                 "hidden_width",
@@ -172,8 +176,8 @@ pub fn load(
             {
                 return Err(fail(format!(
                     "{}: unknown field (mesh, transform, edges, outlines, wire_color, \
-                     fill_color, line_width, outline_color, outline_width, hidden, \
-                     hidden_color, hidden_width, highlight)",
+                     fill_color, line_width, outline_color, outline_width, edge_pattern, \
+                     outline_pattern, hidden, hidden_color, hidden_width, highlight)",
                     field(key)
                 )));
             }
@@ -252,6 +256,20 @@ pub fn load(
         };
         style.line_width = width("line_width")?;
         style.outline_width = width("outline_width")?;
+        let pattern = |name: &str| -> Result<Option<LinePattern>> {
+            o.get(name)
+                .map(|v| {
+                    v.as_str()
+                        .ok_or_else(|| fail(format!("{}: not a string", field(name))))
+                        .and_then(|t| {
+                            LinePattern::parse_visible(t)
+                                .map_err(|e| fail(format!("{}: {e}", field(name))))
+                        })
+                })
+                .transpose()
+        };
+        style.edge_pattern = pattern("edge_pattern")?;
+        style.outline_pattern = pattern("outline_pattern")?;
         // The object's own hidden lines; what it leaves out comes from the file's style,
         // else the defaults.
         let pattern = match o.get("hidden") {
@@ -343,17 +361,23 @@ pub struct FileStyle {
     pub outline_color: Option<Color>,
     /// `outline_width`, pixels.
     pub outline_width: Option<f32>,
+    /// `edge_pattern`: `solid`, `dashed[:DASH,GAP]` or `dotted[:SPACING]`.
+    pub edge_pattern: Option<LinePattern>,
+    /// `outline_pattern`, likewise.
+    pub outline_pattern: Option<LinePattern>,
 }
 
 fn file_style(v: &Value) -> std::result::Result<FileStyle, String> {
     let o = v.as_object().ok_or(": not an object")?;
-    const KEYS: [&str; 6] = [
+    const KEYS: [&str; 8] = [
         "hidden",
         "hidden_color",
         "hidden_width",
         "fill_opacity",
         "outline_color",
         "outline_width",
+        "edge_pattern",
+        "outline_pattern",
     ];
     if let Some(k) = o.keys().find(|k| !KEYS.contains(&k.as_str())) {
         return Err(format!(".{k}: unknown field ({})", KEYS.join(", ")));
@@ -377,6 +401,11 @@ fn file_style(v: &Value) -> std::result::Result<FileStyle, String> {
             .map(|t| Color::from_hex(t).map_err(|e| format!(".{k}: {e}")))
             .transpose()
     };
+    let pattern = |k: &str| -> std::result::Result<Option<LinePattern>, String> {
+        text(k)?
+            .map(|t| LinePattern::parse_visible(t).map_err(|e| format!(".{k}: {e}")))
+            .transpose()
+    };
     Ok(FileStyle {
         hidden: text("hidden")?
             .map(|t| LinePattern::parse(t).map_err(|e| format!(".hidden: {e}")))
@@ -386,6 +415,8 @@ fn file_style(v: &Value) -> std::result::Result<FileStyle, String> {
         fill_opacity: number("fill_opacity")?,
         outline_color: color("outline_color")?,
         outline_width: number("outline_width")?,
+        edge_pattern: pattern("edge_pattern")?,
+        outline_pattern: pattern("outline_pattern")?,
     })
 }
 
@@ -591,13 +622,15 @@ mod tests {
                 {"mesh": "sphere:200"},
                 {"mesh": "sphere:200", "transform": {"translate": [3, 0, 0]}, "edges": "none",
                  "wire_color": "#ff0000", "line_width": 3, "fill_color": "#00ff00"},
-                {"mesh": "sphere:200", "edges": "all", "outlines": false},
+                {"mesh": "sphere:200", "edges": "all", "outlines": false,
+                 "edge_pattern": "dotted:3", "outline_pattern": "solid"},
                 {"mesh": "sphere:200", "outline_color": "#0000ff", "outline_width": 4,
                  "hidden": "dashed:5,2", "hidden_width": 2},
                 {"mesh": "sphere:200", "hidden": "off", "highlight": true}
             ],
             "camera": {"eye": [0, 0, 5], "orthographic": {"height": 4, "near": 0.1, "far": 20}},
-            "style": {"hidden": "dotted:3", "fill_opacity": 0.25, "outline_width": 2}}"##,
+            "style": {"hidden": "dotted:3", "fill_opacity": 0.25, "outline_width": 2,
+                      "edge_pattern": "dashed:4,2"}}"##,
         );
         let SceneFile {
             world,
@@ -612,6 +645,10 @@ mod tests {
                 hidden: Some(Some(LinePattern::Dotted { spacing: 3.0 })),
                 fill_opacity: Some(0.25),
                 outline_width: Some(2.0),
+                edge_pattern: Some(LinePattern::Dashed {
+                    dash: 4.0,
+                    gap: 2.0
+                }),
                 ..FileStyle::default()
             }
         );
@@ -644,6 +681,15 @@ mod tests {
         );
         assert_eq!(world.objects[0].style.fill_color, None);
         assert_eq!(world.objects[2].style.outlines, Some(false));
+        assert_eq!(
+            world.objects[2].style.edge_pattern,
+            Some(LinePattern::Dotted { spacing: 3.0 })
+        );
+        assert_eq!(
+            world.objects[2].style.outline_pattern,
+            Some(LinePattern::Solid)
+        );
+        assert_eq!(world.objects[0].style.edge_pattern, None);
         assert!(camera.unwrap().view(1.5).is_orthographic());
     }
 
@@ -681,6 +727,18 @@ mod tests {
             (
                 r#"{"objects": [{"mesh": "sphere:100", "highlight": 1}]}"#,
                 "objects[0].highlight",
+            ),
+            (
+                r#"{"objects": [{"mesh": "sphere:100", "edge_pattern": "off"}]}"#,
+                "objects[0].edge_pattern",
+            ),
+            (
+                r#"{"objects": [{"mesh": "sphere:100", "outline_pattern": "dashed:0,3"}]}"#,
+                "outline pattern",
+            ),
+            (
+                r#"{"objects": [{"mesh": "sphere:100"}], "style": {"edge_pattern": "wavy"}}"#,
+                "style.edge_pattern",
             ),
             (
                 r#"{"objects": [{"mesh": "sphere:100", "hidden_width": -1}]}"#,

@@ -30,8 +30,11 @@
 //!
 //! **Line width.** `BENTLEY_materials_line_style`'s `width` (pixels), on the material of the
 //! edges (`EXT_mesh_primitive_edge_visibility`'s `material`, else the primitive's), becomes
-//! [`GltfMesh::line_width`]; wirepass draws one width per object, so a mesh whose
-//! primitives disagree takes the first and says so in a note. Dash patterns are not drawn.
+//! [`GltfMesh::line_width`], and its 16-bit `pattern` (one bit a pixel)
+//! [`GltfMesh::line_pattern`] ([`LinePattern::from_bits`](crate::LinePattern::from_bits):
+//! a repeat of one dash or dot; others are drawn solid, with a note). wirepass draws one
+//! width and pattern per object, so a mesh whose primitives disagree takes the first and
+//! says so in a note.
 
 // `!(a > b)` is deliberate throughout: NaN must take the rejecting branch.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -80,6 +83,8 @@ pub struct GltfMesh {
     pub edges: Option<EdgeSelection>,
     /// The line width the file asks for, in pixels (`BENTLEY_materials_line_style`).
     pub line_width: Option<f32>,
+    /// The pattern of the drawn edges the file asks for (`BENTLEY_materials_line_style`).
+    pub line_pattern: Option<crate::style::LinePattern>,
 }
 
 /// A glTF camera where its node puts it.

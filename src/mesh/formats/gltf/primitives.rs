@@ -10,6 +10,7 @@ use super::{named, FileResult, GltfMesh};
 use crate::error::Error;
 use crate::mesh::adjacency::NO_NEIGHBOUR;
 use crate::mesh::{EdgeSelection, Mesh};
+use crate::style::LinePattern;
 use glam::Vec3;
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::{Mode, Semantic};
@@ -33,6 +34,7 @@ struct Builder {
     /// Per triangle, each edge's visibility level, once any primitive has edge data.
     levels: Option<Vec<[u8; 3]>>,
     line_width: Option<f32>,
+    line_pattern: Option<LinePattern>,
 }
 
 pub(super) fn build_mesh(
@@ -53,6 +55,7 @@ pub(super) fn build_mesh(
     // Primitives that share vertex accessors share vertices.
     let mut bases: HashMap<(usize, Option<usize>), u32> = HashMap::new();
     let mut widths = Vec::new();
+    let mut patterns = Vec::new();
     for p in mesh.primitives() {
         let at = format!("{what}, primitive {}", p.index());
         let mode = p.mode();
@@ -171,9 +174,9 @@ pub(super) fn build_mesh(
         } else {
             b.triangles.extend(tris.iter().map(|t| t.map(|v| v + base)));
         }
-        if let Some(w) = line_width(doc, &p, notes, &at) {
-            widths.push(w);
-        }
+        let (width, pattern) = line_style(doc, &p, notes, &at);
+        widths.extend(width);
+        patterns.extend(pattern);
     }
     if b.triangles.is_empty() {
         notes.push(format!("{what} has no triangles; its nodes are not drawn"));
@@ -186,6 +189,14 @@ pub(super) fn build_mesh(
             ));
         }
         b.line_width = Some(w);
+    }
+    if let Some(&p) = patterns.first() {
+        if patterns.iter().any(|&x| x != p) {
+            notes.push(format!(
+                "{what}: its primitives ask for line patterns {patterns:?}; one pattern is drawn per object: {p:?}"
+            ));
+        }
+        b.line_pattern = Some(p);
     }
     finish(b, &what, name).map(Some)
 }
@@ -326,39 +337,45 @@ fn mark_pairs(levels: &mut [[u8; 3]], tris: &[[u32; 3]], pairs: &HashSet<(u32, u
     }
 }
 
-/// The width `BENTLEY_materials_line_style` gives the primitive's edges, if any.
-fn line_width(
+/// The width and pattern `BENTLEY_materials_line_style` gives the primitive's edges, if
+/// any.
+fn line_style(
     doc: &gltf::Document,
     p: &gltf::Primitive,
     notes: &mut Vec<String>,
     at: &str,
-) -> Option<f32> {
+) -> (Option<f32>, Option<LinePattern>) {
     let edge_material = p
         .extension_value("EXT_mesh_primitive_edge_visibility")
         .and_then(|e| e.get("material"))
         .and_then(Value::as_u64)
         .and_then(|i| doc.materials().nth(usize::try_from(i).ok()?));
     let material = edge_material.unwrap_or_else(|| p.material());
-    let style = material.extension_value("BENTLEY_materials_line_style")?;
-    if let Some(pattern) = style.get("pattern").and_then(Value::as_u64) {
-        if pattern & 0xffff != 0xffff {
+    let Some(style) = material.extension_value("BENTLEY_materials_line_style") else {
+        return (None, None);
+    };
+    let pattern = style.get("pattern").and_then(|v| {
+        let bits = v.as_u64().and_then(|b| u16::try_from(b).ok());
+        let pattern = bits.and_then(LinePattern::from_bits);
+        if pattern.is_none() {
             notes.push(format!(
-                "{at}: the dash pattern {pattern:#06x} is not drawn; lines are solid"
+                "{at}: the line pattern {v} is not a 16-bit pattern of one dash (or dot) \
+                 repeating; lines are solid"
             ));
         }
-    }
-    let width = style.get("width")?.as_f64();
-    match width {
+        pattern
+    });
+    let width = style.get("width").and_then(|v| match v.as_f64() {
         Some(w) if w > 0.0 && w <= f64::from(crate::style::MAX_LINE_WIDTH) => Some(w as f32),
         _ => {
             notes.push(format!(
-                "{at}: line width {} is not in (0, {}] pixels; ignored",
-                style.get("width").map(Value::to_string).unwrap_or_default(),
+                "{at}: line width {v} is not in (0, {}] pixels; ignored",
                 crate::style::MAX_LINE_WIDTH
             ));
             None
         }
-    }
+    });
+    (width, pattern)
 }
 
 /// Builds the mesh, then its authored edge masks from the levels.
@@ -370,6 +387,7 @@ fn finish(b: Builder, what: &str, name: String) -> FileResult<GltfMesh> {
         triangles,
         levels,
         line_width,
+        line_pattern,
     } = b;
     let invalid = |e: Error| match e {
         Error::InvalidMesh(m) => format!("{what}: {m}"),
@@ -411,6 +429,7 @@ fn finish(b: Builder, what: &str, name: String) -> FileResult<GltfMesh> {
         name,
         edges,
         line_width,
+        line_pattern,
     })
 }
 
