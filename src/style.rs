@@ -322,33 +322,6 @@ impl LinePattern {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::LinePattern;
-
-    #[test]
-    fn bit_patterns_become_one_dash_a_repeat() {
-        let dashed = |dash, gap| Some(LinePattern::Dashed { dash, gap });
-        assert_eq!(LinePattern::from_bits(0xffff), Some(LinePattern::Solid));
-        assert_eq!(LinePattern::from_bits(0xf0f0), dashed(4.0, 4.0));
-        // Lit bits 0, 1, 6 and 7 of each byte: one run of 4 across the repeat's end.
-        assert_eq!(LinePattern::from_bits(0xc3c3), dashed(4.0, 4.0));
-        assert_eq!(LinePattern::from_bits(0x00ff), dashed(8.0, 8.0));
-        assert_eq!(LinePattern::from_bits(0x3fff), dashed(14.0, 2.0));
-        assert_eq!(
-            LinePattern::from_bits(0xaaaa),
-            Some(LinePattern::Dotted { spacing: 2.0 })
-        );
-        assert_eq!(
-            LinePattern::from_bits(0x0001),
-            Some(LinePattern::Dotted { spacing: 16.0 })
-        );
-        // Two runs in the repeat, or none.
-        assert_eq!(LinePattern::from_bits(0x0505), None);
-        assert_eq!(LinePattern::from_bits(0x0000), None);
-    }
-}
-
 /// Twin of `dash_nearest` in common.wgsl: of the points of the pattern's dashes (cores
 /// `[j·period, j·period + dash]` for every integer j; `period` 0 for a solid line) that lie
 /// in `[lo, hi]`, the one nearest `s` (positions along the line, pixels); `None` where the
@@ -554,6 +527,28 @@ pub fn srgb_to_linear(x: f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn bit_patterns_become_one_dash_a_repeat() {
+        let dashed = |dash, gap| Some(LinePattern::Dashed { dash, gap });
+        assert_eq!(LinePattern::from_bits(0xffff), Some(LinePattern::Solid));
+        assert_eq!(LinePattern::from_bits(0xf0f0), dashed(4.0, 4.0));
+        // Lit bits 0, 1, 6 and 7 of each byte: one run of 4 across the repeat's end.
+        assert_eq!(LinePattern::from_bits(0xc3c3), dashed(4.0, 4.0));
+        assert_eq!(LinePattern::from_bits(0x00ff), dashed(8.0, 8.0));
+        assert_eq!(LinePattern::from_bits(0x3fff), dashed(14.0, 2.0));
+        assert_eq!(
+            LinePattern::from_bits(0xaaaa),
+            Some(LinePattern::Dotted { spacing: 2.0 })
+        );
+        assert_eq!(
+            LinePattern::from_bits(0x0001),
+            Some(LinePattern::Dotted { spacing: 16.0 })
+        );
+        // Two runs in the repeat, or none.
+        assert_eq!(LinePattern::from_bits(0x0505), None);
+        assert_eq!(LinePattern::from_bits(0x0000), None);
+    }
 
     #[test]
     fn hex_colours() {

@@ -407,6 +407,10 @@ struct BenchArgs {
     /// dotted[:SPACING]); the other methods draw none.
     #[arg(long, default_value = "off", value_name = "STYLE")]
     hidden: String,
+    /// Pattern of the visible drawn edges for the deferred method (solid,
+    /// dashed[:DASH,GAP], dotted[:SPACING]); the other methods draw them solid.
+    #[arg(long, default_value = "solid", value_name = "PATTERN")]
+    edge_pattern: String,
 }
 
 fn parse_timed(s: &str) -> std::result::Result<Timed, String> {
@@ -456,6 +460,7 @@ fn bench_command(args: &BenchArgs) -> Result<()> {
                         pattern,
                         ..HiddenLines::default()
                     }),
+                    edge_pattern: LinePattern::parse_visible(&args.edge_pattern)?,
                     ..Style::default()
                 };
                 style.validate()?;
@@ -487,6 +492,9 @@ fn bench_command(args: &BenchArgs) -> Result<()> {
     }
     progress.finish_and_clear();
     let device = wirepass::tools::bench::DeviceInfo::of(&ctx);
+    if args.edge_pattern != "solid" {
+        println!("Edges: {} (deferred only).\n", args.edge_pattern);
+    }
     if args.hidden != "off" {
         println!("Hidden lines: {} (deferred only).\n", args.hidden);
     }
