@@ -46,9 +46,14 @@ struct Frame {
     // Hidden lines (HIDDEN): linear RGBA colour of every instance's (without COLORS, they
     // share one).
     hidden_color: vec4<f32>,
-    // Chains of drawn edges (HIDDEN with a pattern, `chain_phases`): words of the phase
-    // tables in the outline buffer, chains over all instances, entries of `chain_work`.
+    // Chains of drawn edges (PATTERNS, `chain_phases`): words of the phase tables in the
+    // outline buffer, chains over all instances, entries of `chain_work`.
     chain_work: vec4<u32>,
+    // Linear RGBA of back faces seen through a section's cut (`sections_on` 1), and the
+    // section planes as coefficients of clip-space points (`section_sides`; unused: 0).
+    section_color: vec4<f32>,
+    sections: array<vec4<f32>, 6>,
+    sections_on: u32,
 }
 
 // Per instance (src/gpu/frame.rs, InstanceRecord). "Local" coordinates are the mesh
@@ -110,8 +115,9 @@ const INSTANCE_OUTLINES: u32 = 2u;
 const INSTANCE_HIDDEN: u32 = 4u;
 const INSTANCE_BEHIND_HOST: u32 = 8u;
 const INSTANCE_HIDDEN_EDGES: u32 = 16u;
-// Its drawn edges are patterned: the outline pass draws them, the edge pass leaves them.
-const INSTANCE_PATTERNED_EDGES: u32 = 32u;
+// Its drawn edges are drawn by the outline pass (patterned, or cut by section planes), and
+// the edge pass leaves them.
+const INSTANCE_LISTED_EDGES: u32 = 32u;
 // It has a phase table (`chain_phases`).
 const INSTANCE_PHASES: u32 = 64u;
 
@@ -488,6 +494,19 @@ fn srgb_to_linear(c: vec3<f32>) -> vec3<f32> {
 
 // Clip position for rasterising onto the targets with reverse depth (1 at near, 0 at far):
 // x and y mapped by the frame's crop, depth from the instance's depth row.
+// The sides of clip-space point c of the frame's section planes 0..3 and 4..5: negative
+// where c is cut away (0 for unused planes). Affine in c, so interpolated over a triangle
+// they are each pixel centre's own.
+struct SectionSides {
+    a: vec4<f32>,
+    b: vec2<f32>,
+}
+
+fn section_sides(f: Frame, c: vec4<f32>) -> SectionSides {
+    let s = f.sections;
+    return SectionSides(vec4<f32>(dot(s[0], c), dot(s[1], c), dot(s[2], c), dot(s[3], c)), vec2<f32>(dot(s[4], c), dot(s[5], c)));
+}
+
 fn raster_position(f: Frame, clip: mat4x4<f32>, depth_row: vec4<f32>, p: vec3<f32>) -> vec4<f32> {
     let h = vec4<f32>(p, 1.0);
     let c = clip * h;

@@ -426,7 +426,7 @@ fn own_lines(s: Sample) -> Own {
     let flags = instances[slot(s.inst)].flags;
     let bits = info[instances[slot(s.inst)].triangle_base + s.tri];
     // Patterned edges are drawn by the outline pass.
-    let edges = (flags & (INSTANCE_EDGES | INSTANCE_PATTERNED_EDGES)) == INSTANCE_EDGES;
+    let edges = (flags & (INSTANCE_EDGES | INSTANCE_LISTED_EDGES)) == INSTANCE_EDGES;
     let mask = select(0u, bits & 7u, edges);
     let near = vec3<f32>(s.clip0.z, s.clip1.z, s.clip2.z);
     let d = drawn_distances(s.lines, near, mask);
@@ -465,6 +465,13 @@ fn surface_pixel(xy: vec2<u32>, s: Sample, own: f32) -> Pixel {
     let n = b.x * unpack_normal(bitcast<u32>(s.v0.w)) + b.y * unpack_normal(bitcast<u32>(s.v1.w)) + b.z * unpack_normal(bitcast<u32>(s.v2.w));
     let face = cross(s.v1.xyz - s.v0.xyz, s.v2.xyz - s.v0.xyz);
     p.surface = surface_color(frame, instances[slot(inst)], local, n, face);
+    // A back face seen through a section's cut is the section face: the face's winding as
+    // the instance's transform leaves it (mirrored where its determinant is negative),
+    // against the eye.
+    let mirror = dot(instances[slot(inst)].normal_x, cross(instances[slot(inst)].normal_y, instances[slot(inst)].normal_z));
+    let eye = instances[slot(inst)].eye;
+    let back = dot(face, eye.xyz - local * eye.w) * mirror < 0.0;
+    p.surface = select(p.surface, frame.section_color.rgb, back && frame.sections_on != 0u);
     p.depth = s.depth;
     if own_key >= outline.x {
         p.distance = own;

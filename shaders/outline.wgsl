@@ -29,9 +29,10 @@
 // along the edge's projection from its end that comes first in (x, y, z) order, or on
 // along its chain of drawn edges (`chain_phases`).
 //
-// Patterned edges (INSTANCE_PATTERNED_EDGES): an instance whose drawn edges are dashed or
-// dotted has all of them in view listed here too, their visible runs drawn in dashes; the
-// edge pass then leaves its own triangles' edges.
+// Listed edges (INSTANCE_LISTED_EDGES): an instance whose drawn edges are dashed or dotted,
+// or cut by section planes, has all of them in view listed here too, their visible runs
+// drawn (in dashes); the edge pass then leaves its own triangles' edges. Every line ends
+// where a section plane cuts it (`edge_span`).
 //
 // Flags: COLORS (instances differ in line colour, or an outline's colour differs from the
 // edges': each pixel also keeps the greatest (intensity level, class, instance) word,
@@ -119,7 +120,7 @@ fn outline_cull(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     let outlines = (flags & INSTANCE_OUTLINES) != 0u && cluster_may_fold(cluster, instances[slot(inst)].eye);
     let splats = (flags & INSTANCE_EDGES) != 0u && cluster_splats(cluster);
     // Every drawn edge in view has a hidden part to find (HIDDEN), or a pattern to draw.
-    var listed = (flags & INSTANCE_PATTERNED_EDGES) != 0u;
+    var listed = (flags & INSTANCE_LISTED_EDGES) != 0u;
 #if HIDDEN
     let hidden_edges = INSTANCE_EDGES | INSTANCE_HIDDEN | INSTANCE_HIDDEN_EDGES;
     listed = listed || (flags & hidden_edges) == hidden_edges;
@@ -212,7 +213,7 @@ fn outline_triangle(inst: u32, t: u32) {
     let allowed = select(0u, (bits >> 8u) & 7u, outlines);
     // Drawn edges of a large patch, drawn here like outlines (mesh_store::EdgeData); all
     // drawn edges where they are patterned.
-    let patterned = select(0u, bits & 7u, (flags & INSTANCE_PATTERNED_EDGES) != 0u);
+    let patterned = select(0u, bits & 7u, (flags & INSTANCE_LISTED_EDGES) != 0u);
     let splat = select(0u, (bits >> 12u) & 7u, (flags & INSTANCE_EDGES) != 0u && patterned == 0u);
 #if HIDDEN
     // Drawn edges: their hidden parts, wherever they are.
@@ -295,7 +296,7 @@ fn pattern_anchor(inst: u32, t: u32, i: u32, a: vec3<f32>, b: vec3<f32>, mode: u
     if frame.chain_work.x != 0u && chained != 0u && (flags & INSTANCE_PHASES) != 0u {
         let e = chain_anchor(inst, phase_key(t, i));
         let hidden_edges = INSTANCE_EDGES | INSTANCE_HIDDEN | INSTANCE_HIDDEN_EDGES;
-        if (flags & INSTANCE_PATTERNED_EDGES) != 0u && (mode & DRAW_OUTLINE) == 0u {
+        if (flags & INSTANCE_LISTED_EDGES) != 0u && (mode & DRAW_OUTLINE) == 0u {
             anchor = vec4<f32>(e.y, e.z, anchor.zw);
         }
         if (flags & hidden_edges) == hidden_edges && instances[slot(inst)].hidden_period > 0.0 {
@@ -507,6 +508,10 @@ fn edge_span(inst: u32, a: vec3<f32>, b: vec3<f32>) -> Span {
     let fade_row = instances[slot(inst)].fade_row;
     var s = keep_positive(vec2<f32>(0.0, 1.0), ca.z, cb.z);
     s = keep_positive(s, dot(depth_row, ha), dot(depth_row, hb));
+    // Not behind a section plane (unused planes are 0, which keeps everything).
+    for (var k = 0u; k < 6u; k++) {
+        s = keep_positive(s, dot(frame.sections[k], ca), dot(frame.sections[k], cb));
+    }
     span.s = s;
     if !(s.x <= s.y) {
         return span;

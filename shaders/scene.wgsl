@@ -291,7 +291,8 @@ struct Sample {
     l1: vec3<f32>,
     l2: vec3<f32>,
     bary: vec3<f32>,
-    // The point's ray hits the triangle between the near and far planes.
+    // The point's ray hits the triangle between the near and far planes, where no section
+    // plane cuts it away.
     covers: bool,
     // Distances from the point to the three edge lines, drawn or not.
     lines: vec3<f32>,
@@ -337,7 +338,10 @@ fn sample_corners(inst: u32, tri: u32, v0: vec4<f32>, v1: vec4<f32>, v2: vec4<f3
     let b = s.bary;
     let hit = b.x * s.clip0 + b.y * s.clip1 + b.z * s.clip2;
     let r = b.x * dot(depth_row, h0) + b.y * dot(depth_row, h1) + b.z * dot(depth_row, h2);
-    s.covers = all(b >= vec3<f32>(0.0)) && hit.z >= 0.0 && r >= 0.0;
+    // Not cut away by a section plane (the visibility pass's test, at this point).
+    let sides = section_sides(frame, hit);
+    let kept = all(sides.a >= vec4<f32>(0.0)) && all(sides.b >= vec2<f32>(0.0));
+    s.covers = all(b >= vec3<f32>(0.0)) && hit.z >= 0.0 && r >= 0.0 && kept;
     s.near = hit.z;
     s.w = hit.w;
     s.depth = r / hit.w;

@@ -6,7 +6,8 @@
 //
 // Flags: PULLED (no PRIMITIVE_INDEX: a non-indexed draw of 3 × triangles vertices per
 // instance pulls its vertices from storage and passes the triangle as a flat varying;
-// SPLIT as in scene.wgsl).
+// SPLIT as in scene.wgsl), SECTIONS (fragments behind a section plane are discarded: the
+// planes' sides, interpolated, are exact at each pixel centre).
 
 #if !PULLED
 enable primitive_index;
@@ -30,17 +31,48 @@ struct Varyings {
 #if PULLED
     @location(1) @interpolate(flat) tri: u32,
 #endif
+#if SECTIONS
+    @location(2) sides_a: vec4<f32>,
+    @location(3) sides_b: vec2<f32>,
+#endif
+}
+
+// The varyings of local point p of an instance with clip rows `clip` and depth row
+// `depth_row`, in triangle `tri` (PULLED).
+fn varyings(clip: mat4x4<f32>, depth_row: vec4<f32>, p: vec3<f32>, slot: u32, tri: u32) -> Varyings {
+    var v: Varyings;
+    v.clip = raster_position(frame, clip, depth_row, p);
+    v.slot = slot;
+#if PULLED
+    v.tri = tri;
+#endif
+#if SECTIONS
+    let sides = section_sides(frame, clip * vec4<f32>(p, 1.0));
+    v.sides_a = sides.a;
+    v.sides_b = sides.b;
+#endif
+    return v;
+}
+
+// Discards a fragment behind a section plane (SECTIONS).
+fn cut(in: Varyings) {
+#if SECTIONS
+    if any(in.sides_a < vec4<f32>(0.0)) || any(in.sides_b < vec2<f32>(0.0)) {
+        discard;
+    }
+#endif
 }
 
 #if !PULLED
 @vertex
 fn vs_main(@location(0) position: vec3<f32>, inst: InstanceIn) -> Varyings {
     let clip = mat4x4<f32>(inst.clip0, inst.clip1, inst.clip2, inst.clip3);
-    return Varyings(raster_position(frame, clip, inst.depth_row, position), inst.slot);
+    return varyings(clip, inst.depth_row, position, inst.slot, 0u);
 }
 
 @fragment
 fn fs_main(in: Varyings, @builtin(primitive_index) primitive: u32) -> @location(0) vec2<u32> {
+    cut(in);
     return vec2<u32>(in.slot, primitive);
 }
 #else
@@ -74,11 +106,12 @@ fn vs_main(@builtin(vertex_index) corner: u32, inst: InstanceIn) -> Varyings {
     let p = vertices[v].xyz;
 #endif
     let clip = mat4x4<f32>(inst.clip0, inst.clip1, inst.clip2, inst.clip3);
-    return Varyings(raster_position(frame, clip, inst.depth_row, p), inst.slot, corner / 3u);
+    return varyings(clip, inst.depth_row, p, inst.slot, corner / 3u);
 }
 
 @fragment
 fn fs_main(in: Varyings) -> @location(0) vec2<u32> {
+    cut(in);
     return vec2<u32>(in.slot, in.tri);
 }
 #endif

@@ -103,7 +103,7 @@ pub use gpu::{
     PreparedFrame, RenderTarget, TriangleIds,
 };
 pub use mesh::{EdgeSelection, Mesh};
-pub use scene::{Highlight, Instance, InstanceStyle, Scene};
+pub use scene::{Highlight, Instance, InstanceStyle, Scene, SectionPlane, MAX_SECTIONS};
 pub use style::{Color, HiddenLines, LinePattern, Style};
 
 /// The wgpu this crate is built against: use it (`wirepass::wgpu`) so the host's types match.

@@ -8,7 +8,7 @@ use crate::camera::View;
 use crate::error::{Error, Result};
 use crate::gpu::MeshId;
 use crate::style::{Color, HiddenLines, LinePattern, MAX_LINE_WIDTH};
-use glam::DMat4;
+use glam::{DMat4, DVec3};
 
 /// Most instances a frame may hold: instance slots must fit 19 bits of the outline pass's
 /// per-pixel owner word, whose 20th says whether the line is an outline or an edge.
@@ -279,6 +279,73 @@ pub struct Scene<'a> {
     pub view: View,
     /// What is drawn, in order (the order numbers instances in dumps and ids).
     pub instances: std::borrow::Cow<'a, [Instance]>,
+    /// Section planes, at most [`MAX_SECTIONS`]: what lies behind any of them is cut away.
+    pub sections: Vec<SectionPlane>,
+}
+
+/// Most section planes a scene may hold.
+pub const MAX_SECTIONS: usize = 6;
+
+/// A section plane in world space: the half-space behind it (where
+/// `(x − point) · normal < 0`) is cut away, surfaces and lines alike, as a section view of a
+/// CAD program cuts a part open.
+///
+/// Surfaces are cut at each pixel centre (by the plane's distance, interpolated over the
+/// triangle from its corners, not by a depth guess); a drawn edge or an outline that crosses
+/// a plane ends where it meets it; back faces seen through the cut are drawn in
+/// [`Style::section_color`](crate::Style::section_color), so a closed part shows a solid
+/// section face. Only the deferred pass and the ground truth cut.
+///
+/// ```
+/// use wirepass::glam::DVec3;
+/// use wirepass::SectionPlane;
+/// // Keep x >= 0.5.
+/// let plane = SectionPlane::new(DVec3::new(0.5, 0.0, 0.0), DVec3::X);
+/// assert!(plane.validate(0).is_ok());
+/// assert!(plane.side(DVec3::new(1.0, 2.0, 3.0)) > 0.0);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SectionPlane {
+    /// A point of the plane.
+    pub point: DVec3,
+    /// Its normal, towards what is kept; any non-zero length.
+    pub normal: DVec3,
+}
+
+impl SectionPlane {
+    /// The plane through `point` with `normal` pointing into the kept half-space.
+    pub fn new(point: DVec3, normal: DVec3) -> SectionPlane {
+        SectionPlane { point, normal }
+    }
+
+    /// The plane's function at `p`: `(p − point) · normal / |normal|`, the signed distance,
+    /// negative where `p` is cut away.
+    pub fn side(&self, p: DVec3) -> f64 {
+        (p - self.point).dot(self.normal) / self.normal.length()
+    }
+
+    /// The plane as the coefficients `(n, −n · point)` of a unit normal n.
+    pub fn coefficients(&self) -> glam::DVec4 {
+        let n = self.normal / self.normal.length();
+        n.extend(-n.dot(self.point))
+    }
+
+    /// Checks that the point is finite and the normal finite and not zero; `index` names
+    /// the plane in errors.
+    pub fn validate(&self, index: usize) -> Result<()> {
+        let bad = |m: String| Err(Error::InvalidScene(format!("section plane {index}: {m}")));
+        if !self.point.is_finite() {
+            return bad(format!("its point {} is not finite", self.point));
+        }
+        let length = self.normal.length();
+        if !self.normal.is_finite() || !(length > 0.0) || !length.is_finite() {
+            return bad(format!(
+                "its normal {} is not a finite, non-zero vector",
+                self.normal
+            ));
+        }
+        Ok(())
+    }
 }
 
 impl<'a> Scene<'a> {
@@ -287,6 +354,7 @@ impl<'a> Scene<'a> {
         Scene {
             view,
             instances: instances.into(),
+            sections: Vec::new(),
         }
     }
 
@@ -295,7 +363,13 @@ impl<'a> Scene<'a> {
         Scene {
             view,
             instances: instances.into(),
+            sections: Vec::new(),
         }
+    }
+
+    /// This scene cut by `sections` (see [`SectionPlane`]).
+    pub fn with_sections(self, sections: Vec<SectionPlane>) -> Scene<'a> {
+        Scene { sections, ..self }
     }
 
     /// Checks the view and every instance.
@@ -311,6 +385,20 @@ impl<'a> Scene<'a> {
         for (i, instance) in self.instances.iter().enumerate() {
             instance.validate(i)?;
         }
-        Ok(())
+        validate_sections(&self.sections)
     }
+}
+
+/// Checks a list of section planes: at most [`MAX_SECTIONS`], each valid.
+pub fn validate_sections(sections: &[SectionPlane]) -> Result<()> {
+    if sections.len() > MAX_SECTIONS {
+        return Err(Error::InvalidScene(format!(
+            "{} section planes; at most {MAX_SECTIONS} are supported",
+            sections.len()
+        )));
+    }
+    for (i, s) in sections.iter().enumerate() {
+        s.validate(i)?;
+    }
+    Ok(())
 }

@@ -69,6 +69,9 @@ pub struct Style {
     pub fill_opacity: f32,
     /// Colour where no triangle is visible.
     pub background: Color,
+    /// Colour of the back faces seen through the cut of a section plane
+    /// ([`SectionPlane`](crate::SectionPlane)), unlit: the section face of a closed part.
+    pub section_color: Color,
     /// Share of ambient light, 0..1; the rest comes from the key light.
     pub ambient: f32,
     /// Direction towards the key light in view space (x right, y up, z towards the viewer),
@@ -377,6 +380,8 @@ impl Default for Style {
             fill_color: Color([0.55, 0.62, 0.72, 1.0]),
             fill_opacity: 1.0,
             background: Color([1.0, 1.0, 1.0, 1.0]),
+            // #d9a38c.
+            section_color: Color([0.694, 0.366, 0.262, 1.0]),
             ambient: 0.3,
             light_view_dir: Vec3::new(-0.4, 0.6, 1.0),
             outline_color: None,

@@ -9,7 +9,7 @@
 use crate::camera::View;
 use crate::error::{Error, Result};
 use crate::mesh::{EdgeSelection, Mesh};
-use crate::scene::InstanceStyle;
+use crate::scene::{InstanceStyle, SectionPlane};
 use crate::style::Style;
 use glam::{DMat4, DVec3};
 use std::sync::Arc;
@@ -62,12 +62,15 @@ pub struct World {
     pub meshes: Vec<WorldMesh>,
     /// The objects, in order; several may share a mesh.
     pub objects: Vec<Object>,
+    /// Section planes cutting the whole world (see [`SectionPlane`]).
+    pub sections: Vec<SectionPlane>,
 }
 
 impl World {
     /// One mesh, placed once at the origin.
     pub fn single(mesh: Mesh, edges: EdgeSelection) -> World {
         World {
+            sections: Vec::new(),
             meshes: vec![WorldMesh {
                 mesh: Arc::new(mesh),
                 edges,
@@ -83,6 +86,7 @@ impl World {
 
     /// Checks the objects' meshes and that every global id fits the id maps.
     pub fn validate(&self) -> Result<()> {
+        crate::scene::validate_sections(&self.sections)?;
         for (i, o) in self.objects.iter().enumerate() {
             if o.mesh >= self.meshes.len() {
                 return Err(Error::InvalidScene(format!(
@@ -144,7 +148,7 @@ impl World {
 #[cfg(feature = "formats")]
 impl World {
     /// A glTF scene as a world: each glTF mesh once, an object per instance in node order,
-    /// with the file's line width where it gives one. Each mesh draws `edges`, or, when that
+    /// with the file's line width and pattern where it gives them. Each mesh draws `edges`, or, when that
     /// is `None`, its authored edges where it has them (polygon edges otherwise); see
     /// [`Mesh::resolve_edges`] for what an explicit selection does to the file's outline mask.
     pub fn from_gltf(
@@ -181,7 +185,11 @@ impl World {
                 style: styles[mesh],
             })
             .collect();
-        World { meshes, objects }
+        World {
+            meshes,
+            objects,
+            sections: Vec::new(),
+        }
     }
 }
 

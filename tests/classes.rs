@@ -24,6 +24,7 @@ fn world() -> World {
     let scale = 2.0 / (hi - lo).max_element();
     let centre = 0.5 * (lo + hi);
     World {
+        sections: Vec::new(),
         meshes: vec![
             WorldMesh {
                 mesh: Arc::new(fandisk),
@@ -143,6 +144,7 @@ fn default_outline_style_is_the_line_style() {
     let world = world();
     let view = view(&world);
     let plain = World {
+        sections: Vec::new(),
         objects: world
             .objects
             .iter()

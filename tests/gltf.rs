@@ -428,6 +428,7 @@ fn node_hierarchy_instances_meshes_against_the_ground_truth() {
     let view = Camera::framing(lo, hi, aspect()).to_view(aspect());
     against_truth("hierarchy", &world, view, &Style::default());
     let feature = World {
+        sections: Vec::new(),
         meshes: world
             .meshes
             .iter()

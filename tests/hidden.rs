@@ -34,6 +34,7 @@ fn style(pattern: LinePattern, width: f32) -> Style {
 /// torus's rings, and its own back edges.
 fn cube_and_torus() -> World {
     World {
+        sections: Vec::new(),
         meshes: vec![
             WorldMesh {
                 mesh: Arc::new(Procedural::Cube(300).build().unwrap()),

@@ -20,6 +20,7 @@ const SIZE: (u32, u32) = (320, 240);
 /// A torus in front of a sphere, which it hides in part; both with polygon edges.
 fn world() -> World {
     World {
+        sections: Vec::new(),
         meshes: vec![
             WorldMesh {
                 mesh: Arc::new(Procedural::Sphere(800).build().unwrap()),

@@ -56,6 +56,7 @@ fn fixture() -> &'static Fixture {
     FIXTURE.get_or_init(|| {
         let scene = HostScene::new(common::load("spot.obj"), common::load("suzanne.obj"));
         let world = |meshes: Vec<&wirepass::Mesh>, at: Vec<wirepass::glam::DMat4>| World {
+            sections: Vec::new(),
             meshes: meshes
                 .into_iter()
                 .map(|m| WorldMesh {

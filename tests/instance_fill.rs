@@ -26,6 +26,7 @@ fn world() -> World {
         },
     };
     World {
+        sections: Vec::new(),
         meshes: vec![WorldMesh {
             mesh: Arc::new(Procedural::Sphere(2000).build().unwrap()),
             edges: EdgeSelection::Feature(60.0),

@@ -26,6 +26,7 @@ const DOTTED: LinePattern = LinePattern::Dotted { spacing: 5.0 };
 /// edges.
 fn part_and_torus() -> World {
     World {
+        sections: Vec::new(),
         meshes: vec![
             WorldMesh {
                 mesh: Arc::new(load("fandisk.obj")),

@@ -27,6 +27,7 @@ fn world() -> World {
     let sphere = std::sync::Arc::new(wirepass::mesh::sphere(600).unwrap());
     let tilt = DQuat::from_rotation_x(0.8);
     World {
+        sections: Vec::new(),
         meshes: vec![
             WorldMesh {
                 mesh: torus,

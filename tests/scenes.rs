@@ -22,6 +22,7 @@ const ASPECT: f64 = 320.0 / 240.0;
 
 fn world(meshes: Vec<(Mesh, EdgeSelection)>, objects: Vec<(usize, DMat4)>) -> World {
     World {
+        sections: Vec::new(),
         meshes: meshes
             .into_iter()
             .map(|(mesh, edges)| WorldMesh {

@@ -206,6 +206,7 @@ fn outline_pieces_past_the_list_s_room_are_drawn_where_they_are_found() {
         },
     };
     let world = World {
+        sections: Vec::new(),
         meshes: vec![WorldMesh {
             mesh,
             edges: EdgeSelection::All,

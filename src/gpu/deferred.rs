@@ -434,7 +434,7 @@ impl DeferredPass {
             }));
         }
         let split = data.split();
-        self.visibility.prepare(device, split)?;
+        self.visibility.prepare(device, split, data.sections())?;
         let targets = self
             .targets
             .clone()

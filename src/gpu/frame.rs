@@ -7,7 +7,7 @@ use super::canvas::Region;
 use super::mesh_store::{MeshRecord, MeshStore, StoreBuffers};
 use crate::camera::View;
 use crate::error::{Error, Result};
-use crate::scene::Scene;
+use crate::scene::{Scene, MAX_SECTIONS};
 use crate::style::Style;
 use glam::{DMat3, DMat4, DVec3, DVec4};
 use wgpu::util::DeviceExt;
@@ -36,6 +36,10 @@ pub(crate) struct FrameUniforms {
     fill_opacity: f32,
     hidden_color: [f32; 4],
     chain_work: [u32; 4],
+    section_color: [f32; 4],
+    sections: [[f32; 4]; MAX_SECTIONS],
+    sections_on: u32,
+    _pad_sections: [u32; 3],
 }
 
 /// Mirror of WGSL `struct Instance`; field order and padding match it.
@@ -86,7 +90,7 @@ const INSTANCE_BEHIND_HOST: u32 = 8;
 const INSTANCE_HIDDEN_EDGES: u32 = 16;
 /// `Instance.flags`: its drawn edges are patterned, so the outline pass draws them (their
 /// visible runs) and the edge pass leaves them.
-const INSTANCE_PATTERNED_EDGES: u32 = 32;
+const INSTANCE_LISTED_EDGES: u32 = 32;
 /// `Instance.flags`: it has a phase table (`chain_phases`).
 const INSTANCE_PHASES: u32 = 64;
 
@@ -295,7 +299,9 @@ impl FrameRecords {
             let edge_pattern = s.edge_pattern_in(style).dash_period();
             let outline_pattern = s.outline_pattern_in(style).dash_period();
             let patterned_edges = draws_edges && edge_pattern[1] > 0.0;
-            outlines |= hidden.is_some() || patterned_edges;
+            // Section planes cut the drawn edges short: the outline pass draws them.
+            let listed_edges = patterned_edges || (draws_edges && !scene.sections.is_empty());
+            outlines |= hidden.is_some() || listed_edges;
             patterns |= patterned_edges
                 || (draws_outline && outline_pattern[1] > 0.0)
                 || hidden.is_some_and(|h| h.pattern.dash_period()[1] > 0.0);
@@ -312,8 +318,8 @@ impl FrameRecords {
                 } else {
                     0
                 }
-                | if patterned_edges {
-                    INSTANCE_PATTERNED_EDGES
+                | if listed_edges {
+                    INSTANCE_LISTED_EDGES
                 } else {
                     0
                 };
@@ -373,7 +379,7 @@ impl FrameRecords {
             let mesh = store.record(scene.instances[order[slot] as usize].mesh)?;
             let wanted = INSTANCE_EDGES | INSTANCE_HIDDEN | INSTANCE_HIDDEN_EDGES;
             let hidden = record.hidden_period > 0.0 && record.flags & wanted == wanted;
-            let visible = record.flags & INSTANCE_PATTERNED_EDGES != 0;
+            let visible = record.flags & INSTANCE_LISTED_EDGES != 0 && record.edge_pattern[1] > 0.0;
             if !(hidden || visible) || mesh.chains == 0 {
                 continue;
             }
@@ -452,6 +458,10 @@ impl FrameRecords {
                 chain_work.len() as u32,
                 0,
             ],
+            section_color: style.section_color.0,
+            sections: section_planes(&view, &scene.sections)?,
+            sections_on: u32::from(!scene.sections.is_empty()),
+            _pad_sections: [0; 3],
         };
         Ok(FrameRecords {
             uniforms,
@@ -469,6 +479,35 @@ impl FrameRecords {
             chain_work,
         })
     }
+}
+
+/// The section planes as coefficients of the points of every instance's clip space (rows
+/// x, y, near, w of `View::clip_rows`): a world plane p composed with the inverse of the
+/// world → clip map, in f64. Unused planes are 0, which cut nothing.
+fn section_planes(
+    view: &View,
+    sections: &[crate::SectionPlane],
+) -> Result<[[f32; 4]; MAX_SECTIONS]> {
+    let mut out = [[0.0; 4]; MAX_SECTIONS];
+    if sections.is_empty() {
+        return Ok(out);
+    }
+    let clip = view.clip_rows(DMat4::IDENTITY).clip;
+    let det = clip.determinant();
+    if !(det.is_finite() && det != 0.0) {
+        return Err(Error::InvalidCamera(
+            "the view's projection cannot be inverted to place section planes".into(),
+        ));
+    }
+    let inverse = clip.inverse();
+    for (o, s) in out.iter_mut().zip(sections) {
+        // For a clip point c = C x: p · x = p · C⁻¹ c = (C⁻ᵀ p) · c.
+        let c = inverse.transpose() * s.coefficients();
+        // Scaled to unit size, so f32 keeps it whatever the scene's scale.
+        let c = c / c.abs().max_element();
+        *o = c.as_vec4().to_array();
+    }
+    Ok(out)
 }
 
 /// Words of a phase table entry: the edge's key, the hidden-line pattern's position and the
@@ -556,6 +595,11 @@ impl FrameData {
     /// Clusters of all instances together.
     pub fn uniforms_clusters(&self) -> u32 {
         self.uniforms.clusters
+    }
+
+    /// Whether the frame has section planes.
+    pub fn sections(&self) -> bool {
+        self.uniforms.sections_on != 0
     }
 
     /// Words of the outline buffer's phase tables, and the chains `chain_phases` visits.
@@ -688,7 +732,7 @@ mod tests {
     fn records_match_their_wgsl_layout() {
         assert_eq!(std::mem::size_of::<InstanceRecord>(), 272);
         assert!(u64::from(UNIFORM_INSTANCE_CAPACITY) * INSTANCE_BYTES <= 65536);
-        assert_eq!(std::mem::size_of::<FrameUniforms>(), 176);
+        assert_eq!(std::mem::size_of::<FrameUniforms>(), 304);
         let r = InstanceRecord::zeroed_for_test();
         let base = &r as *const _ as usize;
         assert_eq!(
@@ -780,5 +824,34 @@ mod tests {
         let e = glam::Vec4::from_array(r.eye).as_dvec4();
         let back = transform.transform_point3(mesh.origin + e.truncate() * mesh.scale);
         assert!((back - view.eye().truncate()).length() < 1e-4, "{back}");
+    }
+}
+
+#[cfg(test)]
+mod section_tests {
+    use super::*;
+
+    #[test]
+    fn section_planes_vanish_on_their_plane() {
+        let view = crate::camera::Camera {
+            eye: glam::Vec3::new(2.0, 2.2, 2.6),
+            target: glam::Vec3::ZERO,
+            up: glam::Vec3::Y,
+            fov_y_deg: 45.0,
+            near: 0.05,
+            far: 100.0,
+        }
+        .to_view(4.0 / 3.0);
+        let s = crate::SectionPlane::new(DVec3::new(0.2, 0.0, 0.0), DVec3::new(-1.0, 0.0, 0.0));
+        let planes = section_planes(&view, &[s]).unwrap();
+        let p = glam::Vec4::from_array(planes[0]).as_dvec4();
+        let clip = view.clip_rows(DMat4::IDENTITY).clip;
+        // On the plane: zero to f32's rounding; either side: the world side's sign.
+        let on = clip * DVec3::new(0.2, 1.0, -1.0).extend(1.0);
+        assert!(p.dot(on).abs() < 1e-6, "{}", p.dot(on));
+        for x in [DVec3::new(0.2036, 0.99, -1.0), DVec3::new(0.1, 0.0, 0.5)] {
+            let c = clip * x.extend(1.0);
+            assert_eq!(p.dot(c) > 0.0, s.side(x) > 0.0, "{x}");
+        }
     }
 }

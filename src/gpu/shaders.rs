@@ -119,9 +119,13 @@ pub fn encode_output(format: wgpu::TextureFormat) -> &'static str {
     }
 }
 
-/// The visibility pass's module: vertex-pulled or not, for a split store or not.
-pub fn visibility_source(pulled: bool, split: bool) -> String {
+/// The visibility pass's module: vertex-pulled or not, for a split store or not, cutting by
+/// section planes or not.
+pub fn visibility_source(pulled: bool, split: bool, sections: bool) -> String {
     let mut flags = vec![];
+    if sections {
+        flags.push("SECTIONS");
+    }
     if pulled {
         flags.push("PULLED");
     }

@@ -158,10 +158,12 @@ pub fn shader_modules() -> Vec<(String, String)> {
     }
     for pulled in [false, true] {
         for split in [false, true] {
-            out.push((
-                format!("visibility pulled={pulled} split={split}"),
-                visibility_source(pulled, split),
-            ));
+            for sections in [false, true] {
+                out.push((
+                    format!("visibility pulled={pulled} split={split} sections={sections}"),
+                    visibility_source(pulled, split, sections),
+                ));
+            }
         }
     }
     let variants = Variant::all();

@@ -9,10 +9,15 @@ use super::{shaders, GpuTimer};
 use crate::error::Result;
 
 /// The visibility pipelines: instanced with `@builtin(primitive_index)`, or vertex-pulled
-/// (`TriangleIds`; then also in a variant for a split store).
+/// (`TriangleIds`; then also in a variant for a split store); each also cutting by section
+/// planes, built for the first frame that has some. Indexed by `split + 2 · sections`.
 pub(crate) struct Visibility {
     pulled: bool,
-    pipelines: [Option<Raster>; 2],
+    pipelines: [Option<Raster>; 4],
+}
+
+fn index(split: bool, sections: bool) -> usize {
+    usize::from(split) + 2 * usize::from(sections)
 }
 
 struct Raster {
@@ -70,14 +75,14 @@ impl Visibility {
     pub fn new(device: &wgpu::Device, pulled: bool) -> Result<Visibility> {
         let mut v = Visibility {
             pulled,
-            pipelines: [None, None],
+            pipelines: [None, None, None, None],
         };
-        v.pipelines[0] = Some(v.build(device, false)?);
+        v.pipelines[0] = Some(v.build(device, false, false)?);
         Ok(v)
     }
 
-    fn build(&self, device: &wgpu::Device, split: bool) -> Result<Raster> {
-        let source = shaders::visibility_source(self.pulled, split);
+    fn build(&self, device: &wgpu::Device, split: bool, sections: bool) -> Result<Raster> {
+        let source = shaders::visibility_source(self.pulled, split, sections);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("wirepass visibility"),
             source: wgpu::ShaderSource::Wgsl(source.into()),
@@ -145,10 +150,13 @@ impl Visibility {
         })
     }
 
-    /// Builds what a frame with a split store needs, before it is encoded.
-    pub fn prepare(&mut self, device: &wgpu::Device, split: bool) -> Result<()> {
-        if split && self.pulled && self.pipelines[1].is_none() {
-            self.pipelines[1] = Some(self.build(device, true)?);
+    /// Builds what a frame with a split store, or with section planes, needs, before it is
+    /// encoded.
+    pub fn prepare(&mut self, device: &wgpu::Device, split: bool, sections: bool) -> Result<()> {
+        let split = split && self.pulled;
+        let at = index(split, sections);
+        if self.pipelines[at].is_none() {
+            self.pipelines[at] = Some(self.build(device, split, sections)?);
         }
         Ok(())
     }
@@ -165,7 +173,7 @@ impl Visibility {
         timer: Option<&mut GpuTimer>,
     ) -> Result<()> {
         let split = frame.split() && self.pulled;
-        let raster = self.pipelines[usize::from(split)]
+        let raster = self.pipelines[index(split, frame.sections())]
             .as_ref()
             .ok_or_else(|| crate::Error::Device("visibility pipeline was not prepared".into()))?;
         let group = bindings::bind_group(

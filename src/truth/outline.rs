@@ -14,10 +14,11 @@
 //! that draw their edges, by the same definition: the pixels of a large patch near an
 //! undrawn edge find their lines here.
 //!
-//! The drawn edges of an object whose edges are patterned are all here, their visible parts
-//! in dashes (the per-pixel own-edge distance leaves them). A pattern of drawn edges or of
-//! their hidden parts runs along each chain of drawn edges (`src/mesh/chains.rs`): an
-//! edge's dashes start where the chain's projected length before it leaves the pattern.
+//! The drawn edges of an object whose edges are patterned, or cut by section planes, are all
+//! here, their visible parts drawn (in dashes; the per-pixel own-edge distance leaves them),
+//! and every line ends where a section plane cuts it. A pattern of drawn edges or of their
+//! hidden parts runs along each chain of drawn edges (`src/mesh/chains.rs`): an edge's
+//! dashes start where the chain's projected length before it leaves the pattern.
 //!
 //! Visibility along an edge is found by casting a ray through points every 1/8 pixel of its
 //! projection and bisecting each change to 2⁻³⁰ of the edge. The GPU pass does the same at
@@ -141,7 +142,7 @@ pub(crate) fn outline_map(
             let mesh = &world.meshes[object.mesh].mesh;
             let local = edge_math::local_eye(object.transform, eye);
             let first = caster.first_ids()[o];
-            let patterned = styles[o].patterned_edges();
+            let listed = styles[o].listed_edges();
             let widths = (styles[o].width, styles[o].outline_width);
             let patterns = (styles[o].edge_pattern, styles[o].outline_pattern);
             let tris = mesh.triangles();
@@ -155,7 +156,7 @@ pub(crate) fn outline_map(
                 };
                 edges.extend(outline_edges(mesh, local).into_iter().map(|e| (e, outline)));
             }
-            if styles[o].edges && !patterned {
+            if styles[o].edges && !listed {
                 let splat = &patches[object.mesh].splat;
                 let draw = Draw {
                     visible: true,
@@ -168,12 +169,12 @@ pub(crate) fn outline_map(
                         .map(move |i| ((t as u32, i), draw))
                 }));
             }
-            if styles[o].edges && (hidden_edges || patterned) {
+            if styles[o].edges && (hidden_edges || listed) {
                 // Every drawn edge has hidden parts to find, or visible ones to draw in
                 // their pattern; a shared one is drawn by the lower id only.
                 let mask = &masks[object.mesh];
                 let draw = Draw {
-                    visible: patterned,
+                    visible: listed,
                     hidden: hidden_edges,
                     outline: false,
                 };
@@ -204,7 +205,7 @@ pub(crate) fn outline_map(
             let hidden_period = hidden
                 .filter(|_| hidden_edges)
                 .map_or(0.0, |h| f64::from(h.pattern.dash_period()[1]));
-            let periods = [hidden_period, if patterned { patterns.0[1] } else { 0.0 }];
+            let periods = [hidden_period, if listed { patterns.0[1] } else { 0.0 }];
             // Welded vertices and the chains' anchors, where a pattern runs along them.
             let chained = (styles[o].edges && periods.iter().any(|&p| p > 0.0)).then(|| {
                 let weld = crate::mesh::adjacency::weld_by_position(mesh.positions());
@@ -355,8 +356,9 @@ enum Class {
 }
 
 impl Visibility<'_> {
-    /// The part of the edge `a` → `b` (world coordinates) in front of the near plane and not
-    /// beyond the far one, as parameters along it, and the projections of its ends.
+    /// The part of the edge `a` → `b` (world coordinates) in front of the near plane, not
+    /// beyond the far one and not behind a section plane, as parameters along it, and the
+    /// projections of its ends.
     fn span(&self, a: DVec3, b: DVec3) -> Option<((f64, f64), Projected, Projected)> {
         let (ca, cb) = (self.rays.clip(a), self.rays.clip(b));
         let depth = self.rays.rows().depth;
@@ -364,6 +366,9 @@ impl Visibility<'_> {
         let mut s = (0.0, 1.0);
         keep_positive(&mut s, ca.z, cb.z);
         keep_positive(&mut s, depth.dot(ha), depth.dot(hb));
+        for plane in &self.caster.world().sections {
+            keep_positive(&mut s, plane.side(a), plane.side(b));
+        }
         if !(s.0 <= s.1) {
             return None;
         }

@@ -216,6 +216,8 @@ struct Shading {
     ambient: f64,
     fade: [f64; 2],
     fill_opacity: f64,
+    /// The colour of back faces seen through a section's cut (linear RGB).
+    section_color: [f64; 3],
 }
 
 impl Shading {
@@ -229,6 +231,7 @@ impl Shading {
             ambient: f64::from(s.ambient),
             fade: s.fade_range().map(f64::from),
             fill_opacity: f64::from(s.fill_opacity),
+            section_color: [0, 1, 2].map(|k| f64::from(s.section_color.0[k])),
         }
     }
 }
@@ -311,7 +314,7 @@ impl Truth<'_> {
         let corners = self.caster.corners(hit.id);
         let clip: [DVec4; 3] = corners.map(|p| self.rays.clip(p));
         // Patterned edges are in the outline map, drawn where they are visible.
-        let own_edges = st.edges && !st.patterned_edges();
+        let own_edges = st.edges && !st.listed_edges();
         let mask = if own_edges {
             self.masks[object.mesh][hit.tri as usize]
         } else {
@@ -361,7 +364,15 @@ impl Truth<'_> {
         };
         // The surface over the background at the fill opacity (twin of `see_through`).
         let (surface, alpha) = {
-            let s = surface_color(sh, st, &wm.mesh, tri, e.bary, point);
+            // A back face seen through a section's cut is the section face (twin of
+            // `surface_pixel`): the world winding of its corners, against the eye.
+            let face = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
+            let back = face.dot(edge_math::towards_eye(point, sh.eye)) < 0.0;
+            let s = if st.sectioned && back {
+                sh.section_color
+            } else {
+                surface_color(sh, st, &wm.mesh, tri, e.bary, point)
+            };
             let k = sh.fill_opacity;
             if k < 1.0 {
                 let bg = sh.background.0.map(f64::from);

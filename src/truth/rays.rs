@@ -145,6 +145,11 @@ impl<'a> RayCaster<'a> {
             let Some(t) = intersect(&self.corners[id as usize], o, d) else {
                 return f32::INFINITY;
             };
+            // What a section plane cuts away is not there.
+            let point = self.centre + o + d * t;
+            if self.world.sections.iter().any(|s| s.side(point) < 0.0) {
+                return f32::INFINITY;
+            }
             let better = match best {
                 None => true,
                 Some((bt, bid)) => t < bt || (t == bt && id < bid),
@@ -299,6 +304,8 @@ pub(crate) struct ObjectStyle {
     /// edges', the outline's.
     pub edge_pattern: [f64; 2],
     pub outline_pattern: [f64; 2],
+    /// The world has section planes.
+    pub sectioned: bool,
     /// Its hidden lines, where it draws any lines.
     pub hidden: Option<style::HiddenLines>,
     /// Model → world normal matrix.
@@ -306,10 +313,10 @@ pub(crate) struct ObjectStyle {
 }
 
 impl ObjectStyle {
-    /// Whether the object draws its edges in a dashed or dotted pattern (the outline map
-    /// then holds them).
-    pub fn patterned_edges(&self) -> bool {
-        self.edges && self.edge_pattern[1] > 0.0
+    /// Whether the object's drawn edges are in the outline map (dashed or dotted, or cut by
+    /// section planes), not measured from each pixel's own triangle.
+    pub fn listed_edges(&self) -> bool {
+        self.edges && (self.edge_pattern[1] > 0.0 || self.sectioned)
     }
 
     pub fn of(world: &World, style: &style::Style) -> Vec<ObjectStyle> {
@@ -338,6 +345,7 @@ impl ObjectStyle {
                     .outline_pattern_in(style)
                     .dash_period()
                     .map(f64::from),
+                sectioned: !world.sections.is_empty(),
                 hidden: o.style.hidden_in(style).filter(|_| {
                     o.style.edges.unwrap_or(true) || o.style.outlines.unwrap_or(style.silhouettes)
                 }),

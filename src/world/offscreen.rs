@@ -44,7 +44,7 @@ impl Uploaded {
                 style: o.style,
             })
             .collect();
-        Scene::new(view, instances)
+        Scene::new(view, instances).with_sections(world.sections.clone())
     }
 
     /// The two-pass method's edge lists of every mesh.

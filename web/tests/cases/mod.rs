@@ -87,6 +87,7 @@ fn framed(world: &World) -> View {
 
 fn world(meshes: Vec<Mesh>, objects: Vec<(usize, DMat4)>) -> World {
     World {
+        sections: Vec::new(),
         meshes: meshes
             .into_iter()
             .map(|mesh| WorldMesh {

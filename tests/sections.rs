@@ -1,0 +1,193 @@
+//! Section planes (`Scene::sections`, `World::sections`): the deferred pass cuts surfaces
+//! and lines where the ground truth does, and draws the back faces seen through the cut in
+//! the section colour.
+
+mod common;
+
+use common::{channel_difference, load, shoot_world, worst_pixels};
+use glam::{DMat4, DVec3, Vec3};
+use std::sync::Arc;
+use wirepass::mesh::Procedural;
+use wirepass::tools::offline::Method;
+use wirepass::truth::accuracy::{distance_error, id_agreement};
+use wirepass::world::{Object, World, WorldMesh};
+use wirepass::{EdgeSelection, Error, Mesh, SectionPlane, Style, View};
+
+const SIZE: (u32, u32) = (320, 240);
+
+fn perspective(world: &World, eye: DVec3) -> View {
+    let (lo, hi) = world.bounds();
+    wirepass::Camera {
+        eye: eye.as_vec3(),
+        target: (0.5 * (lo + hi)).as_vec3(),
+        up: Vec3::Y,
+        fov_y_deg: 45.0,
+        near: 0.05,
+        far: 100.0,
+    }
+    .to_view(f64::from(SIZE.0) / f64::from(SIZE.1))
+}
+
+fn plane(point: [f64; 3], normal: [f64; 3]) -> SectionPlane {
+    SectionPlane::new(DVec3::from(point), DVec3::from(normal))
+}
+
+/// The deferred frame against the ground truth; returns the pixels showing a section face
+/// (a back face in the section colour) in the truth.
+fn check(name: &str, world: &World, view: View, style: &Style) -> usize {
+    let truth = shoot_world(world, view, style, SIZE, Method::Raycast);
+    let frame = shoot_world(world, view, style, SIZE, Method::Deferred);
+    let (ids, _) = id_agreement(&truth, &frame).unwrap();
+    let lines = distance_error(&truth, &frame).unwrap();
+    println!("{name}: id {ids:.5}, lines {lines:?}");
+    let worst = || worst_pixels(&truth, &frame, 0.01, 8);
+    assert!(ids >= 0.999, "{name}: id agreement {ids}");
+    if lines.pixels > 0 {
+        assert!(lines.p99.unwrap() <= 0.01, "{name}: {lines:?}\n{}", worst());
+        assert!(lines.max.unwrap() <= 0.1, "{name}: {lines:?}\n{}", worst());
+    }
+    // Colours where both show the same triangle away from lines: the section face and the
+    // shaded surface alike.
+    let section = style.section_color.to_srgb8();
+    let (mut faces, mut worst_channel) = (0, 0);
+    for i in 0..truth.ids.len() {
+        if truth.ids[i] != frame.ids[i] || truth.edge_distance[i] < 3.0 {
+            continue;
+        }
+        worst_channel = worst_channel.max(channel_difference(&truth, &frame, i));
+        if truth.rgba[4 * i..4 * i + 3] == section[..3] {
+            faces += 1;
+        }
+    }
+    assert!(
+        worst_channel <= 1,
+        "{name}: colours differ by {worst_channel}"
+    );
+    faces
+}
+
+fn single(mesh: Mesh, edges: EdgeSelection, sections: Vec<SectionPlane>) -> World {
+    let mut world = World::single(mesh, edges);
+    world.sections = sections;
+    world
+}
+
+#[test]
+fn a_closed_part_cut_open_shows_its_section_face() {
+    let mesh = load("fandisk.obj");
+    let (lo, hi) = mesh.bounds_f64();
+    let centre = 0.5 * (lo + hi);
+    let world = single(
+        mesh,
+        EdgeSelection::Feature(30.0),
+        vec![plane(centre.to_array(), [1.0, 0.0, 0.3])],
+    );
+    let view = perspective(&world, centre + DVec3::new(-1.5, 1.0, 2.2));
+    let faces = check("fandisk", &world, view, &Style::default());
+    assert!(faces > 500, "fandisk: {faces} section-face pixels");
+    // The cut away half is gone: fewer triangles seen than uncut.
+    let mut whole = world.clone();
+    whole.sections.clear();
+    let cut = shoot_world(&world, view, &Style::default(), SIZE, Method::Deferred);
+    let uncut = shoot_world(&whole, view, &Style::default(), SIZE, Method::Deferred);
+    let differ = (0..cut.ids.len())
+        .filter(|&i| cut.ids[i] != uncut.ids[i])
+        .count();
+    assert!(differ > 5000, "{differ} pixels changed by the cut");
+}
+
+#[test]
+fn a_plane_that_misses_everything_changes_nothing() {
+    let mesh = Procedural::Torus(2000).build().unwrap();
+    let world = single(
+        mesh.clone(),
+        EdgeSelection::All,
+        vec![plane([0.0, -5.0, 0.0], [0.0, 1.0, 0.0])],
+    );
+    let view = perspective(&world, DVec3::new(1.5, 2.0, 2.5));
+    assert_eq!(check("missing", &world, view, &Style::default()), 0);
+    // The same image as without it, but for the drawn edges now found by the outline pass
+    // (the same lines within the usual bounds).
+    let plain = shoot_world(
+        &World::single(mesh, EdgeSelection::All),
+        view,
+        &Style::default(),
+        SIZE,
+        Method::Deferred,
+    );
+    let cut = shoot_world(&world, view, &Style::default(), SIZE, Method::Deferred);
+    assert_eq!(plain.ids, cut.ids);
+}
+
+#[test]
+fn two_planes_cut_a_corner_out_of_a_box() {
+    let world = single(
+        Procedural::Cube(300).build().unwrap(),
+        EdgeSelection::Feature(30.0),
+        vec![
+            plane([0.2, 0.0, 0.0], [-1.0, 0.0, 0.0]),
+            plane([0.0, 0.1, 0.0], [0.0, -1.0, 0.0]),
+        ],
+    );
+    // What is kept: x <= 0.2 and y <= 0.1, two cuts meeting along an edge, seen from the
+    // side they open.
+    let view = perspective(&world, DVec3::new(2.0, 2.2, 2.6));
+    let faces = check("corner", &world, view, &Style::default());
+    assert!(faces > 1000, "corner: {faces} section-face pixels");
+}
+
+#[test]
+fn a_dense_mesh_cut_at_a_grazing_angle_and_an_open_mesh() {
+    let world = single(
+        Procedural::Sphere(200_000).build().unwrap(),
+        EdgeSelection::Polygon,
+        vec![plane([0.0, 0.0, 0.0], [0.05, 0.2, 1.0])],
+    );
+    // The eye almost in the plane.
+    let view = perspective(&world, DVec3::new(0.3, -0.2, 2.4));
+    check("grazing", &world, view, &Style::default());
+    // A grid (open boundaries) cut across, and a mirrored copy, orthographic.
+    let grid = Procedural::Grid(2000).build().unwrap();
+    let mut world = single(
+        grid,
+        EdgeSelection::All,
+        vec![plane([0.1, 0.0, 0.0], [1.0, 0.4, 0.2])],
+    );
+    world.objects.push(Object::new(
+        0,
+        DMat4::from_translation(DVec3::new(0.0, 0.0, -0.5))
+            * DMat4::from_scale(DVec3::new(-1.0, 1.0, 1.0)),
+    ));
+    let aspect = f64::from(SIZE.0) / f64::from(SIZE.1);
+    let at = (DVec3::new(-1.0, 2.0, 3.0), DVec3::ZERO, DVec3::Y);
+    let ortho = View::orthographic(at, 3.0, aspect, (0.1, 20.0));
+    check("open, orthographic", &world, ortho, &Style::default());
+}
+
+#[test]
+fn bad_section_planes_are_errors() {
+    let mesh = Arc::new(Procedural::Sphere(200).build().unwrap());
+    let mut world = World {
+        meshes: vec![WorldMesh {
+            mesh,
+            edges: EdgeSelection::All,
+            name: "sphere".into(),
+        }],
+        objects: vec![Object::new(0, DMat4::IDENTITY)],
+        sections: Vec::new(),
+    };
+    for (sections, expect) in [
+        (vec![plane([0.0; 3], [0.0; 3])], "normal"),
+        (vec![plane([0.0; 3], [f64::NAN, 1.0, 0.0])], "normal"),
+        (
+            vec![plane([f64::INFINITY, 0.0, 0.0], [1.0, 0.0, 0.0])],
+            "point",
+        ),
+        (vec![plane([0.0; 3], [1.0, 0.0, 0.0]); 7], "at most 6"),
+    ] {
+        world.sections = sections;
+        let e = world.validate().unwrap_err();
+        assert!(matches!(e, Error::InvalidScene(_)), "{e}");
+        assert!(e.to_string().contains(expect), "{e}");
+    }
+}
