@@ -54,6 +54,9 @@ struct Frame {
     section_color: vec4<f32>,
     sections: array<vec4<f32>, 6>,
     sections_on: u32,
+    // The cut lines' width in pixels and linear RGBA colour.
+    section_width: f32,
+    section_line_color: vec4<f32>,
 }
 
 // Per instance (src/gpu/frame.rs, InstanceRecord). "Local" coordinates are the mesh

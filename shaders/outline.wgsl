@@ -125,8 +125,11 @@ fn outline_cull(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     let hidden_edges = INSTANCE_EDGES | INSTANCE_HIDDEN | INSTANCE_HIDDEN_EDGES;
     listed = listed || (flags & hidden_edges) == hidden_edges;
 #endif
-    let drawn = listed && cluster_draws(cluster) && cluster_in_view(instances[slot(inst)].clip, cluster);
-    if !outlines && !splats && !drawn {
+    let in_view = cluster_in_view(instances[slot(inst)].clip, cluster);
+    let drawn = listed && cluster_draws(cluster) && in_view;
+    // A section plane cuts it: it has cut lines to draw.
+    let cut = frame.sections_on != 0u && cluster_cut(instances[slot(inst)].clip, cluster) && in_view;
+    if !outlines && !splats && !drawn && !cut {
         return;
     }
     let k = atomicAdd(&cull_rw.count, 1u);
@@ -154,6 +157,62 @@ fn cluster_in_view(clip: mat4x4<f32>, c: Cluster) -> bool {
         inside = inside && dot(r.xyz, c.center) + r.w >= -cluster_radius(c) * length(r.xyz);
     }
     return inside;
+}
+
+// Whether a section plane passes through a cluster's bounding sphere (local -> clip rows
+// `clip`; unused planes are 0 and pass through nothing).
+fn cluster_cut(clip: mat4x4<f32>, c: Cluster) -> bool {
+    var cut = false;
+    for (var k = 0u; k < 6u; k++) {
+        let r = frame.sections[k] * clip;
+        let reach = cluster_radius(c) * length(r.xyz);
+        cut = cut || (reach > 0.0 && abs(dot(r.xyz, c.center) + r.w) <= reach);
+    }
+    return cut;
+}
+
+// The section planes a triangle (local corners p) crosses, a bit each: those with corners
+// on both sides (cut away, and kept).
+fn cut_planes(inst: u32, p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>) -> u32 {
+    let clip = instances[slot(inst)].clip;
+    let c0 = clip * vec4<f32>(p0, 1.0);
+    let c1 = clip * vec4<f32>(p1, 1.0);
+    let c2 = clip * vec4<f32>(p2, 1.0);
+    var cuts = 0u;
+    for (var k = 0u; k < 6u; k++) {
+        let s = vec3<f32>(dot(frame.sections[k], c0), dot(frame.sections[k], c1), dot(frame.sections[k], c2));
+        let away = s < vec3<f32>(0.0);
+        cuts |= select(0u, 1u << k, any(away) && !all(away));
+    }
+    return cuts;
+}
+
+// Where section plane k meets a triangle that crosses it (local corners p): the points
+// where its side changes sign on the two edges it crosses (twin of `cut_segment` in
+// src/truth/outline.rs).
+fn cut_segment(inst: u32, p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>, k: u32) -> array<vec3<f32>, 2> {
+    let clip = instances[slot(inst)].clip;
+    let p = array<vec3<f32>, 3>(p0, p1, p2);
+    var s: array<f32, 3>;
+    for (var j = 0u; j < 3u; j++) {
+        s[j] = dot(frame.sections[k], clip * vec4<f32>(p[j], 1.0));
+    }
+    var ends = array<vec3<f32>, 2>(p0, p0);
+    var found = 0u;
+    for (var j = 0u; j < 3u; j++) {
+        let a = s[j];
+        let b = s[(j + 1u) % 3u];
+        if (a < 0.0) != (b < 0.0) && found < 2u {
+            ends[found] = mix(p[j], p[(j + 1u) % 3u], a / (a - b));
+            found++;
+        }
+    }
+    return ends;
+}
+
+// The plane of a cut line's `mode` (DRAW_CUT), else NO_PLANE.
+fn cut_plane(mode: u32) -> u32 {
+    return select(NO_PLANE, (mode >> CUT_PLANE_SHIFT) & 7u, (mode & DRAW_CUT) != 0u);
 }
 
 // Triangles per cluster, and invocations per workgroup of both entry points.
@@ -188,11 +247,19 @@ fn outline_pieces_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_i
         let piece = atomicLoad(&acc_rw[at + 3u]) & 0xffffu;
         let base = instances[slot(inst)].triangle_base;
         let v = corners(base + t) + instances[slot(inst)].vertex_base;
-        let a = vertex_at(v[i]).xyz;
-        let b = vertex_at(v[(i + 1u) % 3u]).xyz;
         let mode = word >> 2u;
+        var a = vertex_at(v[i]).xyz;
+        var b = vertex_at(v[(i + 1u) % 3u]).xyz;
+        var n = neighbour(base + t, i);
+        // A cut line: where its plane meets the triangle.
+        if (mode & DRAW_CUT) != 0u {
+            let cut = cut_segment(inst, vertex_at(v.x).xyz, vertex_at(v.y).xyz, vertex_at(v.z).xyz, cut_plane(mode));
+            a = cut[0];
+            b = cut[1];
+            n = BACKGROUND_ID;
+        }
         let anchor = pattern_anchor(inst, t, i, a, b, mode);
-        let c = clip_outline(inst, t, neighbour(base + t, i), a, b, anchor);
+        let c = clip_outline(inst, t, n, a, b, anchor, cut_plane(mode));
         draw_piece(c.seg, f32(piece) / f32(c.pieces), f32(piece + 1u) / f32(c.pieces), c.length_px, mode);
     }
 }
@@ -239,8 +306,16 @@ fn outline_triangle(inst: u32, t: u32) {
     // Seen along one direction (w = 0): the angle to edge-on is the same from every vertex.
     let along = !(abs(dot(eye.xyz, normal)) > fold_bound * length(eye.xyz) * length(normal));
     let may_fold = select(along, !(height > fold_bound * farthest * length(normal)), eye.w != 0.0);
-    if !(may_fold && outlines) && !boundary && splat == 0u && drawn == 0u {
+    let cuts = cut_planes(inst, p[0], p[1], p[2]);
+    if !(may_fold && outlines) && !boundary && splat == 0u && drawn == 0u && cuts == 0u {
         return;
+    }
+    // Cut lines, one a plane the triangle crosses (a loop, which a software rasterizer skips
+    // where no lane enters it).
+    for (var rest = cuts; rest != 0u; rest &= rest - 1u) {
+        let k = firstTrailingBit(rest);
+        let cut = cut_segment(inst, p[0], p[1], p[2], k);
+        list_outline(inst, t, 0u, BACKGROUND_ID, cut[0], cut[1], DRAW_VISIBLE | DRAW_CUT | (k << CUT_PLANE_SHIFT));
     }
     for (var i = 0u; i < 3u; i++) {
         if ((allowed | splat | drawn) & (1u << i)) == 0u {
@@ -293,7 +368,7 @@ fn pattern_anchor(inst: u32, t: u32, i: u32, a: vec3<f32>, b: vec3<f32>, mode: u
 #if PATTERNS
     let flags = instances[slot(inst)].flags;
     let chained = (info[instances[slot(inst)].triangle_base + t] >> (INFO_CHAINED_SHIFT + i)) & 1u;
-    if frame.chain_work.x != 0u && chained != 0u && (flags & INSTANCE_PHASES) != 0u {
+    if frame.chain_work.x != 0u && chained != 0u && (flags & INSTANCE_PHASES) != 0u && (mode & DRAW_CUT) == 0u {
         let e = chain_anchor(inst, phase_key(t, i));
         let hidden_edges = INSTANCE_EDGES | INSTANCE_HIDDEN | INSTANCE_HIDDEN_EDGES;
         if (flags & INSTANCE_LISTED_EDGES) != 0u && (mode & DRAW_OUTLINE) == 0u {
@@ -369,7 +444,7 @@ fn chain_phases(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
         atomicStore(&acc_rw[at], e.z);
         atomicStore(&acc_rw[at + 1u], bitcast<u32>(position.x));
         atomicStore(&acc_rw[at + 2u], bitcast<u32>(position.y));
-        let span = edge_span(inst, vertex_at(vbase + e.x).xyz, vertex_at(vbase + e.y).xyz);
+        let span = edge_span(inst, vertex_at(vbase + e.x).xyz, vertex_at(vbase + e.y).xyz, NO_PLANE);
         position += select(0.0, length(span.p1.xy - span.p0.xy), span.s.x <= span.s.y);
         position = select(vec2<f32>(0.0), position - periods * floor(position / periods), periods > vec2<f32>(0.0));
     }
@@ -407,11 +482,17 @@ fn chain_anchor(inst: u32, key: u32) -> vec3<f32> {
 const DRAW_VISIBLE: u32 = 1u;
 const DRAW_HIDDEN: u32 = 2u;
 const DRAW_OUTLINE: u32 = 4u;
+// A section's cut line (its plane in the bits from CUT_PLANE_SHIFT), of its own class.
+const DRAW_CUT: u32 = 8u;
+const CUT_PLANE_SHIFT: u32 = 4u;
+// No section plane (`edge_span`'s `skip`).
+const NO_PLANE: u32 = 6u;
 
 // The classes of line splat_runs writes.
 const LINE_EDGE: u32 = 0u;
 const LINE_OUTLINE: u32 = 1u;
 const LINE_HIDDEN: u32 = 2u;
+const LINE_CUT: u32 = 3u;
 
 // Narrows [range.x, range.y] to the parameters u where lo <= p0 + u d <= hi.
 fn keep_between(range: vec2<f32>, p0: f32, d: f32, lo: f32, hi: f32) -> vec2<f32> {
@@ -497,7 +578,7 @@ struct Span {
     p1: Projected,
 }
 
-fn edge_span(inst: u32, a: vec3<f32>, b: vec3<f32>) -> Span {
+fn edge_span(inst: u32, a: vec3<f32>, b: vec3<f32>, skip: u32) -> Span {
     var span: Span;
     let clip = instances[slot(inst)].clip;
     let ha = vec4<f32>(a, 1.0);
@@ -508,9 +589,11 @@ fn edge_span(inst: u32, a: vec3<f32>, b: vec3<f32>) -> Span {
     let fade_row = instances[slot(inst)].fade_row;
     var s = keep_positive(vec2<f32>(0.0, 1.0), ca.z, cb.z);
     s = keep_positive(s, dot(depth_row, ha), dot(depth_row, hb));
-    // Not behind a section plane (unused planes are 0, which keeps everything).
+    // Not behind a section plane (unused planes are 0, which keeps everything); a cut line
+    // is not clipped by its own plane, on which it lies (`skip`).
     for (var k = 0u; k < 6u; k++) {
-        s = keep_positive(s, dot(frame.sections[k], ca), dot(frame.sections[k], cb));
+        let own = k == skip;
+        s = keep_positive(s, select(dot(frame.sections[k], ca), 1.0, own), select(dot(frame.sections[k], cb), 1.0, own));
     }
     span.s = s;
     if !(s.x <= s.y) {
@@ -538,10 +621,10 @@ struct Clipped {
     pieces: u32,
 }
 
-fn clip_outline(inst: u32, t: u32, n: u32, a: vec3<f32>, b: vec3<f32>, anchor: vec4<f32>) -> Clipped {
+fn clip_outline(inst: u32, t: u32, n: u32, a: vec3<f32>, b: vec3<f32>, anchor: vec4<f32>, skip: u32) -> Clipped {
     var c: Clipped;
     c.pieces = 0u;
-    let span = edge_span(inst, a, b);
+    let span = edge_span(inst, a, b, skip);
     if !(span.s.x <= span.s.y) {
         return c;
     }
@@ -576,8 +659,9 @@ fn clip_outline(inst: u32, t: u32, n: u32, a: vec3<f32>, b: vec3<f32>, anchor: v
 fn list_outline(inst: u32, t: u32, i: u32, n: u32, a: vec3<f32>, b: vec3<f32>, mode: u32) {
     // The pattern's anchor only matters where a piece is drawn here (the piece pass finds it
     // for the pieces it draws): looking it up for every listed edge would cost every lane.
-    let c = clip_outline(inst, t, n, a, b, vec4<f32>(0.0, 1.0, 0.0, 1.0));
-    let visible_width = select(instances[slot(inst)].line_width, instances[slot(inst)].outline_width, (mode & DRAW_OUTLINE) != 0u);
+    let c = clip_outline(inst, t, n, a, b, vec4<f32>(0.0, 1.0, 0.0, 1.0), cut_plane(mode));
+    var visible_width = select(instances[slot(inst)].line_width, instances[slot(inst)].outline_width, (mode & DRAW_OUTLINE) != 0u);
+    visible_width = select(visible_width, frame.section_width, (mode & DRAW_CUT) != 0u);
     var reach = select(0.0, line_reach(visible_width), (mode & DRAW_VISIBLE) != 0u);
 #if HIDDEN
     reach = max(reach, select(0.0, line_reach(instances[slot(inst)].hidden_width), (mode & DRAW_HIDDEN) != 0u));
@@ -610,7 +694,7 @@ fn list_outline(inst: u32, t: u32, i: u32, n: u32, a: vec3<f32>, b: vec3<f32>, m
             atomicMax(&acc_rw[list], size.x);
             atomicMax(&acc_rw[list + 1u], size.y);
         } else {
-            let anchored = clip_outline(inst, t, n, a, b, pattern_anchor(inst, t, i, a, b, mode));
+            let anchored = clip_outline(inst, t, n, a, b, pattern_anchor(inst, t, i, a, b, mode), cut_plane(mode));
             draw_piece(anchored.seg, k0, k1, c.length_px, mode);
         }
     }
@@ -683,7 +767,8 @@ fn draw_piece(seg: Segment, k0: f32, k1: f32, length_px: f32, mode: u32) {
         }
     }
     if (mode & DRAW_VISIBLE) != 0u && count > 0u {
-        splat_runs(seg, k0, k1, &runs, count, select(LINE_EDGE, LINE_OUTLINE, (mode & DRAW_OUTLINE) != 0u));
+        let kind = select(select(LINE_EDGE, LINE_OUTLINE, (mode & DRAW_OUTLINE) != 0u), LINE_CUT, (mode & DRAW_CUT) != 0u);
+        splat_runs(seg, k0, k1, &runs, count, kind);
     }
 #if HIDDEN
     if (mode & DRAW_HIDDEN) != 0u && hidden_count > 0u {
@@ -718,6 +803,7 @@ fn push_run(runs: ptr<function, array<vec2<f32>, MAX_RUNS>>, count: ptr<function
 // lines' word.
 fn splat_runs(seg: Segment, k0: f32, k1: f32, runs: ptr<function, array<vec2<f32>, MAX_RUNS>>, count: u32, kind: u32) {
     var width = select(instances[slot(seg.inst)].line_width, instances[slot(seg.inst)].outline_width, kind == LINE_OUTLINE);
+    width = select(width, frame.section_width, kind == LINE_CUT);
     var pattern = vec2<f32>(0.0);
     var phase = seg.phase;
     var phase_dir = seg.phase_dir;
@@ -725,6 +811,7 @@ fn splat_runs(seg: Segment, k0: f32, k1: f32, runs: ptr<function, array<vec2<f32
     let hidden = kind == LINE_HIDDEN;
 #if PATTERNS
     pattern = select(instances[slot(seg.inst)].edge_pattern, instances[slot(seg.inst)].outline_pattern, kind == LINE_OUTLINE);
+    pattern = select(pattern, vec2<f32>(0.0), kind == LINE_CUT);
 #endif
 #if HIDDEN
     if hidden {
@@ -827,7 +914,8 @@ fn splat_runs(seg: Segment, k0: f32, k1: f32, runs: ptr<function, array<vec2<f32
 #endif
 #if COLORS
             atomicMax(&acc_rw[2u * index], key);
-            atomicMax(&acc_rw[2u * index + 1u], (key & 0xfff00000u) | select(0u, OWNER_OUTLINE, kind == LINE_OUTLINE) | seg.inst);
+            let owner = select(select(0u, OWNER_OUTLINE, kind == LINE_OUTLINE), OWNER_CUT, kind == LINE_CUT);
+            atomicMax(&acc_rw[2u * index + 1u], (key & 0xfff00000u) | owner | seg.inst);
 #else
             atomicMax(&acc_rw[index], key);
 #endif

@@ -43,16 +43,20 @@ fn outline_tile_count() -> u32 {
     return ((size.x + 7u) / 8u) * ((size.y + 7u) / 8u);
 }
 
-// The bit of the outline pass's owner word (COLORS: intensity level << 20 | this bit |
-// instance slot) that marks an outline's line, whose colour is the instance's outline
-// colour, not its line colour.
+// The bits of the outline pass's owner word (COLORS: intensity level << 20 | a class bit |
+// instance slot) that mark an outline's line (the instance's outline colour, not its line
+// colour) and a section's cut line (the frame's section line colour); the slot's bits.
 const OWNER_OUTLINE: u32 = 0x80000u;
+const OWNER_CUT: u32 = 0x40000u;
+const OWNER_INSTANCE: u32 = 0x3ffffu;
 
 // The colour of the outline pass's line whose owner word is `owner`: the owning instance's
-// outline colour for an outline, its line colour for a drawn edge.
+// outline colour for an outline, the section line colour for a cut line, its line colour
+// for a drawn edge.
 fn owner_color(owner: u32) -> vec4<f32> {
-    let i = slot(owner & (OWNER_OUTLINE - 1u));
-    return select(instances[i].wire_color, unpack_color(instances[i].outline_color), (owner & OWNER_OUTLINE) != 0u);
+    let i = slot(owner & OWNER_INSTANCE);
+    let line = select(instances[i].wire_color, frame.section_line_color, (owner & OWNER_CUT) != 0u);
+    return select(line, unpack_color(instances[i].outline_color), (owner & OWNER_OUTLINE) != 0u);
 }
 
 // Word offset of the hidden lines (HIDDEN): the greatest `line_key` per target pixel (with
@@ -68,7 +72,7 @@ fn hidden_lines() -> u32 {
 
 // The colour of the hidden line whose owner word (COLORS) is `owner`.
 fn hidden_color_of(owner: u32) -> vec4<f32> {
-    return unpack_color(instances[slot(owner & (OWNER_OUTLINE - 1u))].hidden_color);
+    return unpack_color(instances[slot(owner & OWNER_INSTANCE)].hidden_color);
 }
 
 // Word offset of the tile marks.

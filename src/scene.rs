@@ -10,9 +10,10 @@ use crate::gpu::MeshId;
 use crate::style::{Color, HiddenLines, LinePattern, MAX_LINE_WIDTH};
 use glam::{DMat4, DVec3};
 
-/// Most instances a frame may hold: instance slots must fit 19 bits of the outline pass's
-/// per-pixel owner word, whose 20th says whether the line is an outline or an edge.
-pub const MAX_INSTANCES: u32 = 1 << 19;
+/// Most instances a frame may hold: instance slots must fit 18 bits of the outline pass's
+/// per-pixel owner word, whose next two say whether the line is an outline, a section's cut
+/// line or an edge.
+pub const MAX_INSTANCES: u32 = 1 << 18;
 
 /// Per-instance departures from the frame's [`Style`](crate::Style); `None` keeps the
 /// style's setting.

@@ -72,6 +72,11 @@ pub struct Style {
     /// Colour of the back faces seen through the cut of a section plane
     /// ([`SectionPlane`](crate::SectionPlane)), unlit: the section face of a closed part.
     pub section_color: Color,
+    /// Colour of the cut lines, where a section plane meets a surface.
+    pub section_line_color: Color,
+    /// Width of the cut lines in pixels; `None` draws them at
+    /// [`line_width`](Self::line_width).
+    pub section_line_width: Option<f32>,
     /// Share of ambient light, 0..1; the rest comes from the key light.
     pub ambient: f32,
     /// Direction towards the key light in view space (x right, y up, z towards the viewer),
@@ -382,6 +387,9 @@ impl Default for Style {
             background: Color([1.0, 1.0, 1.0, 1.0]),
             // #d9a38c.
             section_color: Color([0.694, 0.366, 0.262, 1.0]),
+            // #5a1e0f.
+            section_line_color: Color([0.102, 0.013, 0.005, 1.0]),
+            section_line_width: None,
             ambient: 0.3,
             light_view_dir: Vec3::new(-0.4, 0.6, 1.0),
             outline_color: None,
@@ -396,11 +404,20 @@ impl Default for Style {
 }
 
 impl Style {
+    /// The width of the cut lines: [`section_line_width`](Self::section_line_width), else
+    /// the line width.
+    pub fn section_width(&self) -> f32 {
+        self.section_line_width.unwrap_or(self.line_width)
+    }
+}
+
+impl Style {
     /// Rejects settings that cannot produce a sensible image.
     pub fn validate(&self) -> Result<()> {
         let widths = [
             ("line", Some(self.line_width)),
             ("outline", self.outline_width),
+            ("section line", self.section_line_width),
         ];
         for (what, w) in widths {
             if let Some(w) = w.filter(|w| !(*w >= 0.0 && *w <= MAX_LINE_WIDTH)) {

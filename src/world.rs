@@ -272,4 +272,6 @@ pub enum LineClass {
     Outline = 2,
     /// A hidden line ([`Style::hidden`](crate::Style::hidden)).
     Hidden = 3,
+    /// A section's cut line ([`SectionPlane`]).
+    Cut = 4,
 }

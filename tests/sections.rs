@@ -9,7 +9,8 @@ use glam::{DMat4, DVec3, Vec3};
 use std::sync::Arc;
 use wirepass::mesh::Procedural;
 use wirepass::tools::offline::Method;
-use wirepass::truth::accuracy::{distance_error, id_agreement};
+use wirepass::truth::accuracy::{distance_error, id_agreement, line_class_agreement};
+use wirepass::world::LineClass;
 use wirepass::world::{Object, World, WorldMesh};
 use wirepass::{EdgeSelection, Error, Mesh, SectionPlane, Style, View};
 
@@ -33,8 +34,8 @@ fn plane(point: [f64; 3], normal: [f64; 3]) -> SectionPlane {
 }
 
 /// The deferred frame against the ground truth; returns the pixels showing a section face
-/// (a back face in the section colour) in the truth.
-fn check(name: &str, world: &World, view: View, style: &Style) -> usize {
+/// (a back face in the section colour) and those a cut line colours, in the truth.
+fn check(name: &str, world: &World, view: View, style: &Style) -> (usize, usize) {
     let truth = shoot_world(world, view, style, SIZE, Method::Raycast);
     let frame = shoot_world(world, view, style, SIZE, Method::Deferred);
     let (ids, _) = id_agreement(&truth, &frame).unwrap();
@@ -63,7 +64,17 @@ fn check(name: &str, world: &World, view: View, style: &Style) -> usize {
         worst_channel <= 1,
         "{name}: colours differ by {worst_channel}"
     );
-    faces
+    // Which line colours each pixel: the cut lines are a class of their own.
+    let classes = line_class_agreement(&truth, &frame).unwrap().unwrap_or(1.0);
+    let cut = LineClass::Cut as u8;
+    let cuts = truth.line_class.iter().filter(|&&c| c == cut).count();
+    let gpu_cuts = frame.line_class.iter().filter(|&&c| c == cut).count();
+    println!(
+        "{name}: {faces} section-face pixels, {cuts} cut-line pixels ({gpu_cuts} deferred), \
+         classes agree on {classes:.5}"
+    );
+    assert!(classes >= 0.999, "{name}: line classes agree on {classes}");
+    (faces, cuts)
 }
 
 fn single(mesh: Mesh, edges: EdgeSelection, sections: Vec<SectionPlane>) -> World {
@@ -83,8 +94,9 @@ fn a_closed_part_cut_open_shows_its_section_face() {
         vec![plane(centre.to_array(), [1.0, 0.0, 0.3])],
     );
     let view = perspective(&world, centre + DVec3::new(-1.5, 1.0, 2.2));
-    let faces = check("fandisk", &world, view, &Style::default());
+    let (faces, cuts) = check("fandisk", &world, view, &Style::default());
     assert!(faces > 500, "fandisk: {faces} section-face pixels");
+    assert!(cuts > 300, "fandisk: {cuts} cut-line pixels");
     // The cut away half is gone: fewer triangles seen than uncut.
     let mut whole = world.clone();
     whole.sections.clear();
@@ -105,7 +117,7 @@ fn a_plane_that_misses_everything_changes_nothing() {
         vec![plane([0.0, -5.0, 0.0], [0.0, 1.0, 0.0])],
     );
     let view = perspective(&world, DVec3::new(1.5, 2.0, 2.5));
-    assert_eq!(check("missing", &world, view, &Style::default()), 0);
+    assert_eq!(check("missing", &world, view, &Style::default()), (0, 0));
     // The same image as without it, but for the drawn edges now found by the outline pass
     // (the same lines within the usual bounds).
     let plain = shoot_world(
@@ -132,8 +144,14 @@ fn two_planes_cut_a_corner_out_of_a_box() {
     // What is kept: x <= 0.2 and y <= 0.1, two cuts meeting along an edge, seen from the
     // side they open.
     let view = perspective(&world, DVec3::new(2.0, 2.2, 2.6));
-    let faces = check("corner", &world, view, &Style::default());
+    // Wide cut lines.
+    let style = Style {
+        section_line_width: Some(3.0),
+        ..Style::default()
+    };
+    let (faces, cuts) = check("corner", &world, view, &style);
     assert!(faces > 1000, "corner: {faces} section-face pixels");
+    assert!(cuts > 300, "corner: {cuts} cut-line pixels");
 }
 
 #[test]
@@ -143,9 +161,10 @@ fn a_dense_mesh_cut_at_a_grazing_angle_and_an_open_mesh() {
         EdgeSelection::Polygon,
         vec![plane([0.0, 0.0, 0.0], [0.05, 0.2, 1.0])],
     );
-    // The eye almost in the plane.
-    let view = perspective(&world, DVec3::new(0.3, -0.2, 2.4));
-    check("grazing", &world, view, &Style::default());
+    // The eye just off the plane (0.01 in front of it): the section face seen edge-on.
+    let view = perspective(&world, DVec3::new(2.4, -0.3, -0.05));
+    let (_, cuts) = check("grazing", &world, view, &Style::default());
+    assert!(cuts > 100, "grazing: {cuts} cut-line pixels");
     // A grid (open boundaries) cut across, and a mirrored copy, orthographic.
     let grid = Procedural::Grid(2000).build().unwrap();
     let mut world = single(

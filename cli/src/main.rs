@@ -117,6 +117,21 @@ struct SceneArgs {
     /// hide it, its fill tinted; repeat it, or give a list (0,2), for several.
     #[arg(long, value_name = "N", value_delimiter = ',')]
     highlight: Vec<usize>,
+    /// A section plane through point (px, py, pz) with normal (nx, ny, nz), world
+    /// coordinates: what lies behind it is cut away, back faces seen through the cut drawn
+    /// as the section face; repeat it for up to 6 (a scene file's `sections` come first).
+    /// Only deferred and raycast cut.
+    #[arg(long, value_name = "PX,PY,PZ,NX,NY,NZ", value_parser = parse_section)]
+    section: Vec<wirepass::SectionPlane>,
+    /// Colour of the section face (back faces seen through a cut), #rrggbb (sRGB).
+    #[arg(long, default_value = "#d9a38c")]
+    section_color: String,
+    /// Colour of the cut lines, where a section plane meets a surface, #rrggbb[aa] (sRGB).
+    #[arg(long, default_value = "#5a1e0f")]
+    section_line_color: String,
+    /// Width of the cut lines in pixels [default: the line width].
+    #[arg(long, allow_hyphen_values = true)]
+    section_line_width: Option<f32>,
     #[command(flatten)]
     camera: CameraArgs,
 }
@@ -127,6 +142,23 @@ fn parse_switch(s: &str) -> std::result::Result<bool, String> {
         "off" => Ok(false),
         _ => Err(format!("{s:?} is not on or off")),
     }
+}
+
+fn parse_section(s: &str) -> std::result::Result<wirepass::SectionPlane, String> {
+    let bad = || format!("{s:?} is not PX,PY,PZ,NX,NY,NZ, six numbers");
+    let n: Vec<f64> = s
+        .split(',')
+        .map(|t| t.trim().parse::<f64>().map_err(|_| bad()))
+        .collect::<std::result::Result<_, _>>()?;
+    let [px, py, pz, nx, ny, nz] = n[..] else {
+        return Err(bad());
+    };
+    let plane = wirepass::SectionPlane::new(
+        wirepass::glam::DVec3::new(px, py, pz),
+        wirepass::glam::DVec3::new(nx, ny, nz),
+    );
+    plane.validate(0).map_err(|e| format!("{s:?}: {e}"))?;
+    Ok(plane)
 }
 
 fn parse_fade(s: &str) -> std::result::Result<DepthFade, String> {
@@ -183,6 +215,9 @@ impl SceneArgs {
             wire_color: Color::from_hex(&self.wire_color)?,
             fill_color: Color::from_hex(&self.fill_color)?,
             background: Color::from_hex(&self.background)?,
+            section_color: Color::from_hex(&self.section_color)?,
+            section_line_color: Color::from_hex(&self.section_line_color)?,
+            section_line_width: self.section_line_width,
             silhouettes: self.silhouettes,
             depth_fade: self.depth_fade,
             ..Style::default()
@@ -224,7 +259,9 @@ impl SceneArgs {
             .chain(&loaded.highlight)
             .copied()
             .collect();
-        let world = highlighted(loaded.world, &selected, &style)?;
+        let mut world = highlighted(loaded.world, &selected, &style)?;
+        world.sections.extend_from_slice(&self.section);
+        world.validate()?;
         let placement = self.camera.placement();
         let file_camera = loaded.camera.filter(|_| placement.is_empty());
         if let Some(wirepass::tools::scene_file::FileCamera::Gltf(c)) = &file_camera {
@@ -255,7 +292,7 @@ struct RenderArgs {
     output: PathBuf,
     /// Also write ids.npy (global triangle ids), depth.npy, edge_distance.npy,
     /// hidden_distance.npy, line_class.npy (deferred and raycast: 0 no line, 1 drawn edge, 2
-    /// outline, 3 hidden line) and camera.json (the view and projection matrices used) into
+    /// outline, 3 hidden line, 4 section cut line) and camera.json (the view and projection matrices used) into
     /// this directory.
     #[arg(long)]
     dump: Option<PathBuf>,

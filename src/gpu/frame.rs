@@ -39,7 +39,9 @@ pub(crate) struct FrameUniforms {
     section_color: [f32; 4],
     sections: [[f32; 4]; MAX_SECTIONS],
     sections_on: u32,
-    _pad_sections: [u32; 3],
+    section_width: f32,
+    _pad_sections: [u32; 2],
+    section_line_color: [f32; 4],
 }
 
 /// Mirror of WGSL `struct Instance`; field order and padding match it.
@@ -153,6 +155,7 @@ pub fn guard_band(scene: &Scene<'_>, style: &Style) -> u32 {
         })
         .flatten()
         .chain(style.outline_width)
+        .chain((!scene.sections.is_empty()).then(|| style.section_width()))
         .fold(style.line_width, f32::max);
     (crate::style::line_reach(f64::from(widest)).ceil() as u32).saturating_add(2)
 }
@@ -401,9 +404,10 @@ impl FrameRecords {
         // The edge pass must know whose line, and of which class, each outline-pass pixel
         // holds where colours differ between instances or between an outline and its edges.
         // Likewise for hidden lines whose colours differ between instances.
-        let mixed_colors = records
-            .windows(2)
-            .any(|w| w[0].wire_color != w[1].wire_color)
+        let mixed_colors = !scene.sections.is_empty()
+            || records
+                .windows(2)
+                .any(|w| w[0].wire_color != w[1].wire_color)
             || records
                 .iter()
                 .any(|r| r.outline_color != pack_color(r.wire_color))
@@ -461,7 +465,9 @@ impl FrameRecords {
             section_color: style.section_color.0,
             sections: section_planes(&view, &scene.sections)?,
             sections_on: u32::from(!scene.sections.is_empty()),
-            _pad_sections: [0; 3],
+            section_width: style.section_width(),
+            _pad_sections: [0; 2],
+            section_line_color: style.section_line_color.0,
         };
         Ok(FrameRecords {
             uniforms,
@@ -732,7 +738,7 @@ mod tests {
     fn records_match_their_wgsl_layout() {
         assert_eq!(std::mem::size_of::<InstanceRecord>(), 272);
         assert!(u64::from(UNIFORM_INSTANCE_CAPACITY) * INSTANCE_BYTES <= 65536);
-        assert_eq!(std::mem::size_of::<FrameUniforms>(), 304);
+        assert_eq!(std::mem::size_of::<FrameUniforms>(), 320);
         let r = InstanceRecord::zeroed_for_test();
         let base = &r as *const _ as usize;
         assert_eq!(

@@ -37,6 +37,9 @@
 //!   `dotted[:SPACING]`), `hidden_color`, `hidden_width`, `fill_opacity`, `outline_color`,
 //!   `outline_width`, `edge_pattern` and `outline_pattern`, where the command line does not
 //!   set them.
+//! - `sections` (optional): up to 6 section planes, `{"point": [x, y, z], "normal": [x, y,
+//!   z]}` in world coordinates; what lies behind any (against its normal) is cut away
+//!   (`wirepass::SectionPlane`).
 //! - `camera`: `{"eye", "target", "up", "fov", "near", "far"}` (a perspective look-at;
 //!   `far` may be `null` for an infinite far plane), or `{"view": [16], "projection": [16],
 //!   "depth": "standard"|"reversed"}` (column-major matrices as a renderer has them), or
@@ -127,9 +130,9 @@ pub fn load(
         .as_object()
         .ok_or_else(|| fail("the scene is not a JSON object".into()))?;
     for key in top.keys() {
-        if !["objects", "camera", "style"].contains(&key.as_str()) {
+        if !["objects", "camera", "style", "sections"].contains(&key.as_str()) {
             return Err(fail(format!(
-                "unknown field {key:?} (objects, camera, style)"
+                "unknown field {key:?} (objects, camera, style, sections)"
             )));
         }
     }
@@ -318,6 +321,9 @@ pub fn load(
             style,
         });
     }
+    if let Some(v) = top.get("sections") {
+        world.sections = sections(v).map_err(|m| fail(format!("sections{m}")))?;
+    }
     world.validate().map_err(|e| fail(e.to_string()))?;
     let camera = match top.get("camera") {
         None => None,
@@ -418,6 +424,34 @@ fn file_style(v: &Value) -> std::result::Result<FileStyle, String> {
         edge_pattern: pattern("edge_pattern")?,
         outline_pattern: pattern("outline_pattern")?,
     })
+}
+
+/// `sections`: a list of `{"point": [x, y, z], "normal": [x, y, z]}`.
+fn sections(v: &Value) -> std::result::Result<Vec<crate::SectionPlane>, String> {
+    let list = v.as_array().ok_or(": not a list")?;
+    list.iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let o = p.as_object().ok_or(format!("[{i}]: not an object"))?;
+            if let Some(k) = o
+                .keys()
+                .find(|k| !["point", "normal"].contains(&k.as_str()))
+            {
+                return Err(format!("[{i}].{k}: unknown field (point, normal)"));
+            }
+            let field = |k: &str| {
+                o.get(k)
+                    .ok_or(format!("[{i}].{k}: missing"))
+                    .and_then(|v| vec3(v).map_err(|m| format!("[{i}].{k}: {m}")))
+            };
+            let plane = crate::SectionPlane::new(field("point")?, field("normal")?);
+            plane.validate(i).map_err(|e| match e {
+                Error::InvalidScene(m) => format!(": {m}"),
+                e => format!(": {e}"),
+            })?;
+            Ok(plane)
+        })
+        .collect()
 }
 
 /// A mesh spec relative to the scene file's folder: procedural names stay as they are.
@@ -630,7 +664,9 @@ mod tests {
             ],
             "camera": {"eye": [0, 0, 5], "orthographic": {"height": 4, "near": 0.1, "far": 20}},
             "style": {"hidden": "dotted:3", "fill_opacity": 0.25, "outline_width": 2,
-                      "edge_pattern": "dashed:4,2"}}"##,
+                      "edge_pattern": "dashed:4,2"},
+            "sections": [{"point": [0, 0, 0], "normal": [1, 0, 0]},
+                         {"point": [0, 0.5, 0], "normal": [0, -1, 0]}]}"##,
         );
         let SceneFile {
             world,
@@ -690,6 +726,13 @@ mod tests {
             Some(LinePattern::Solid)
         );
         assert_eq!(world.objects[0].style.edge_pattern, None);
+        assert_eq!(
+            world.sections,
+            vec![
+                crate::SectionPlane::new(DVec3::ZERO, DVec3::X),
+                crate::SectionPlane::new(DVec3::new(0.0, 0.5, 0.0), -DVec3::Y),
+            ]
+        );
         assert!(camera.unwrap().view(1.5).is_orthographic());
     }
 
@@ -739,6 +782,14 @@ mod tests {
             (
                 r#"{"objects": [{"mesh": "sphere:100"}], "style": {"edge_pattern": "wavy"}}"#,
                 "style.edge_pattern",
+            ),
+            (
+                r#"{"objects": [{"mesh": "sphere:100"}], "sections": [{"point": [0, 0, 0], "normal": [0, 0, 0]}]}"#,
+                "sections: section plane 0: its normal",
+            ),
+            (
+                r#"{"objects": [{"mesh": "sphere:100"}], "sections": [{"point": [0, 0, 0]}]}"#,
+                "sections[0].normal: missing",
             ),
             (
                 r#"{"objects": [{"mesh": "sphere:100", "hidden_width": -1}]}"#,

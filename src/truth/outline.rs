@@ -96,6 +96,8 @@ struct Stretch {
     width: f64,
     /// An outline's line, not an edge's (hidden lines: false).
     outline: bool,
+    /// A section's cut line.
+    cut: bool,
     /// A hidden line drawn over the host's surface ([`HiddenLines::behind_host`]).
     ///
     /// [`HiddenLines::behind_host`]: crate::HiddenLines::behind_host
@@ -110,6 +112,8 @@ struct Draw {
     visible: bool,
     hidden: bool,
     outline: bool,
+    /// A cut line: where section plane k meets the triangle.
+    cut: Option<usize>,
 }
 
 /// The outline map of `caster`'s world for `shot`, seen along `rays`; `masks` are each
@@ -135,7 +139,7 @@ pub(crate) fn outline_map(
         .objects
         .iter()
         .enumerate()
-        .filter(|(o, _)| styles[*o].outlines || styles[*o].edges)
+        .filter(|(o, _)| styles[*o].outlines || styles[*o].edges || styles[*o].sectioned)
         .flat_map(|(o, object)| {
             let hidden = styles[o].hidden;
             let hidden_edges = hidden.is_some_and(|h| h.edges);
@@ -143,7 +147,11 @@ pub(crate) fn outline_map(
             let local = edge_math::local_eye(object.transform, eye);
             let first = caster.first_ids()[o];
             let listed = styles[o].listed_edges();
-            let widths = (styles[o].width, styles[o].outline_width);
+            let widths = (
+                styles[o].width,
+                styles[o].outline_width,
+                styles[o].section_width,
+            );
             let patterns = (styles[o].edge_pattern, styles[o].outline_pattern);
             let tris = mesh.triangles();
             let neighbours = mesh.edge_neighbours();
@@ -153,6 +161,7 @@ pub(crate) fn outline_map(
                     visible: true,
                     hidden: hidden.is_some(),
                     outline: true,
+                    cut: None,
                 };
                 edges.extend(outline_edges(mesh, local).into_iter().map(|e| (e, outline)));
             }
@@ -162,6 +171,7 @@ pub(crate) fn outline_map(
                     visible: true,
                     hidden: hidden_edges,
                     outline: false,
+                    cut: None,
                 };
                 edges.extend(splat.iter().enumerate().flat_map(|(t, &bits)| {
                     (0..3u32)
@@ -177,6 +187,7 @@ pub(crate) fn outline_map(
                     visible: listed,
                     hidden: hidden_edges,
                     outline: false,
+                    cut: None,
                 };
                 edges.extend((0..tris.len() as u32).flat_map(|t| {
                     (0..3u32)
@@ -185,6 +196,24 @@ pub(crate) fn outline_map(
                             mask[t as usize] & (1 << i) != 0 && (n == NO_NEIGHBOUR || t < n)
                         })
                         .map(move |i| ((t, i), draw))
+                }));
+            }
+            // Cut lines, each (triangle, 3 + plane), where a section plane crosses a triangle.
+            let sections = &world.sections;
+            if !sections.is_empty() {
+                edges.extend((0..tris.len() as u32).flat_map(|t| {
+                    let corners = caster.corners(first + t);
+                    (0..sections.len())
+                        .filter(move |&k| cut_segment(corners, &sections[k]).is_some())
+                        .map(move |k| {
+                            let draw = Draw {
+                                visible: true,
+                                hidden: false,
+                                outline: false,
+                                cut: Some(k),
+                            };
+                            ((t, 3 + k as u32), draw)
+                        })
                 }));
             }
             // One entry per edge, drawing all that any of its entries asks.
@@ -215,10 +244,28 @@ pub(crate) fn outline_map(
             merged
                 .into_par_iter()
                 .map(move |((t, i), draw)| {
+                    if let Some(k) = draw.cut {
+                        let corners = caster.corners(first + t);
+                        let ends = cut_segment(corners, &world.sections[k]).unwrap_or_default();
+                        let lines = (([0.0; 2], (0.0, true)), (0.0, true));
+                        let edge = (t, NO_NEIGHBOUR, ends);
+                        return view.stretches(
+                            first,
+                            edge,
+                            (o as u32, widths),
+                            draw,
+                            (lines, None),
+                        );
+                    }
                     let n = neighbours[t as usize][i as usize];
                     let corners = tris[t as usize];
                     let p = mesh.positions();
                     let (a, b) = (corners[i as usize], corners[(i as usize + 1) % 3]);
+                    let world_corners = caster.corners(first + t);
+                    let ends = (
+                        world_corners[i as usize],
+                        world_corners[(i as usize + 1) % 3],
+                    );
                     let on_chain = chained.as_ref().and_then(|(weld, anchors)| {
                         let (wa, wb) = (weld[a as usize], weld[b as usize]);
                         let &(positions, entry) = anchors.get(&(wa.min(wb), wa.max(wb)))?;
@@ -238,7 +285,13 @@ pub(crate) fn outline_map(
                         (patterns.0, along(1))
                     };
                     let lines = (visible, along(0));
-                    view.stretches(first, (t, i, n), (o as u32, widths), draw, (lines, hidden))
+                    view.stretches(
+                        first,
+                        (t, n, ends),
+                        (o as u32, widths),
+                        draw,
+                        (lines, hidden),
+                    )
                 })
                 .collect::<Vec<_>>()
         })
@@ -299,11 +352,12 @@ fn splat(
                         intensity,
                         object: s.object,
                         outline: s.outline,
+                        cut: s.cut,
                     };
                     // The greatest key gives the distance and intensity; whose line it is
                     // (object and class) goes, as the GPU's owner word does, to the greatest
                     // (intensity level, outline), the greatest key among equals.
-                    let owner = |l: &Line| (l.key >> 20, l.outline);
+                    let owner = |l: &Line| (l.key >> 20, l.outline, l.cut);
                     *out = Some(match *out {
                         None => line,
                         Some(l) => {
@@ -312,6 +366,7 @@ fn splat(
                                 Line {
                                     object: other.object,
                                     outline: other.outline,
+                                    cut: other.cut,
                                     ..keep
                                 }
                             } else {
@@ -359,15 +414,23 @@ impl Visibility<'_> {
     /// The part of the edge `a` → `b` (world coordinates) in front of the near plane, not
     /// beyond the far one and not behind a section plane, as parameters along it, and the
     /// projections of its ends.
-    fn span(&self, a: DVec3, b: DVec3) -> Option<((f64, f64), Projected, Projected)> {
+    fn span(
+        &self,
+        a: DVec3,
+        b: DVec3,
+        skip: Option<usize>,
+    ) -> Option<((f64, f64), Projected, Projected)> {
         let (ca, cb) = (self.rays.clip(a), self.rays.clip(b));
         let depth = self.rays.rows().depth;
         let (ha, hb) = (a.extend(1.0), b.extend(1.0));
         let mut s = (0.0, 1.0);
         keep_positive(&mut s, ca.z, cb.z);
         keep_positive(&mut s, depth.dot(ha), depth.dot(hb));
-        for plane in &self.caster.world().sections {
-            keep_positive(&mut s, plane.side(a), plane.side(b));
+        // A cut line lies on its own plane (`skip`).
+        for (k, plane) in self.caster.world().sections.iter().enumerate() {
+            if Some(k) != skip {
+                keep_positive(&mut s, plane.side(a), plane.side(b));
+            }
         }
         if !(s.0 <= s.1) {
             return None;
@@ -414,7 +477,7 @@ impl Visibility<'_> {
                 let entry = if e.forward { wa } else { wb };
                 out.insert((wa.min(wb), wa.max(wb)), (position, entry));
                 let corners = self.caster.corners(first + e.t);
-                if let Some((_, p0, p1)) = self.span(corners[i], corners[(i + 1) % 3]) {
+                if let Some((_, p0, p1)) = self.span(corners[i], corners[(i + 1) % 3], None) {
                     let length = p0.xy.distance(p1.xy);
                     for (s, &period) in position.iter_mut().zip(&periods) {
                         *s = if period > 0.0 {
@@ -439,8 +502,8 @@ impl Visibility<'_> {
     fn stretches(
         &self,
         first: u32,
-        (t, i, n): (u32, u32, u32),
-        (object, (edge_width, outline_width)): (u32, (f64, f64)),
+        (t, n, (a, b)): (u32, u32, (DVec3, DVec3)),
+        (object, (edge_width, outline_width, section_width)): (u32, (f64, f64, f64)),
         draw: Draw,
         (((visible_pattern, visible_anchor), hidden_anchor), hidden): (
             (([f64; 2], (f64, bool)), (f64, bool)),
@@ -448,15 +511,15 @@ impl Visibility<'_> {
         ),
     ) -> (Vec<Stretch>, Vec<Stretch>) {
         let none = (Vec::new(), Vec::new());
-        let corners = self.caster.corners(first + t);
-        let (a, b) = (corners[i as usize], corners[(i as usize + 1) % 3]);
-        // In front of the near plane, not beyond the far plane.
-        let Some((_, p0, p1)) = self.span(a, b) else {
+        // In front of the near plane, not beyond the far plane, not cut away.
+        let Some((_, p0, p1)) = self.span(a, b, draw.cut) else {
             return none;
         };
         // Within reach of the image: an edge just outside it still draws its line inside.
         let size = self.rays.size();
-        let width = if draw.outline {
+        let width = if draw.cut.is_some() {
+            section_width
+        } else if draw.outline {
             outline_width
         } else {
             edge_width
@@ -506,6 +569,7 @@ impl Visibility<'_> {
         }
         runs.push((start, u.1, last.1));
 
+        let cut = draw.cut.is_some();
         let stretch = |(k0, k1): (f64, f64), width: f64, (outline, over_host): (bool, bool)| {
             let (q0, q1) = (point(k0), point(k1));
             Stretch {
@@ -517,6 +581,7 @@ impl Visibility<'_> {
                 object,
                 width,
                 outline,
+                cut,
                 over_host,
             }
         };
@@ -589,6 +654,24 @@ impl Visibility<'_> {
                 }
             }
         }
+    }
+}
+
+/// Where section plane `plane` meets a triangle (world corners `c`) that it crosses (corners
+/// cut away, and kept): the points where its side changes sign on the two edges it crosses
+/// (twin of `cut_segment` in outline.wgsl); `None` where it does not cross it.
+fn cut_segment(c: [DVec3; 3], plane: &crate::SectionPlane) -> Option<(DVec3, DVec3)> {
+    let s = c.map(|p| plane.side(p));
+    let mut ends = Vec::with_capacity(2);
+    for j in 0..3 {
+        let (a, b) = (s[j], s[(j + 1) % 3]);
+        if (a < 0.0) != (b < 0.0) {
+            ends.push(c[j].lerp(c[(j + 1) % 3], a / (a - b)));
+        }
+    }
+    match ends[..] {
+        [a, b] => Some((a, b)),
+        _ => None,
     }
 }
 
@@ -955,6 +1038,7 @@ mod tests {
             visible: true,
             hidden: true,
             outline: true,
+            cut: None,
         };
         let hidden = crate::HiddenLines {
             pattern: crate::LinePattern::Dashed {
@@ -963,9 +1047,11 @@ mod tests {
             },
             ..crate::HiddenLines::default()
         };
-        let edge = (0, 1, NO_NEIGHBOUR);
+        let corners = caster.corners(0);
+        let edge = (0, NO_NEIGHBOUR, (corners[1], corners[2]));
         let lines = (([0.0; 2], (0.0, true)), (0.0, true));
-        let (s, h) = vis.stretches(0, edge, (0, (1.5, 1.5)), draw, (lines, Some(hidden)));
+        let widths = (0, (1.5, 1.5, 1.5));
+        let (s, h) = vis.stretches(0, edge, widths, draw, (lines, Some(hidden)));
         assert_eq!(s.len(), 1, "{s:?}");
         let top_of_near = {
             let c = cam.view_projection(64, 64) * DVec4::new(1.0, 0.0, 1.0, 1.0);

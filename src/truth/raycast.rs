@@ -58,6 +58,8 @@ fn line_class(visible: LineClass, i: f64, h: f64) -> LineClass {
 fn class_of(l: &Line) -> LineClass {
     if l.outline {
         LineClass::Outline
+    } else if l.cut {
+        LineClass::Cut
     } else {
         LineClass::Edge
     }
@@ -216,8 +218,10 @@ struct Shading {
     ambient: f64,
     fade: [f64; 2],
     fill_opacity: f64,
-    /// The colour of back faces seen through a section's cut (linear RGB).
+    /// The colour of back faces seen through a section's cut (linear RGB), and of the cut
+    /// lines (linear RGBA).
     section_color: [f64; 3],
+    section_line: [f64; 4],
 }
 
 impl Shading {
@@ -232,6 +236,7 @@ impl Shading {
             fade: s.fade_range().map(f64::from),
             fill_opacity: f64::from(s.fill_opacity),
             section_color: [0, 1, 2].map(|k| f64::from(s.section_color.0[k])),
+            section_line: s.section_line_color.0.map(f64::from),
         }
     }
 }
@@ -254,6 +259,8 @@ impl Truth<'_> {
         let st = &self.styles[l.object as usize];
         if l.outline {
             st.outline
+        } else if l.cut {
+            self.shading.section_line
         } else {
             st.wire
         }

@@ -306,6 +306,8 @@ pub(crate) struct ObjectStyle {
     pub outline_pattern: [f64; 2],
     /// The world has section planes.
     pub sectioned: bool,
+    /// The cut lines' width.
+    pub section_width: f64,
     /// Its hidden lines, where it draws any lines.
     pub hidden: Option<style::HiddenLines>,
     /// Model → world normal matrix.
@@ -346,6 +348,7 @@ impl ObjectStyle {
                     .dash_period()
                     .map(f64::from),
                 sectioned: !world.sections.is_empty(),
+                section_width: f64::from(style.section_width()),
                 hidden: o.style.hidden_in(style).filter(|_| {
                     o.style.edges.unwrap_or(true) || o.style.outlines.unwrap_or(style.silhouettes)
                 }),
@@ -620,4 +623,6 @@ pub struct Line {
     pub object: u32,
     /// Whether it is an outline (drawn in the object's outline colour), not an edge.
     pub outline: bool,
+    /// Whether it is a section's cut line (drawn in the section line colour).
+    pub cut: bool,
 }
