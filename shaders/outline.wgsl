@@ -210,6 +210,32 @@ fn cut_segment(inst: u32, p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>, k: u32) -
     return ends;
 }
 
+// Whether triangle (local corners p) of `inst` faces away from the eye, by its winding as
+// the instance's transform leaves it (mirrored where its determinant is negative).
+fn faces_away(inst: u32, p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>) -> bool {
+    let i = instances[slot(inst)];
+    let mirror = dot(i.normal_x, cross(i.normal_y, i.normal_z));
+    return dot(cross(p1 - p0, p2 - p0), towards_eye(p0, i.eye)) * mirror < 0.0;
+}
+
+// In a frame with section planes, back faces stand for the section face of a cut solid, so
+// a line between two of them (edge i of triangle t, its neighbour's too; a boundary of one)
+// lies behind that face: what of it is visible counts as hidden (twin of `capped` in
+// src/truth/outline.rs). Cut lines are on the face.
+fn capped(inst: u32, t: u32, i: u32, mode: u32) -> bool {
+    let base = instances[slot(inst)].triangle_base;
+    let v = corners(base + t) + instances[slot(inst)].vertex_base;
+    let p0 = vertex_at(v.x);
+    let p1 = vertex_at(v.y);
+    let p2 = vertex_at(v.z);
+    let word = neighbour_word(base + t, i);
+    var edge = array<vec4<f32>, 3>(p0, p1, p2);
+    let q = beyond_edge(inst, select(word, 0u, word == BACKGROUND_ID), edge[i], edge[(i + 1u) % 3u]);
+    let away = faces_away(inst, p0.xyz, p1.xyz, p2.xyz);
+    let beyond = word == BACKGROUND_ID || faces_away(inst, q.q0.xyz, q.q1.xyz, q.q2.xyz);
+    return frame.sections_on != 0u && (mode & DRAW_CUT) == 0u && away && beyond;
+}
+
 // The plane of a cut line's `mode` (DRAW_CUT), else NO_PLANE.
 fn cut_plane(mode: u32) -> u32 {
     return select(NO_PLANE, (mode >> CUT_PLANE_SHIFT) & 7u, (mode & DRAW_CUT) != 0u);
@@ -259,7 +285,8 @@ fn outline_pieces_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_i
             n = BACKGROUND_ID;
         }
         let anchor = pattern_anchor(inst, t, i, a, b, mode);
-        let c = clip_outline(inst, t, n, a, b, anchor, cut_plane(mode));
+        var c = clip_outline(inst, t, n, a, b, anchor, cut_plane(mode));
+        c.seg.capped = capped(inst, t, i, mode);
         draw_piece(c.seg, f32(piece) / f32(c.pieces), f32(piece + 1u) / f32(c.pieces), c.length_px, mode);
     }
 }
@@ -549,6 +576,8 @@ struct Segment {
     phase_dir: f32,
     hidden_phase: f32,
     hidden_dir: f32,
+    // Behind the section face (`capped`): what is visible of it counts as hidden.
+    capped: bool,
 }
 
 fn seg_at(s: Segment, k: f32) -> Projected {
@@ -561,7 +590,8 @@ fn seg_at(s: Segment, k: f32) -> Projected {
 fn seg_class(s: Segment, k: f32) -> u32 {
     let q = seg_at(s, k);
     let w = 1.0 / q.inv_w;
-    let c = class_at(q.xy, q.near_w * w, w, q.reverse, s.inst, s.t, s.n);
+    var c = class_at(q.xy, q.near_w * w, w, q.reverse, s.inst, s.t, s.n);
+    c = select(c, 1u, c == 0u && s.capped);
 #if HIDDEN
     let behind_host = (instances[slot(s.inst)].flags & INSTANCE_BEHIND_HOST) != 0u;
     return select(c, 1u, c == 2u && behind_host);
@@ -694,7 +724,8 @@ fn list_outline(inst: u32, t: u32, i: u32, n: u32, a: vec3<f32>, b: vec3<f32>, m
             atomicMax(&acc_rw[list], size.x);
             atomicMax(&acc_rw[list + 1u], size.y);
         } else {
-            let anchored = clip_outline(inst, t, n, a, b, pattern_anchor(inst, t, i, a, b, mode), cut_plane(mode));
+            var anchored = clip_outline(inst, t, n, a, b, pattern_anchor(inst, t, i, a, b, mode), cut_plane(mode));
+            anchored.seg.capped = capped(inst, t, i, mode);
             draw_piece(anchored.seg, k0, k1, c.length_px, mode);
         }
     }

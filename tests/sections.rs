@@ -9,7 +9,9 @@ use glam::{DMat4, DVec3, Vec3};
 use std::sync::Arc;
 use wirepass::mesh::Procedural;
 use wirepass::tools::offline::Method;
-use wirepass::truth::accuracy::{distance_error, id_agreement, line_class_agreement};
+use wirepass::truth::accuracy::{
+    distance_error, hidden_distance_error, id_agreement, line_class_agreement,
+};
 use wirepass::world::LineClass;
 use wirepass::world::{Object, World, WorldMesh};
 use wirepass::{EdgeSelection, Error, Mesh, SectionPlane, Style, View};
@@ -97,6 +99,19 @@ fn a_closed_part_cut_open_shows_its_section_face() {
     let (faces, cuts) = check("fandisk", &world, view, &Style::default());
     assert!(faces > 500, "fandisk: {faces} section-face pixels");
     assert!(cuts > 300, "fandisk: {cuts} cut-line pixels");
+    // With hidden lines: what lies behind the section face is drawn hidden, where the truth
+    // puts it.
+    let hidden = Style {
+        hidden: Some(wirepass::HiddenLines::default()),
+        ..Style::default()
+    };
+    check("fandisk, hidden lines", &world, view, &hidden);
+    let truth = shoot_world(&world, view, &hidden, SIZE, Method::Raycast);
+    let frame = shoot_world(&world, view, &hidden, SIZE, Method::Deferred);
+    let h = hidden_distance_error(&truth, &frame).unwrap();
+    println!("fandisk, hidden lines: {h:?}");
+    assert!(h.pixels > 300, "{h:?}");
+    assert!(h.p99.unwrap() <= 0.01 && h.max.unwrap() <= 0.1, "{h:?}");
     // The cut away half is gone: fewer triangles seen than uncut.
     let mut whole = world.clone();
     whole.sections.clear();

@@ -114,6 +114,8 @@ struct Draw {
     outline: bool,
     /// A cut line: where section plane k meets the triangle.
     cut: Option<usize>,
+    /// Behind the section face ([`capped`]): what is visible of it counts as hidden.
+    capped: bool,
 }
 
 /// The outline map of `caster`'s world for `shot`, seen along `rays`; `masks` are each
@@ -162,6 +164,7 @@ pub(crate) fn outline_map(
                     hidden: hidden.is_some(),
                     outline: true,
                     cut: None,
+                    capped: false,
                 };
                 edges.extend(outline_edges(mesh, local).into_iter().map(|e| (e, outline)));
             }
@@ -172,6 +175,7 @@ pub(crate) fn outline_map(
                     hidden: hidden_edges,
                     outline: false,
                     cut: None,
+                    capped: false,
                 };
                 edges.extend(splat.iter().enumerate().flat_map(|(t, &bits)| {
                     (0..3u32)
@@ -188,6 +192,7 @@ pub(crate) fn outline_map(
                     hidden: hidden_edges,
                     outline: false,
                     cut: None,
+                    capped: false,
                 };
                 edges.extend((0..tris.len() as u32).flat_map(|t| {
                     (0..3u32)
@@ -211,6 +216,7 @@ pub(crate) fn outline_map(
                                 hidden: false,
                                 outline: false,
                                 cut: Some(k),
+                                capped: false,
                             };
                             ((t, 3 + k as u32), draw)
                         })
@@ -266,6 +272,10 @@ pub(crate) fn outline_map(
                         world_corners[i as usize],
                         world_corners[(i as usize + 1) % 3],
                     );
+                    let draw = Draw {
+                        capped: !sections.is_empty() && capped(caster, first, (t, n), eye),
+                        ..draw
+                    };
                     let on_chain = chained.as_ref().and_then(|(weld, anchors)| {
                         let (wa, wb) = (weld[a as usize], weld[b as usize]);
                         let &(positions, entry) = anchors.get(&(wa.min(wb), wa.max(wb)))?;
@@ -538,7 +548,10 @@ impl Visibility<'_> {
         let class = |k: f64| {
             let q = point(k);
             let w = 1.0 / q.inv_w;
-            self.class(q.xy, (q.near_w * w, w), first, (t, n), behind_host)
+            match self.class(q.xy, (q.near_w * w, w), first, (t, n), behind_host) {
+                Class::Visible if draw.capped => Class::Hidden,
+                c => c,
+            }
         };
 
         // Runs of one class, as (from, to, class) in parameters of p0 → p1.
@@ -655,6 +668,20 @@ impl Visibility<'_> {
             }
         }
     }
+}
+
+/// In a frame with section planes, back faces stand for the section face of a cut solid, so
+/// a line between two of them (triangle `t` and its neighbour `n`; a boundary of one, where
+/// `n` is `NO_NEIGHBOUR`) lies behind that face: what of it is visible counts as hidden
+/// (twin of `capped` in outline.wgsl). A triangle faces away where its world winding turns
+/// from the eye (`eye`, homogeneous world).
+fn capped(caster: &RayCaster<'_>, first: u32, (t, n): (u32, u32), eye: DVec4) -> bool {
+    let away = |t: u32| {
+        let c = caster.corners(first + t);
+        let normal = (c[1] - c[0]).cross(c[2] - c[0]);
+        normal.dot(edge_math::towards_eye(c[0], eye)) < 0.0
+    };
+    away(t) && (n == NO_NEIGHBOUR || away(n))
 }
 
 /// Where section plane `plane` meets a triangle (world corners `c`) that it crosses (corners
@@ -1039,6 +1066,7 @@ mod tests {
             hidden: true,
             outline: true,
             cut: None,
+            capped: false,
         };
         let hidden = crate::HiddenLines {
             pattern: crate::LinePattern::Dashed {
