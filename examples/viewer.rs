@@ -7,12 +7,16 @@
 //! and the nearest drawn edge and vertex) and selects the mesh (a `Highlight`: its outline
 //! in orange, dashed where it hides itself; a click on the background clears it).
 //! Keys: `E` cycles the edges (polygon, all, feature), `O` toggles outlines, `H` cycles the
-//! hidden lines (off, dashed, dotted, solid; deferred only), `M` switches the method, `+`/`-`
-//! change the line width, `Esc` quits.
+//! hidden lines (off, dashed, dotted, solid; deferred only), `S` adds a section plane
+//! through the orbit's centre facing the way the camera looks (what is nearer is cut away;
+//! up to 6), `[`/`]` move the last one along its normal, `Backspace` removes it (deferred
+//! only), `M` switches the method, `+`/`-` change the line width, `Esc` quits.
 //!
 //! `cargo run --release --example viewer -- [MESH] [--method deferred|forward]
-//! [--edges polygon|all|feature] [--hidden off|dashed|dotted|solid] [--frames N]
+//! [--edges polygon|all|feature] [--hidden off|dashed|dotted|solid] [--cut] [--frames N]
 //! [--screenshot OUT.png] [--pick X,Y]`
+//!
+//! `--cut` presses `S` once before the first frame.
 //!
 //! With `--frames N` the viewer orbits a little each frame and closes after N frames; with
 //! `--screenshot` it reads the last frame back from the surface, checks that it shows the
@@ -35,7 +39,7 @@ use wirepass::gpu::{
 };
 use wirepass::{
     wgpu, EdgeSelection, HiddenLines, Highlight, Instance, InstanceStyle, LinePattern, Mesh, Scene,
-    Style,
+    SectionPlane, Style,
 };
 
 type AnyError = Box<dyn std::error::Error>;
@@ -64,6 +68,8 @@ struct Options {
     frames: Option<u64>,
     screenshot: Option<std::path::PathBuf>,
     pick: Option<(u32, u32)>,
+    /// `--cut`: a section plane from the start.
+    cut: bool,
 }
 
 /// The hidden-line styles `H` cycles through.
@@ -100,6 +106,7 @@ fn options() -> Result<Options, AnyError> {
         frames: None,
         screenshot: None,
         pick: None,
+        cut: false,
     };
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
@@ -130,6 +137,7 @@ fn options() -> Result<Options, AnyError> {
             }
             "--frames" => o.frames = Some(value()?.parse()?),
             "--screenshot" => o.screenshot = Some(value()?.into()),
+            "--cut" => o.cut = true,
             "--pick" => {
                 let v = value()?;
                 let bad = || format!("--pick {v:?} is not X,Y");
@@ -173,6 +181,8 @@ struct Viewer {
     last: Option<(wirepass::PreparedFrame, Scene<'static>)>,
     /// Whether a click selected the mesh.
     selected: bool,
+    /// The section planes `S` placed.
+    sections: Vec<SectionPlane>,
 }
 
 impl Viewer {
@@ -248,7 +258,7 @@ impl Viewer {
         if o.method == Method::Forward && forward.is_none() {
             return Err("--method forward: this device cannot run the forward pass".into());
         }
-        let viewer = Viewer {
+        let mut viewer = Viewer {
             window,
             surface,
             config,
@@ -273,20 +283,36 @@ impl Viewer {
             mesh: mesh.clone(),
             last: None,
             selected: false,
+            sections: Vec::new(),
         };
+        if o.cut {
+            viewer.add_section();
+        }
         viewer.title();
         Ok(viewer)
     }
 
     fn title(&self) {
         self.window.set_title(&format!(
-            "wirepass viewer: {:?}, {} edges, outlines {}, hidden {}, width {:.1} (E, O, H, M, +/-)",
+            "wirepass viewer: {:?}, {} edges, outlines {}, hidden {}, sections {}, width {:.1} \
+             (E, O, H, S, [, ], Backspace, M, +/-)",
             self.method,
             EDGES[self.edges].0,
             if self.style.silhouettes { "on" } else { "off" },
             HIDDEN[self.hidden].0,
+            self.sections.len(),
             self.style.line_width
         ));
+    }
+
+    /// A section plane through the orbit's centre, its normal the way the camera looks: the
+    /// half nearer the eye is cut away.
+    fn add_section(&mut self) {
+        if self.sections.len() < wirepass::MAX_SECTIONS {
+            let forward = self.orbit.target - self.orbit.camera().eye.as_dvec3();
+            self.sections
+                .push(SectionPlane::new(self.orbit.target, forward.normalize()));
+        }
     }
 
     fn resize(&mut self, size: PhysicalSize<u32>) {
@@ -304,6 +330,17 @@ impl Viewer {
             Key::Character("h" | "H") => {
                 self.hidden = (self.hidden + 1) % HIDDEN.len();
                 self.style = with_hidden(&self.style, self.hidden);
+            }
+            Key::Character("s" | "S") => self.add_section(),
+            Key::Character(c @ ("[" | "]")) => {
+                // A twentieth of the framed radius a press.
+                let step = if c == "]" { 0.05 } else { -0.05 } * self.orbit.radius;
+                if let Some(s) = self.sections.last_mut() {
+                    s.point += s.normal * step;
+                }
+            }
+            Key::Named(NamedKey::Backspace) => {
+                self.sections.pop();
             }
             Key::Character("m" | "M") if self.forward.is_some() => {
                 self.method = match self.method {
@@ -391,7 +428,8 @@ impl Viewer {
                 InstanceStyle::default().highlighted(&Highlight::default(), &self.style);
         }
         let instances = [instance];
-        let scene = Scene::borrowed(self.orbit.camera().to_view(aspect), &instances);
+        let scene = Scene::borrowed(self.orbit.camera().to_view(aspect), &instances)
+            .with_sections(self.sections.clone());
         let mut encoder = self.device.create_command_encoder(&Default::default());
         let clear = {
             let [r, g, b, a] = self.style.background.0.map(f64::from);
@@ -439,7 +477,10 @@ impl Viewer {
                 });
                 self.deferred.render(&mut pass, &frame)?;
                 drop(pass);
-                self.last = Some((frame, Scene::new(scene.view, instances.to_vec())));
+                self.last = Some((
+                    frame,
+                    Scene::new(scene.view, instances.to_vec()).with_sections(scene.sections),
+                ));
             }
         }
         self.queue.submit([encoder.finish()]);
