@@ -505,6 +505,7 @@ impl Viewer {
         let view = PickView {
             view: scene.view,
             image: frame.output_size(),
+            sections: scene.sections.clone(),
         };
         let edges = EDGES[self.edges].1;
         let l = hit.locate(&self.mesh, edges, DMat4::IDENTITY, &view, at, 8.0)?;

@@ -101,7 +101,11 @@ fn encoded(world: World, canvas: Option<&wgpu::Texture>) -> Frame {
         up,
         scene,
         frame,
-        view: PickView { view, image: SIZE },
+        view: PickView {
+            view,
+            image: SIZE,
+            sections: Vec::new(),
+        },
     }
 }
 

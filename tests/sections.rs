@@ -225,3 +225,61 @@ fn bad_section_planes_are_errors() {
         assert!(e.to_string().contains(expect), "{e}");
     }
 }
+
+/// Picking sees what the cut leaves: the located point, the snapped edge and vertex are
+/// never cut away, and the triangle is the ground truth's.
+#[test]
+fn picks_ignore_what_is_cut_away() {
+    let world = single(
+        Procedural::Cube(300).build().unwrap(),
+        EdgeSelection::Feature(30.0),
+        vec![plane([0.2, 0.0, 0.0], [-1.0, 0.0, 0.0])],
+    );
+    let view = perspective(&world, DVec3::new(2.0, 2.2, 2.6));
+    let style = Style::default();
+    let shot = wirepass::world::Shot {
+        world: &world,
+        view,
+        style: &style,
+        size: SIZE,
+    };
+    let truth = shoot_world(&world, view, &style, SIZE, Method::Raycast);
+    let plane = &world.sections[0];
+    let kept = |p: [f64; 3]| plane.side(DVec3::from(p)) >= -1e-9;
+    let (mut picked, mut agree, mut snapped) = (0, 0, 0);
+    // Each pick renders the shot: a sparse grid of pixels.
+    for y in (0..SIZE.1).step_by(13) {
+        for x in (0..SIZE.0).step_by(13) {
+            let id = truth.ids[(y * SIZE.0 + x) as usize];
+            if id == wirepass::world::BACKGROUND {
+                continue;
+            }
+            let r = wirepass::tools::pick::pick(common::gpu(), &shot, (x, y), 12.0).unwrap();
+            let Some(point) = r.point else {
+                continue;
+            };
+            picked += 1;
+            agree += usize::from(r.triangle == Some(id));
+            assert!(kept(point), "({x}, {y}): {point:?} is cut away");
+            if let Some(e) = &r.edge {
+                snapped += 1;
+                assert!(
+                    kept(e.point),
+                    "({x}, {y}): edge point {:?} is cut away",
+                    e.point
+                );
+            }
+            if let Some(v) = &r.vertex {
+                assert!(
+                    kept(v.position),
+                    "({x}, {y}): vertex {:?} is cut away",
+                    v.position
+                );
+            }
+        }
+    }
+    println!("{agree} of {picked} picks on the truth's triangle, {snapped} snapped to an edge");
+    assert!(picked > 40, "{picked} picks");
+    assert!(agree as f64 >= 0.99 * picked as f64, "{agree} of {picked}");
+    assert!(snapped > 5, "{snapped} snaps");
+}

@@ -272,12 +272,15 @@ pub struct VertexSnap {
 }
 
 /// What [`InstanceHit::locate`] needs of the frame: how the image was seen.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct PickView {
     /// The scene's view.
     pub view: View,
     /// The whole image's size in pixels (a tile's frame: the image it is a tile of).
     pub image: (u32, u32),
+    /// The scene's section planes ([`Scene::sections`](crate::Scene::sections)): what they
+    /// cut away is neither located nor snapped to.
+    pub sections: Vec<crate::SectionPlane>,
 }
 
 impl PickView {
@@ -346,6 +349,7 @@ impl InstanceHit {
             )));
         }
         let world = |v: u32| transform.transform_point3(mesh.positions()[v as usize].as_dvec3());
+        let kept = |p: DVec3| view.sections.iter().all(|s| s.side(p) >= 0.0);
         let centre = DVec2::new(f64::from(pixel.0) + 0.5, f64::from(pixel.1) + 0.5);
         let (origin, dir) = view.ray(centre)?;
 
@@ -382,7 +386,8 @@ impl InstanceHit {
             let p = origin + dir * s;
             let inside = [(a, b), (b, c), (c, a)]
                 .iter()
-                .all(|&(e0, e1)| (e1 - e0).cross(p - e0).dot(normal) >= 0.0);
+                .all(|&(e0, e1)| (e1 - e0).cross(p - e0).dot(normal) >= 0.0)
+                && kept(p);
             Some((s, p, normal, inside))
         };
         let (_, point, normal, _) = near
@@ -414,7 +419,7 @@ impl InstanceHit {
             let mask = mesh.triangle_edge_mask(u, edges);
             for i in 0..3 {
                 let (p, q) = (tri[i], tri[(i + 1) % 3]);
-                if let Some((sp, _)) = view.screen(world(p)) {
+                if let Some((sp, _)) = view.screen(world(p)).filter(|_| kept(world(p))) {
                     let d = sp.distance(centre);
                     if d <= snap_radius && vertex.is_none_or(|v| d < v.distance_px) {
                         vertex = Some(VertexSnap {
@@ -427,9 +432,26 @@ impl InstanceHit {
                 if mask & (1 << i) == 0 {
                     continue;
                 }
-                let (Some((sp, wp)), Some((sq, wq))) =
-                    (view.screen(world(p)), view.screen(world(q)))
-                else {
+                // The part of the edge no plane cuts away, as parameters along it.
+                let mut kept_part = (0.0_f64, 1.0_f64);
+                for plane in &view.sections {
+                    let (a, b) = (plane.side(world(p)), plane.side(world(q)));
+                    if a < 0.0 && b < 0.0 {
+                        kept_part = (1.0, 0.0);
+                    } else if a < 0.0 {
+                        kept_part.0 = kept_part.0.max(a / (a - b));
+                    } else if b < 0.0 {
+                        kept_part.1 = kept_part.1.min(a / (a - b));
+                    }
+                }
+                if kept_part.0 > kept_part.1 {
+                    continue;
+                }
+                let (from, to) = (
+                    world(p).lerp(world(q), kept_part.0),
+                    world(p).lerp(world(q), kept_part.1),
+                );
+                let (Some((sp, wp)), Some((sq, wq))) = (view.screen(from), view.screen(to)) else {
                     continue;
                 };
                 let seg = sq - sp;
@@ -442,6 +464,7 @@ impl InstanceHit {
                 if d <= snap_radius && edge.is_none_or(|e| d < e.distance_px) {
                     // Screen parameter s to the edge's own: perspective divides by w.
                     let t = s / wq / ((1.0 - s) / wp + s / wq);
+                    let t = kept_part.0 + (kept_part.1 - kept_part.0) * t;
                     edge = Some(EdgeSnap {
                         vertices: [p, q],
                         distance_px: d,

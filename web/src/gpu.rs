@@ -305,6 +305,7 @@ impl Gpu {
         let view = PickView {
             view: scene.view,
             image: frame.output_size(),
+            sections: scene.sections.clone(),
         };
         let l = hit
             .locate(&model.meshes[m].0, self.ids[m].1, transform, &view, at, 8.0)
