@@ -1,6 +1,7 @@
 //! Image regression: every case renders a shared mesh with one method, edge mode and camera
 //! at 256×256 (and some, by the deferred method, in a technical style: dashed hidden lines,
-//! outlines of their own colour and width, a see-through surface) and compares it with FLIP
+//! outlines of their own colour and width, a see-through surface; or cut by a section plane,
+//! with dashed edges and dotted outlines) and compares it with FLIP
 //! against a blessed PNG under `tests/reference/`.
 //! One test runs every case and reports all failing cases at once; each failure writes
 //! `<case>.actual.png` and `<case>.diff.png` under `target/regression/`.
@@ -52,6 +53,31 @@ fn technical() -> Style {
         fill_opacity: 0.6,
         ..Style::default()
     }
+}
+
+/// The meshes and edge modes also drawn cut open (`section_plane`), in `sectioned`.
+const SECTIONED: &[(&str, &str)] = &[("fandisk", "feature:30")];
+
+/// Patterned lines: dashed edges, dotted outlines, dashed hidden lines, wide cut lines.
+fn sectioned() -> Style {
+    Style {
+        edge_pattern: wirepass::LinePattern::Dashed {
+            dash: 4.0,
+            gap: 3.0,
+        },
+        outline_pattern: wirepass::LinePattern::Dotted { spacing: 4.0 },
+        hidden: Some(wirepass::HiddenLines::default()),
+        section_line_width: Some(2.0),
+        ..Style::default()
+    }
+}
+
+/// A plane through the mesh, a little off its centre (where the inside view's eye is),
+/// slanted; the half towards +z is cut away.
+fn section_plane(mesh: &Mesh) -> wirepass::SectionPlane {
+    let (lo, hi) = mesh.bounds_f64();
+    let centre = 0.5 * (lo + hi) + 0.05 * (hi - lo);
+    wirepass::SectionPlane::new(centre, glam::DVec3::new(-0.2, 0.1, -1.0))
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -111,6 +137,8 @@ const MEASURED: &[(&str, [f32; 2], [f32; 2])] = &[
     ("fandisk_deferred_polygon_inside", [0.0, 0.0], [0.00003, 0.00046]),
     ("fandisk_deferred_feature30_framing_technical", [0.0, 0.0], [0.00001, 0.00002]),
     ("fandisk_deferred_feature30_inside_technical", [0.0, 0.0], [0.00001, 0.00002]),
+    ("fandisk_deferred_feature30_framing_section", [0.0, 0.0], [0.00001, 0.00014]),
+    ("fandisk_deferred_feature30_inside_section", [0.0, 0.0], [0.00002, 0.0004]),
     ("fandisk_forward_feature30_framing", [0.01209, 0.05217], [0.01209, 0.05217]),
     ("fandisk_forward_feature30_inside", [0.00273, 0.01388], [0.03050, 0.63335]),
     ("fandisk_forward_polygon_framing", [0.00071, 0.00804], [0.00071, 0.00807]),
@@ -206,6 +234,17 @@ fn out_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/regression")
 }
 
+/// A family of cases: (mesh, edge mode, style name, style, methods, cut by
+/// `section_plane`).
+type Run = (
+    &'static str,
+    &'static str,
+    &'static str,
+    Style,
+    &'static [Method],
+    bool,
+);
+
 #[test]
 fn every_case_matches_its_reference() {
     let ctx = gpu();
@@ -213,11 +252,10 @@ fn every_case_matches_its_reference() {
     let measured = measured_for(ctx);
     let mut failures = Vec::new();
     let mut cases = 0;
-    // (mesh, edge mode, style name, style, methods)
-    let mut runs: Vec<(&str, &str, &str, Style, &[Method])> = Vec::new();
+    let mut runs: Vec<Run> = Vec::new();
     for &(mesh_name, modes) in MESHES {
         for &mode in modes {
-            runs.push((mesh_name, mode, "", Style::default(), METHODS));
+            runs.push((mesh_name, mode, "", Style::default(), METHODS, false));
         }
     }
     for &(mesh_name, mode) in TECHNICAL {
@@ -227,12 +265,26 @@ fn every_case_matches_its_reference() {
             "_technical",
             technical(),
             &[Method::Deferred],
+            false,
         ));
     }
-    for (mesh_name, mode, style_name, style, methods) in runs {
+    for &(mesh_name, mode) in SECTIONED {
+        runs.push((
+            mesh_name,
+            mode,
+            "_section",
+            sectioned(),
+            &[Method::Deferred],
+            true,
+        ));
+    }
+    for (mesh_name, mode, style_name, style, methods, cut) in runs {
         let mesh = load(&format!("{mesh_name}.obj"));
         let edges: EdgeSelection = mode.parse().unwrap_or_else(|e| panic!("{e}"));
-        let world = World::single(mesh.clone(), edges);
+        let mut world = World::single(mesh.clone(), edges);
+        if cut {
+            world.sections.push(section_plane(&mesh));
+        }
         for view in [View::Framing, View::Inside] {
             let shot = Shot {
                 world: &world,
