@@ -167,6 +167,12 @@ fn two_planes_cut_a_corner_out_of_a_box() {
     let (faces, cuts) = check("corner", &world, view, &style);
     assert!(faces > 1000, "corner: {faces} section-face pixels");
     assert!(cuts > 300, "corner: {cuts} cut-line pixels");
+    // Without edges or outlines, the cut lines are still drawn.
+    let mut bare = world.clone();
+    bare.objects[0].style.edges = Some(false);
+    bare.objects[0].style.outlines = Some(false);
+    let (_, cuts) = check("corner, no edges or outlines", &bare, view, &style);
+    assert!(cuts > 300, "no edges or outlines: {cuts} cut-line pixels");
 }
 
 #[test]

@@ -90,8 +90,8 @@ const INSTANCE_HIDDEN: u32 = 4;
 const INSTANCE_BEHIND_HOST: u32 = 8;
 /// `Instance.flags`: the hidden parts of its drawn edges are drawn, not only its outline's.
 const INSTANCE_HIDDEN_EDGES: u32 = 16;
-/// `Instance.flags`: its drawn edges are patterned, so the outline pass draws them (their
-/// visible runs) and the edge pass leaves them.
+/// `Instance.flags`: its drawn edges are patterned, or cut by section planes, so the outline
+/// pass draws them (their visible runs) and the edge pass leaves them.
 const INSTANCE_LISTED_EDGES: u32 = 32;
 /// `Instance.flags`: it has a phase table (`chain_phases`).
 const INSTANCE_PHASES: u32 = 64;
@@ -304,7 +304,8 @@ impl FrameRecords {
             let patterned_edges = draws_edges && edge_pattern[1] > 0.0;
             // Section planes cut the drawn edges short: the outline pass draws them.
             let listed_edges = patterned_edges || (draws_edges && !scene.sections.is_empty());
-            outlines |= hidden.is_some() || listed_edges;
+            // Cut lines too: every instance has them where a section plane crosses it.
+            outlines |= hidden.is_some() || listed_edges || !scene.sections.is_empty();
             patterns |= patterned_edges
                 || (draws_outline && outline_pattern[1] > 0.0)
                 || hidden.is_some_and(|h| h.pattern.dash_period()[1] > 0.0);
