@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{channel_difference, framing, load, shoot_world, worst_of};
+use common::{channel_difference, cylinder, framing, load, shoot_world, worst_of};
 use glam::{DMat4, DVec3};
 use std::sync::Arc;
 use wirepass::mesh::Procedural;
@@ -249,33 +249,6 @@ fn see_through_surfaces_blend_like_the_ground_truth() {
     assert!(compared > 10_000);
     assert!(worst <= 2, "worst channel difference {worst}");
     assert!(faded > compared / 2, "{faded} of {compared} faded");
-}
-
-/// A closed cylinder of `n` sides, radius 1, from y = -0.5 to 0.5: its rims are circles of
-/// `n` short feature edges each, chains of drawn edges.
-fn cylinder(n: u32) -> wirepass::Mesh {
-    let mut p = Vec::new();
-    for y in [-0.5f32, 0.5] {
-        p.extend((0..n).map(|k| {
-            let a = k as f32 / n as f32 * std::f32::consts::TAU;
-            glam::Vec3::new(a.cos(), y, a.sin())
-        }));
-    }
-    p.extend([
-        glam::Vec3::new(0.0, -0.5, 0.0),
-        glam::Vec3::new(0.0, 0.5, 0.0),
-    ]);
-    let mut tris = Vec::new();
-    for k in 0..n {
-        let j = (k + 1) % n;
-        tris.extend([
-            [k, n + k, j],
-            [j, n + k, n + j],
-            [2 * n, k, j],
-            [2 * n + 1, n + j, n + k],
-        ]);
-    }
-    wirepass::Mesh::new(p, None, tris, None).unwrap()
 }
 
 /// Dashes run on along a chain of drawn edges: the hidden half of a cylinder's rim, made of

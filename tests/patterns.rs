@@ -5,14 +5,14 @@
 
 mod common;
 
-use common::{load, shoot_world, worst_pixels};
+use common::{cylinder, load, shoot_world, worst_pixels};
 use glam::{DMat4, DVec3, Vec3};
 use std::sync::Arc;
 use wirepass::mesh::Procedural;
 use wirepass::tools::offline::Method;
 use wirepass::truth::accuracy::{distance_error, hidden_distance_error, id_agreement};
 use wirepass::world::{Object, World, WorldMesh};
-use wirepass::{Color, EdgeSelection, HiddenLines, LinePattern, Mesh, Style, View};
+use wirepass::{Color, EdgeSelection, HiddenLines, LinePattern, Style, View};
 
 const SIZE: (u32, u32) = (320, 240);
 
@@ -138,30 +138,6 @@ fn dashed_edges_and_dotted_outlines_match_the_ground_truth() {
         ..style
     };
     check("with hidden lines", &world, view, &both);
-}
-
-/// A closed cylinder of `n` sides, radius 1, from y = -0.5 to 0.5: its rims are circles of
-/// `n` short feature edges each, chains of drawn edges.
-fn cylinder(n: u32) -> Mesh {
-    let mut p = Vec::new();
-    for y in [-0.5f32, 0.5] {
-        p.extend((0..n).map(|k| {
-            let a = k as f32 / n as f32 * std::f32::consts::TAU;
-            Vec3::new(a.cos(), y, a.sin())
-        }));
-    }
-    p.extend([Vec3::new(0.0, -0.5, 0.0), Vec3::new(0.0, 0.5, 0.0)]);
-    let mut tris = Vec::new();
-    for k in 0..n {
-        let j = (k + 1) % n;
-        tris.extend([
-            [k, n + k, j],
-            [j, n + k, n + j],
-            [2 * n, k, j],
-            [2 * n + 1, n + j, n + k],
-        ]);
-    }
-    Mesh::new(p, None, tris, None).unwrap()
 }
 
 /// A rim of edges shorter than a dash dashes evenly (its pattern's share of the solid

@@ -211,3 +211,27 @@ pub fn diagnostic_pass(device: &wgpu::Device, pulled: bool) -> DeferredPass {
         .unwrap()
         .with_diagnostics()
 }
+
+/// A closed cylinder of `n` sides, radius 1, from y = -0.5 to 0.5: its rims are circles of
+/// `n` short feature edges each, chains of drawn edges.
+pub fn cylinder(n: u32) -> Mesh {
+    let mut p = Vec::new();
+    for y in [-0.5f32, 0.5] {
+        p.extend((0..n).map(|k| {
+            let a = k as f32 / n as f32 * std::f32::consts::TAU;
+            Vec3::new(a.cos(), y, a.sin())
+        }));
+    }
+    p.extend([Vec3::new(0.0, -0.5, 0.0), Vec3::new(0.0, 0.5, 0.0)]);
+    let mut tris = Vec::new();
+    for k in 0..n {
+        let j = (k + 1) % n;
+        tris.extend([
+            [k, n + k, j],
+            [j, n + k, n + j],
+            [2 * n, k, j],
+            [2 * n + 1, n + j, n + k],
+        ]);
+    }
+    Mesh::new(p, None, tris, None).unwrap()
+}
