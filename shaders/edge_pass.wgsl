@@ -467,12 +467,11 @@ fn surface_pixel(xy: vec2<u32>, s: Sample, own: f32) -> Pixel {
     let n = b.x * unpack_normal(bitcast<u32>(s.v0.w)) + b.y * unpack_normal(bitcast<u32>(s.v1.w)) + b.z * unpack_normal(bitcast<u32>(s.v2.w));
     let face = cross(s.v1.xyz - s.v0.xyz, s.v2.xyz - s.v0.xyz);
     p.surface = surface_color(frame, instances[slot(inst)], local, n, face);
-    // A back face seen through a section's cut is the section face: the face's winding as
-    // the instance's transform leaves it (mirrored where its determinant is negative),
-    // against the eye.
-    let mirror = dot(instances[slot(inst)].normal_x, cross(instances[slot(inst)].normal_y, instances[slot(inst)].normal_z));
+    // A back face seen through a section's cut is the section face: its outward normal
+    // against the eye, in the instance's own space, where the winding is the mesh's whatever
+    // the transform mirrors.
     let eye = instances[slot(inst)].eye;
-    let back = dot(face, eye.xyz - local * eye.w) * mirror < 0.0;
+    let back = dot(face, eye.xyz - local * eye.w) < 0.0;
     p.surface = select(p.surface, frame.section_color.rgb, back && frame.sections_on != 0u);
     p.depth = s.depth;
     if own_key >= outline.x {

@@ -210,19 +210,25 @@ fn cut_segment(inst: u32, p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>, k: u32) -
     return ends;
 }
 
-// Whether triangle (local corners p) of `inst` faces away from the eye, by its winding as
-// the instance's transform leaves it (mirrored where its determinant is negative).
+// Whether triangle (local corners p) of `inst` faces away from the eye: its outward normal,
+// in the instance's own space, where the winding is the mesh's whatever the transform
+// mirrors.
 fn faces_away(inst: u32, p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>) -> bool {
-    let i = instances[slot(inst)];
-    let mirror = dot(i.normal_x, cross(i.normal_y, i.normal_z));
-    return dot(cross(p1 - p0, p2 - p0), towards_eye(p0, i.eye)) * mirror < 0.0;
+    return dot(cross(p1 - p0, p2 - p0), towards_eye(p0, instances[slot(inst)].eye)) < 0.0;
 }
 
-// In a frame with section planes, back faces stand for the section face of a cut solid, so
-// a line between two of them (edge i of triangle t, its neighbour's too; a boundary of one)
-// lies behind that face: what of it is visible counts as hidden (twin of `capped` in
-// src/truth/outline.rs). Cut lines are on the face.
-fn capped(inst: u32, t: u32, i: u32, mode: u32) -> bool {
+// In a frame with section planes, back faces stand for the section face of a cut solid, and
+// a line point that the eye's ray reaches from inside the solid lies behind that face (see
+// `class_at`). Where no other surface lies just in front of the point, its own triangles
+// tell: the ray reaches from inside a line between two back faces (edge i of triangle t, its
+// neighbour's too), a back face's boundary, and a silhouette where the surface folds inwards
+// (concave). Returns the line's CAP_ value (twin of `capped` in src/truth/outline.rs); cut
+// lines are on the face.
+const CAP_NONE: u32 = 0u;
+const CAP_OUTSIDE: u32 = 1u;
+const CAP_INSIDE: u32 = 2u;
+
+fn capped(inst: u32, t: u32, i: u32, mode: u32) -> u32 {
     let base = instances[slot(inst)].triangle_base;
     let v = corners(base + t) + instances[slot(inst)].vertex_base;
     let p0 = vertex_at(v.x);
@@ -233,7 +239,11 @@ fn capped(inst: u32, t: u32, i: u32, mode: u32) -> bool {
     let q = beyond_edge(inst, select(word, 0u, word == BACKGROUND_ID), edge[i], edge[(i + 1u) % 3u]);
     let away = faces_away(inst, p0.xyz, p1.xyz, p2.xyz);
     let beyond = word == BACKGROUND_ID || faces_away(inst, q.q0.xyz, q.q1.xyz, q.q2.xyz);
-    return frame.sections_on != 0u && (mode & DRAW_CUT) == 0u && away && beyond;
+    let centroid = (q.q0.xyz + q.q1.xyz + q.q2.xyz) / 3.0;
+    let concave = dot(cross(p1.xyz - p0.xyz, p2.xyz - p0.xyz), centroid - p0.xyz) > 0.0;
+    let inside = select(away && beyond, concave && word != BACKGROUND_ID, away != beyond);
+    let cap = select(CAP_OUTSIDE, CAP_INSIDE, inside);
+    return select(CAP_NONE, cap, frame.sections_on != 0u && (mode & DRAW_CUT) == 0u);
 }
 
 // The plane of a cut line's `mode` (DRAW_CUT), else NO_PLANE.
@@ -286,7 +296,7 @@ fn outline_pieces_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_i
         }
         let anchor = pattern_anchor(inst, t, i, a, b, mode);
         var c = clip_outline(inst, t, n, a, b, anchor, cut_plane(mode));
-        c.seg.capped = capped(inst, t, i, mode);
+        c.seg.cap = capped(inst, t, i, mode);
         draw_piece(c.seg, f32(piece) / f32(c.pieces), f32(piece + 1u) / f32(c.pieces), c.length_px, mode);
     }
 }
@@ -554,6 +564,9 @@ fn lerp_projected(a: Projected, b: Projected, k: f32) -> Projected {
 
 // Visibility samples per pixel of edge length; each change between two is then bisected.
 const RUN_SAMPLES_PER_PX: f32 = 4.0;
+const END_INSET: f32 = 1.0 / 256.0;
+// Steps of the walks from a line's own triangles' neighbours (`class_at`).
+const FOLD_STEPS: u32 = 4u;
 const RUN_BISECTIONS: u32 = 12u;
 // An edge is drawn in pieces of at most this many pixels, each with up to MAX_RUNS visible
 // runs (more is beyond any real mesh at this scale; the last run then absorbs the rest).
@@ -576,8 +589,8 @@ struct Segment {
     phase_dir: f32,
     hidden_phase: f32,
     hidden_dir: f32,
-    // Behind the section face (`capped`): what is visible of it counts as hidden.
-    capped: bool,
+    // How the eye's ray reaches the line where no other surface tells (`capped`).
+    cap: u32,
 }
 
 fn seg_at(s: Segment, k: f32) -> Projected {
@@ -588,10 +601,13 @@ fn seg_at(s: Segment, k: f32) -> Projected {
 // by the host's where hidden lines are drawn behind it), 2 neither drawn (behind the host).
 // Without HIDDEN only visible or not: 0 or 1.
 fn seg_class(s: Segment, k: f32) -> u32 {
-    let q = seg_at(s, k);
+    // Each end's class is that of the point END_INSET pixels along (twin of `END_INSET` in
+    // src/edge_math.rs): at a vertex every triangle round it agrees with the line only to
+    // rounding, and a run of no length is still drawn as a dot a line wide.
+    let inset = min(END_INSET / max(distance(s.start.xy, s.end.xy), 1e-30), 0.5);
+    let q = seg_at(s, clamp(k, inset, 1.0 - inset));
     let w = 1.0 / q.inv_w;
-    var c = class_at(q.xy, q.near_w * w, w, q.reverse, s.inst, s.t, s.n);
-    c = select(c, 1u, c == 0u && s.capped);
+    let c = class_at(q.xy, q.near_w * w, w, q.reverse, s.inst, s.t, s.n, s.cap);
 #if HIDDEN
     let behind_host = (instances[slot(s.inst)].flags & INSTANCE_BEHIND_HOST) != 0u;
     return select(c, 1u, c == 2u && behind_host);
@@ -725,7 +741,7 @@ fn list_outline(inst: u32, t: u32, i: u32, n: u32, a: vec3<f32>, b: vec3<f32>, m
             atomicMax(&acc_rw[list + 1u], size.y);
         } else {
             var anchored = clip_outline(inst, t, n, a, b, pattern_anchor(inst, t, i, a, b, mode), cut_plane(mode));
-            anchored.seg.capped = capped(inst, t, i, mode);
+            anchored.seg.cap = capped(inst, t, i, mode);
             draw_piece(anchored.seg, k0, k1, c.length_px, mode);
         }
     }
@@ -987,29 +1003,78 @@ fn mark_outline_tiles(first_m: i32, last_m: i32, first_o: i32, last_o: i32, majo
 // Whether the edge's point at screen point x (near row `near`, w `w`, reverse depth `reverse`)
 // is visible (0), hidden by a triangle other than t and n of `inst` that covers x nearer
 // than the point (1), or by the host (2, host_hides_point). The candidates are the triangles the
-// rasterizer gave the 3×3 pixel centres around x (a sliver of surface in front of the edge
+// rasterizer gave the 3×3 pixel centres around x (5×5, and the line's triangles' other
+// neighbours, in a frame with section planes; a sliver of surface in front of the edge
 // may own no centre next to x, but one a pixel further on), and those a walk across edges
 // from them reaches when they do not cover x themselves (x may lie in a small triangle that
 // owns none of those centres). A walk ends at a fold (`locate`): beyond it the surface lies
 // on this side of the fold's edge, and a walk towards x, a point of a silhouette, would
 // only bounce between the edge's two triangles or wander over the far side for all its
 // steps, the slowest lane holding up its batch.
-fn class_at(x: vec2<f32>, near: f32, w: f32, reverse: f32, inst: u32, t: u32, n: u32) -> u32 {
+//
+// In a frame with section planes (`cap` not CAP_NONE) a point the eye's ray reaches from
+// inside a cut solid lies behind its section face, and is hidden too: where the nearest
+// surface in front of it (within HIDDEN_MARGIN) faces away, the ray came out of the solid
+// through it; where that surface faces the eye, it went in there; where none is nearer by
+// CAP_MARGIN, the line's own triangles tell (CAP_INSIDE).
+fn class_at(x: vec2<f32>, near: f32, w: f32, reverse: f32, inst: u32, t: u32, n: u32, cap: u32) -> u32 {
     let centre = vec2<i32>(floor(x - frame.target_origin));
     if host_hides_point(x - frame.target_origin, reverse) {
         return 2u;
     }
     var last = vec2<u32>(BACKGROUND_ID, 0u);
-    for (var k = 0; k < 9; k++) {
-        let id = id_at(centre + vec2<i32>(k % 3 - 1, k / 3 - 1));
+    // The nearest surface in front of the point within HIDDEN_MARGIN: its near row, and 1
+    // where it faces away (where none is, the line's own triangles tell).
+    var front = vec2<f32>(near, select(0.0, 1.0, cap == CAP_INSIDE));
+    // Through a section's cut the eye sees the inside of folded surfaces, where the sheet in
+    // front of an interior silhouette thins out near a fold of its own: look two pixels
+    // round for it there.
+    let r = select(1, 2, frame.sections_on != 0u);
+    let across = 2 * r + 1;
+    for (var k = 0; k < across * across; k++) {
+        let id = id_at(centre + vec2<i32>(k % across - r, k / across - r));
         if id.x >= HOST_ID || (id.x == inst && (id.y == t || id.y == n)) || all(id == last) {
             continue;
         }
         last = id;
-        let s = locate(id.x, id.y, x, WALK_STEPS, true);
-        if s.covers && !(s.inst == inst && (s.tri == t || s.tri == n)) && nearer(s.near, near, w) {
+        if hides(locate(id.x, id.y, x, WALK_STEPS, true), inst, t, n, near, w, &front) {
             return 1u;
         }
     }
-    return 0u;
+    if frame.sections_on != 0u {
+        // And the line's own triangles' other neighbours, and a few triangles on from them
+        // that face the same way: a sheet that folds back over the line starts there (the
+        // walks from the pixels stop at such folds).
+        let base = instances[slot(inst)].triangle_base;
+        for (var j = 0u; j < 6u; j++) {
+            let owner = select(n, t, j < 3u);
+            if owner == BACKGROUND_ID {
+                continue;
+            }
+            let m = neighbour(base + owner, j % 3u);
+            if m == BACKGROUND_ID || m == t || m == n {
+                continue;
+            }
+            if hides(locate(inst, m, x, FOLD_STEPS, true), inst, t, n, near, w, &front) {
+                return 1u;
+            }
+        }
+    }
+    return select(0u, 1u, cap != CAP_NONE && front.y > 0.0);
+}
+
+// Whether sample s of a triangle other than t and n of `inst` covers the line's point (near
+// row `near`, w `w`) nearer than it (by HIDDEN_MARGIN); else keeps in `front` the nearest
+// one within that margin but nearer by CAP_MARGIN, and whether it faces away.
+fn hides(s: Sample, inst: u32, t: u32, n: u32, near: f32, w: f32, front: ptr<function, vec2<f32>>) -> bool {
+    if !s.covers || (s.inst == inst && (s.tri == t || s.tri == n)) {
+        return false;
+    }
+    if nearer(s.near, near, w) {
+        return true;
+    }
+    if nearer_than_cap(s.near, near, w) && s.near < (*front).x {
+        *front = vec2<f32>(s.near, select(0.0, 1.0, faces_away(s.inst, s.v0.xyz, s.v1.xyz, s.v2.xyz)));
+    }
+    return false;
 }

@@ -362,6 +362,15 @@ fn nearer(a_near: f32, b_near: f32, b_w: f32) -> bool {
     return a_near < b_near - HIDDEN_MARGIN * (abs(b_near) + b_w);
 }
 
+// How much nearer than a line's point a surface within HIDDEN_MARGIN of it must be to tell
+// how the eye's ray reaches that point (`class_at`, in a frame with section planes): from
+// the section face of a cut solid, through a back face, or through a front face.
+const CAP_MARGIN: f32 = 1.0e-6;
+
+fn nearer_than_cap(a_near: f32, b_near: f32, b_w: f32) -> bool {
+    return a_near < b_near - CAP_MARGIN * (abs(b_near) + b_w);
+}
+
 // Steps of a walk across edges (`locate`): enough to go round a vertex's fan of small
 // triangles from a rasterized neighbour to the one that owns the point, and, in the
 // outline pass, to cross the few pixels' worth of sub-pixel triangles between a rasterized

@@ -137,7 +137,25 @@ pub fn host_hides(host: f64, point: f64, distance: f64, slope: f64) -> bool {
 /// [`HIDDEN_MARGIN`]. Along one pixel's ray the near row grows with depth, for perspective
 /// and orthographic views alike.
 pub fn nearer(a_near: f64, b_near: f64, b_w: f64) -> bool {
-    a_near < b_near - HIDDEN_MARGIN * (b_near.abs() + b_w)
+    nearer_by(a_near, b_near, b_w, HIDDEN_MARGIN)
+}
+
+/// Twin of `CAP_MARGIN` in scene.wgsl: how much nearer than a point of a line a surface
+/// within [`HIDDEN_MARGIN`] of it must be to tell how the eye's ray reaches that point, in a
+/// frame with section planes (from a cut solid's section face, through a back face or through
+/// a front face).
+pub const CAP_MARGIN: f64 = 1e-6;
+
+/// Twin of `END_INSET` in outline.wgsl: pixels inside a line's ends at which the visibility
+/// of each end is tested. At a vertex every triangle round it agrees with the line only to
+/// rounding, so the end itself could flip to a class its line has nowhere else, and a run of
+/// no length is still drawn as a dot a line wide.
+pub const END_INSET: f64 = 1.0 / 256.0;
+
+/// [`nearer`] by more than `margin` (relative, as [`HIDDEN_MARGIN`]); twin of `nearer` and
+/// `nearer_than_cap` in scene.wgsl.
+pub fn nearer_by(a_near: f64, b_near: f64, b_w: f64, margin: f64) -> bool {
+    a_near < b_near - margin * (b_near.abs() + b_w)
 }
 
 /// Twin of `segment_distance` in common.wgsl: pixels from `pixel` to the screen segment

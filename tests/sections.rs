@@ -205,6 +205,77 @@ fn a_dense_mesh_cut_at_a_grazing_angle_and_an_open_mesh() {
 }
 
 #[test]
+fn a_cut_ring_and_its_mirror_image_show_no_lines_over_their_section_faces() {
+    // A torus (ring in the xz plane) and its mirror image across x = 0, cut by a plane that
+    // the mirror leaves in place, seen from an eye on the mirror plane: the image is its own
+    // mirror image.
+    let mesh = Arc::new(Procedural::Torus(4000).build().unwrap());
+    let placed = DMat4::from_translation(DVec3::new(-1.6, 0.0, 0.0));
+    let mirror = DMat4::from_scale(DVec3::new(-1.0, 1.0, 1.0));
+    let world = World {
+        meshes: vec![WorldMesh {
+            mesh: mesh.clone(),
+            edges: EdgeSelection::Feature(30.0),
+            name: "torus".into(),
+        }],
+        objects: vec![Object::new(0, placed), Object::new(0, mirror * placed)],
+        sections: vec![plane([0.0, 0.0, 0.0], [0.0, 0.2, -1.0])],
+    };
+    let view = perspective(&world, DVec3::new(0.0, 1.4, 3.2));
+    let style = Style::default();
+    let (faces, cuts) = check("ring and mirror", &world, view, &style);
+    assert!(faces > 1000, "ring and mirror: {faces} section-face pixels");
+    assert!(cuts > 200, "ring and mirror: {cuts} cut-line pixels");
+    // Section faces where the mirror puts them: a mirrored instance's outward side is its
+    // mesh's, whatever the transform does to the winding.
+    let truth = shoot_world(&world, view, &style, SIZE, Method::Raycast);
+    let section = style.section_color.to_srgb8();
+    let (w, h) = (SIZE.0 as usize, SIZE.1 as usize);
+    let is_face = |x: usize, y: usize| {
+        let i = y * w + x;
+        truth.rgba[4 * i..4 * i + 3] == section[..3]
+    };
+    let differ = (0..w * h)
+        .filter(|&i| is_face(i % w, i / w) != is_face(w - 1 - i % w, i / w))
+        .count();
+    println!("ring and mirror: {differ} pixels differ from their mirror image");
+    assert!(differ <= w * h / 1000, "{differ} pixels differ from their mirror image");
+    // Through the cut the eye sees the ring's inside: no silhouette of it is drawn over the
+    // section face, inwards folds included. Pixels within half a pixel of an outline whose
+    // neighbours two pixels round all show back faces (a visible silhouette has its own front
+    // face next to it); facing by the mesh's own winding, from the eye in each instance's
+    // space.
+    let eye = view.eye();
+    let triangles = mesh.triangles();
+    let positions = mesh.positions();
+    let back = |frame: &wirepass::world::Rendering, i: usize| {
+        let id = frame.ids[i] as usize;
+        if id >= 2 * triangles.len() {
+            return false;
+        }
+        let local = world.objects[id / triangles.len()].transform.inverse() * eye;
+        let c = triangles[id % triangles.len()].map(|v| positions[v as usize].as_dvec3());
+        let normal = (c[1] - c[0]).cross(c[2] - c[0]);
+        normal.dot(local.truncate() - c[0] * local.w) < 0.0
+    };
+    let deferred = shoot_world(&world, view, &style, SIZE, Method::Deferred);
+    for (name, frame) in [("truth", &truth), ("deferred", &deferred)] {
+        let over = (2..h - 2)
+            .flat_map(|y| (2..w - 2).map(move |x| (x, y)))
+            .filter(|&(x, y)| {
+                let i = y * w + x;
+                frame.line_class[i] == LineClass::Outline as u8
+                    && frame.edge_distance[i] < 0.5
+                    && (0..25).all(|k| back(frame, (y + k / 5 - 2) * w + x + k % 5 - 2))
+            })
+            .inspect(|(x, y)| println!("  over at {x} {y} id {} d {}", frame.ids[y * w + x], frame.edge_distance[y * w + x]))
+            .count();
+        println!("ring and mirror: {over} silhouette pixels over the section face ({name})");
+        assert_eq!(over, 0, "{name}: silhouette pixels over the section face");
+    }
+}
+
+#[test]
 fn bad_section_planes_are_errors() {
     let mesh = Arc::new(Procedural::Sphere(200).build().unwrap());
     let mut world = World {

@@ -32,7 +32,7 @@ use crate::edge_math;
 use crate::mesh::adjacency::NO_NEIGHBOUR;
 use crate::mesh::patches::Patches;
 use crate::style::{depth_fade, line_intensity, line_key, line_reach};
-use crate::truth::rays::{HostMap, Line, ObjectStyle, RayCaster, Rays};
+use crate::truth::rays::{Hit, HostMap, Line, ObjectStyle, RayCaster, Rays};
 use crate::world::Shot;
 use glam::{DVec2, DVec3, DVec4};
 use rayon::prelude::*;
@@ -114,8 +114,18 @@ struct Draw {
     outline: bool,
     /// A cut line: where section plane k meets the triangle.
     cut: Option<usize>,
-    /// Behind the section face ([`capped`]): what is visible of it counts as hidden.
-    capped: bool,
+    /// How the eye's ray reaches it, in a frame with section planes ([`capped`]).
+    cap: Cap,
+}
+
+/// In a frame with section planes, how the eye's ray reaches a line where no other surface
+/// tells (see [`Visibility::class`]): not asked (no planes, or a cut line), from outside the
+/// solid or from inside it (from behind the section face).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+enum Cap {
+    None,
+    Outside,
+    Inside,
 }
 
 /// The outline map of `caster`'s world for `shot`, seen along `rays`; `masks` are each
@@ -134,6 +144,7 @@ pub(crate) fn outline_map(
         rays,
         fade_row: shot.view.view_depth_row(),
         host,
+        eye: shot.view.eye(),
     };
     let view = &view;
     let eye = shot.view.eye();
@@ -148,6 +159,8 @@ pub(crate) fn outline_map(
             let mesh = &world.meshes[object.mesh].mesh;
             let local = edge_math::local_eye(object.transform, eye);
             let first = caster.first_ids()[o];
+            // Outward normals: the world winding, turned where the transform mirrors.
+            let mirror = object.transform.determinant().signum();
             let listed = styles[o].listed_edges();
             let widths = (
                 styles[o].width,
@@ -164,7 +177,7 @@ pub(crate) fn outline_map(
                     hidden: hidden.is_some(),
                     outline: true,
                     cut: None,
-                    capped: false,
+                    cap: Cap::None,
                 };
                 edges.extend(outline_edges(mesh, local).into_iter().map(|e| (e, outline)));
             }
@@ -175,7 +188,7 @@ pub(crate) fn outline_map(
                     hidden: hidden_edges,
                     outline: false,
                     cut: None,
-                    capped: false,
+                    cap: Cap::None,
                 };
                 edges.extend(splat.iter().enumerate().flat_map(|(t, &bits)| {
                     (0..3u32)
@@ -192,7 +205,7 @@ pub(crate) fn outline_map(
                     hidden: hidden_edges,
                     outline: false,
                     cut: None,
-                    capped: false,
+                    cap: Cap::None,
                 };
                 edges.extend((0..tris.len() as u32).flat_map(|t| {
                     (0..3u32)
@@ -216,7 +229,7 @@ pub(crate) fn outline_map(
                                 hidden: false,
                                 outline: false,
                                 cut: Some(k),
-                                capped: false,
+                                cap: Cap::None,
                             };
                             ((t, 3 + k as u32), draw)
                         })
@@ -273,7 +286,11 @@ pub(crate) fn outline_map(
                         world_corners[(i as usize + 1) % 3],
                     );
                     let draw = Draw {
-                        capped: !sections.is_empty() && capped(caster, first, (t, n), eye),
+                        cap: if sections.is_empty() {
+                            Cap::None
+                        } else {
+                            capped(caster, first, (t, n), eye, mirror)
+                        },
                         ..draw
                     };
                     let on_chain = chained.as_ref().and_then(|(weld, anchors)| {
@@ -409,6 +426,8 @@ struct Visibility<'a> {
     fade_row: DVec4,
     /// The host's depth, if the host gave it.
     host: Option<&'a HostMap>,
+    /// The eye, homogeneous world.
+    eye: DVec4,
 }
 
 /// What a point of a line is: visible, hidden by a surface (or by the host, for hidden lines
@@ -545,13 +564,13 @@ impl Visibility<'_> {
         }
         let point = |k: f64| p0.lerp(&p1, k);
         let behind_host = hidden.is_some_and(|h| draw.hidden && h.behind_host);
+        // Where an edge's end is a vertex, the triangles round it meet the edge there only to
+        // rounding: its class is that of the point END_INSET pixels along.
+        let inset = (edge_math::END_INSET / d.length()).min(0.5);
         let class = |k: f64| {
-            let q = point(k);
+            let q = point(k.clamp(inset, 1.0 - inset));
             let w = 1.0 / q.inv_w;
-            match self.class(q.xy, (q.near_w * w, w), first, (t, n), behind_host) {
-                Class::Visible if draw.capped => Class::Hidden,
-                c => c,
-            }
+            self.class(q.xy, (q.near_w * w, w), first, (t, n), behind_host, draw.cap)
         };
 
         // Runs of one class, as (from, to, class) in parameters of p0 → p1.
@@ -638,7 +657,14 @@ impl Visibility<'_> {
     /// What the edge's point at screen point `x` (near row and w) is: where
     /// [`HostMap::hides_point`] says so hidden by the host (`behind_host`: counted as hidden,
     /// else neither drawn), hidden by a triangle other than `t` and `n` of the object (first
-    /// id `first`) that covers `x` nearer than that point, else visible.
+    /// id `first`) that covers `x` nearer than that point, else visible (twin of `class_at`
+    /// in outline.wgsl).
+    ///
+    /// In a frame with section planes (`cap` not [`Cap::None`]) a point that the eye's ray
+    /// reaches from inside a cut solid lies behind its section face, and is hidden too: where
+    /// the nearest other surface in front of it (within [`edge_math::HIDDEN_MARGIN`]) faces
+    /// away, the ray came out of the solid through it; where it faces the eye, the ray went
+    /// in there; where none is nearer by [`edge_math::CAP_MARGIN`], `cap` tells.
     fn class(
         &self,
         x: DVec2,
@@ -646,6 +672,7 @@ impl Visibility<'_> {
         first: u32,
         (t, n): (u32, u32),
         behind_host: bool,
+        cap: Cap,
     ) -> Class {
         if self.host.is_some_and(|h| h.hides_point(x, 1.0 - near / w)) {
             return if behind_host {
@@ -655,33 +682,70 @@ impl Visibility<'_> {
             };
         }
         let (from, to) = self.rays.segment(x);
-        match self.caster.cast(from, to) {
+        let own = [first + t, if n == NO_NEIGHBOUR { u32::MAX } else { first + n }];
+        let front = self.caster.cast_past(from, to, own).and_then(|hit| {
+            let c = self.rays.clip(hit.point);
+            edge_math::nearer_by(c.z, near, w, edge_math::CAP_MARGIN).then_some((hit, c))
+        });
+        match front {
+            Some((_, c)) if edge_math::nearer(c.z, near, w) => Class::Hidden,
+            _ if cap == Cap::None => Class::Visible,
+            Some((hit, _)) if self.faces_away(&hit) => Class::Hidden,
+            Some(_) => Class::Visible,
+            None if cap == Cap::Inside => Class::Hidden,
             None => Class::Visible,
-            Some(hit) => {
-                let own = hit.id == first + t || (n != NO_NEIGHBOUR && hit.id == first + n);
-                let c = self.rays.clip(hit.point);
-                if own || !edge_math::nearer(c.z, near, w) {
-                    Class::Visible
-                } else {
-                    Class::Hidden
-                }
-            }
         }
+    }
+
+    /// Whether the triangle hit faces away from the eye: its outward normal (its world
+    /// winding, turned where its object's transform mirrors) against the eye.
+    fn faces_away(&self, hit: &Hit) -> bool {
+        let world = self.caster.world();
+        let mirror = world.objects[hit.object as usize]
+            .transform
+            .determinant()
+            .signum();
+        let c = self.caster.corners(hit.id);
+        let outward = (c[1] - c[0]).cross(c[2] - c[0]) * mirror;
+        outward.dot(edge_math::towards_eye(c[0], self.eye)) < 0.0
     }
 }
 
-/// In a frame with section planes, back faces stand for the section face of a cut solid, so
-/// a line between two of them (triangle `t` and its neighbour `n`; a boundary of one, where
-/// `n` is `NO_NEIGHBOUR`) lies behind that face: what of it is visible counts as hidden
-/// (twin of `capped` in outline.wgsl). A triangle faces away where its world winding turns
-/// from the eye (`eye`, homogeneous world).
-fn capped(caster: &RayCaster<'_>, first: u32, (t, n): (u32, u32), eye: DVec4) -> bool {
-    let away = |t: u32| {
-        let c = caster.corners(first + t);
-        let normal = (c[1] - c[0]).cross(c[2] - c[0]);
-        normal.dot(edge_math::towards_eye(c[0], eye)) < 0.0
+/// In a frame with section planes, back faces stand for the section face of a cut solid,
+/// and a line point that the eye's ray reaches from inside the solid lies behind that face
+/// (see [`Visibility::class`]). Where no other surface lies just in front of the point, the
+/// line's own triangles tell (twin of `capped` in outline.wgsl): the ray reaches from inside
+/// a line between two back faces (triangle `t` and its neighbour `n`), a back face's boundary
+/// (`n` is `NO_NEIGHBOUR`), and a silhouette where the surface folds inwards (concave). A
+/// triangle faces away where its outward normal (its world winding times `mirror`, the sign
+/// of the transform's determinant) turns from the eye (`eye`, homogeneous world).
+fn capped(
+    caster: &RayCaster<'_>,
+    first: u32,
+    (t, n): (u32, u32),
+    eye: DVec4,
+    mirror: f64,
+) -> Cap {
+    let outward = |c: [DVec3; 3]| (c[1] - c[0]).cross(c[2] - c[0]) * mirror;
+    let away = |c: [DVec3; 3]| outward(c).dot(edge_math::towards_eye(c[0], eye)) < 0.0;
+    let own = caster.corners(first + t);
+    let inside = if n == NO_NEIGHBOUR {
+        away(own)
+    } else {
+        let beyond = caster.corners(first + n);
+        let centroid = (beyond[0] + beyond[1] + beyond[2]) / 3.0;
+        let concave = outward(own).dot(centroid - own[0]) > 0.0;
+        match (away(own), away(beyond)) {
+            (true, true) => true,
+            (false, false) => false,
+            _ => concave,
+        }
     };
-    away(t) && (n == NO_NEIGHBOUR || away(n))
+    if inside {
+        Cap::Inside
+    } else {
+        Cap::Outside
+    }
 }
 
 /// Where section plane `plane` meets a triangle (world corners `c`) that it crosses (corners
@@ -1058,6 +1122,7 @@ mod tests {
             rays: &rays,
             fade_row: view.view_depth_row(),
             host: None,
+            eye: view.eye(),
         };
         // Triangle 0's edge 1 runs from (1, -1) to (1, 1): visible only above y = 0, i.e. on
         // screen from the middle row up, ending where the near quad's top edge crosses it.
@@ -1066,7 +1131,7 @@ mod tests {
             hidden: true,
             outline: true,
             cut: None,
-            capped: false,
+            cap: Cap::None,
         };
         let hidden = crate::HiddenLines {
             pattern: crate::LinePattern::Dashed {

@@ -372,8 +372,10 @@ impl Truth<'_> {
         // The surface over the background at the fill opacity (twin of `see_through`).
         let (surface, alpha) = {
             // A back face seen through a section's cut is the section face (twin of
-            // `surface_pixel`): the world winding of its corners, against the eye.
-            let face = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
+            // `surface_pixel`): its outward normal (the world winding of its corners, turned
+            // where the transform mirrors) against the eye.
+            let face = (corners[1] - corners[0]).cross(corners[2] - corners[0])
+                * object.transform.determinant().signum();
             let back = face.dot(edge_math::towards_eye(point, sh.eye)) < 0.0;
             let s = if st.sectioned && back {
                 sh.section_color

@@ -101,6 +101,12 @@ impl<'a> RayCaster<'a> {
     /// The nearest triangle hit by the segment from `from` (t = 0) to `to` (t = 1), both in
     /// world space, with `0 ≤ t ≤ 1`.
     pub fn cast(&self, from: DVec3, to: DVec3) -> Option<Hit> {
+        self.cast_past(from, to, [u32::MAX; 2])
+    }
+
+    /// [`cast`](Self::cast), passing through the triangles with the global ids `skip` (a line's
+    /// own triangles, for what lies in front of a point of it).
+    pub fn cast_past(&self, from: DVec3, to: DVec3, skip: [u32; 2]) -> Option<Hit> {
         let o = from - self.centre;
         let d = to - from;
         // Clip the segment to the padded bounds in f64, so the f32 ray the BVH sees starts
@@ -142,6 +148,9 @@ impl<'a> RayCaster<'a> {
         let mut hit = RayHit::none();
         self.bvh.ray_traverse(ray, &mut hit, |_, slot| {
             let id = self.bvh.primitive_indices[slot];
+            if skip.contains(&id) {
+                return f32::INFINITY;
+            }
             let Some(t) = intersect(&self.corners[id as usize], o, d) else {
                 return f32::INFINITY;
             };
