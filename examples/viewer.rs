@@ -309,9 +309,7 @@ impl Viewer {
     /// half nearer the eye is cut away.
     fn add_section(&mut self) {
         if self.sections.len() < wirepass::MAX_SECTIONS {
-            let forward = self.orbit.target - self.orbit.camera().eye.as_dvec3();
-            self.sections
-                .push(SectionPlane::new(self.orbit.target, forward.normalize()));
+            self.sections.push(SectionPlane::across(&self.orbit));
         }
     }
 
@@ -333,10 +331,8 @@ impl Viewer {
             }
             Key::Character("s" | "S") => self.add_section(),
             Key::Character(c @ ("[" | "]")) => {
-                // A twentieth of the framed radius a press.
-                let step = if c == "]" { 0.05 } else { -0.05 } * self.orbit.radius;
                 if let Some(s) = self.sections.last_mut() {
-                    s.point += s.normal * step;
+                    *s = s.nudged(&self.orbit, if c == "]" { 1.0 } else { -1.0 });
                 }
             }
             Key::Named(NamedKey::Backspace) => {

@@ -4,7 +4,7 @@
 // `!(a > b)` is deliberate throughout: NaN must take the rejecting branch.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-use crate::camera::View;
+use crate::camera::{Orbit, View};
 use crate::error::{Error, Result};
 use crate::gpu::MeshId;
 use crate::style::{Color, HiddenLines, LinePattern, MAX_LINE_WIDTH};
@@ -319,6 +319,20 @@ impl SectionPlane {
         SectionPlane { point, normal }
     }
 
+    /// The plane through the point `orbit` circles, its normal the way the camera looks: the
+    /// half nearer the eye is cut away, so the cut faces the viewer (a viewer's `S` key).
+    pub fn across(orbit: &Orbit) -> SectionPlane {
+        let eye = orbit.camera().eye.as_dvec3();
+        SectionPlane::new(orbit.target, orbit.target - eye)
+    }
+
+    /// The plane moved along its normal by `steps` twentieths of `orbit`'s framed radius
+    /// (negative steps move it back; a viewer's `[`/`]` keys).
+    pub fn nudged(self, orbit: &Orbit, steps: f64) -> SectionPlane {
+        let along = self.normal.normalize_or_zero() * (0.05 * steps * orbit.radius);
+        SectionPlane::new(self.point + along, self.normal)
+    }
+
     /// The plane's function at `p`: `(p − point) · normal / |normal|`, the signed distance,
     /// negative where `p` is cut away.
     pub fn side(&self, p: DVec3) -> f64 {
@@ -402,4 +416,20 @@ pub fn validate_sections(sections: &[SectionPlane]) -> Result<()> {
         s.validate(i)?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_plane_across_an_orbit_cuts_away_the_half_nearer_the_eye() {
+        let orbit = Orbit::framing(DVec3::splat(-1.0), DVec3::splat(1.0));
+        let plane = SectionPlane::across(&orbit);
+        assert!(plane.side(orbit.camera().eye.as_dvec3()) < 0.0);
+        assert!(plane.side(orbit.target).abs() < 1e-6);
+        // Two steps on: a tenth of the radius further from the eye.
+        let moved = plane.nudged(&orbit, 2.0).side(orbit.target);
+        assert!((moved + 0.1 * orbit.radius).abs() < 1e-6, "{moved}");
+    }
 }

@@ -239,7 +239,10 @@ fn a_cut_ring_and_its_mirror_image_show_no_lines_over_their_section_faces() {
         .filter(|&i| is_face(i % w, i / w) != is_face(w - 1 - i % w, i / w))
         .count();
     println!("ring and mirror: {differ} pixels differ from their mirror image");
-    assert!(differ <= w * h / 1000, "{differ} pixels differ from their mirror image");
+    assert!(
+        differ <= w * h / 1000,
+        "{differ} pixels differ from their mirror image"
+    );
     // Through the cut the eye sees the ring's inside: no silhouette of it is drawn over the
     // section face, inwards folds included. Pixels within half a pixel of an outline whose
     // neighbours two pixels round all show back faces (a visible silhouette has its own front
@@ -268,7 +271,13 @@ fn a_cut_ring_and_its_mirror_image_show_no_lines_over_their_section_faces() {
                     && frame.edge_distance[i] < 0.5
                     && (0..25).all(|k| back(frame, (y + k / 5 - 2) * w + x + k % 5 - 2))
             })
-            .inspect(|(x, y)| println!("  over at {x} {y} id {} d {}", frame.ids[y * w + x], frame.edge_distance[y * w + x]))
+            .inspect(|(x, y)| {
+                println!(
+                    "  over at {x} {y} id {} d {}",
+                    frame.ids[y * w + x],
+                    frame.edge_distance[y * w + x]
+                )
+            })
             .count();
         println!("ring and mirror: {over} silhouette pixels over the section face ({name})");
         assert_eq!(over, 0, "{name}: silhouette pixels over the section face");
