@@ -593,6 +593,13 @@ fn diff_command(args: &DiffArgs) -> Result<()> {
 }
 
 fn main() -> ExitCode {
+    // Mesa's Vulkan device-selection layer connects to the Wayland and X servers to find the
+    // display's GPU, and libwayland prints an error on a machine without one; every command
+    // here draws offscreen and ranks the adapters itself, so it asks the loader to leave the
+    // layer out (unless the caller says otherwise). Set before any thread starts.
+    if std::env::var_os("NODEVICE_SELECT").is_none() {
+        std::env::set_var("NODEVICE_SELECT", "1");
+    }
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Render(args) => render_command(args),

@@ -62,6 +62,23 @@ fn renders_the_built_in_scene_and_dumps_numpy_files() {
 }
 
 #[test]
+fn a_render_without_a_display_says_only_what_it_wrote() {
+    // No window system to probe: the command draws offscreen and says only what it wrote.
+    let png = temp("quiet.png");
+    let out = Command::new(env!("CARGO_BIN_EXE_wirepass"))
+        .args(["render", "--size", "32x24", "-o", png.to_str().unwrap()])
+        .env_remove("XDG_RUNTIME_DIR")
+        .env_remove("WAYLAND_DISPLAY")
+        .env_remove("DISPLAY")
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let said = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(said.lines().count(), 1, "{said}");
+    assert!(said.starts_with("wrote "), "{said}");
+}
+
+#[test]
 fn bad_settings_give_one_clear_line() {
     let out = temp("bad.png");
     let o = out.to_str().unwrap();
