@@ -7,7 +7,8 @@ use std::sync::{Arc, Mutex};
 use wirepass::camera::Orbit;
 use wirepass::gpu::{Composite, MeshId, PickView, Picked, PickedIds, RenderTarget};
 use wirepass::{
-    wgpu, DeferredPass, EdgeSelection, Instance, MeshStore, OutputTarget, PassOptions, Scene, Style,
+    wgpu, DeferredPass, EdgeSelection, Instance, MeshStore, OutputTarget, PassOptions, Scene,
+    SectionPlane, Style,
 };
 
 /// The edge choices the page offers: the file's own (authored edges where a glTF has them,
@@ -182,8 +183,14 @@ impl Gpu {
         }
     }
 
-    /// Draws the model into the canvas and presents it.
-    pub fn draw(&mut self, model: &Model, orbit: &Orbit, style: &Style) -> Result<(), String> {
+    /// Draws the model, cut by `sections`, into the canvas and presents it.
+    pub fn draw(
+        &mut self,
+        model: &Model,
+        orbit: &Orbit,
+        style: &Style,
+        sections: &[SectionPlane],
+    ) -> Result<(), String> {
         let texture = match self.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(t)
             | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
@@ -193,7 +200,7 @@ impl Gpu {
             }
             other => return Err(format!("the canvas gave no frame: {other:?}")),
         };
-        self.record(&texture.texture, model, orbit, style)?;
+        self.record(&texture.texture, model, orbit, style, sections)?;
         self.queue.present(texture);
         Ok(())
     }
@@ -224,6 +231,7 @@ impl Gpu {
         model: &Model,
         orbit: &Orbit,
         style: &Style,
+        sections: &[SectionPlane],
     ) -> Result<(), String> {
         let target = texture.create_view(&wgpu::TextureViewDescriptor {
             format: Some(self.view_format),
@@ -236,7 +244,8 @@ impl Gpu {
             .iter()
             .map(|&(m, transform)| Instance::new(self.ids[m].0, transform))
             .collect();
-        let scene = Scene::borrowed(orbit.camera().to_view(aspect), &instances);
+        let scene = Scene::borrowed(orbit.camera().to_view(aspect), &instances)
+            .with_sections(sections.to_vec());
         let err = |e: wirepass::Error| e.to_string();
         let frame = self
             .pass

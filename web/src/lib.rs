@@ -4,7 +4,9 @@
 //! right or middle drag (or shift-drag, or two fingers) pans, the wheel (or a pinch) zooms,
 //! a click (or tap) picks: the toolbar says what the pixel shows.
 //! Keys: `E` cycles the edges, `O` toggles outlines, `H` cycles the hidden lines (off,
-//! dashed, dotted, solid), `+`/`-` change the line width.
+//! dashed, dotted, solid), `+`/`-` change the line width, `S` adds a section plane through
+//! the orbit's centre that cuts away the half nearer the eye (up to 6), `[`/`]` move the
+//! last one along its normal, `Backspace` removes it.
 //!
 //! `?adapter=high-performance|low-power|fallback` asks the browser for another adapter.
 //! [`Viewer`] is what the page's script gets from [`start`]; its `snapshot` and `model_name`
@@ -22,7 +24,7 @@ use wasm_bindgen::prelude::*;
 use wasm_bindgen::JsCast;
 use web_sys::{HtmlCanvasElement, HtmlElement, HtmlInputElement, HtmlSelectElement};
 use wirepass::camera::Orbit;
-use wirepass::{wgpu, Style};
+use wirepass::{wgpu, SectionPlane, Style};
 
 /// The page's state: what is shown, how, and the pointers on the canvas.
 struct App {
@@ -35,6 +37,8 @@ struct App {
     edges: usize,
     /// Which of [`HIDDEN`] the style draws.
     hidden: usize,
+    /// The section planes `S` placed.
+    sections: Vec<SectionPlane>,
     /// Pointers down on the canvas: id, position, button.
     pointers: Vec<(i32, f64, f64, i16)>,
     /// Where the primary button went down, to tell a click (a pick) from a drag.
@@ -89,7 +93,7 @@ impl Viewer {
             let app = &mut *app;
             let texture = app.gpu.offscreen(app.gpu.size());
             app.gpu
-                .record(&texture, &app.model, &app.orbit, &app.style)
+                .record(&texture, &app.model, &app.orbit, &app.style, &app.sections)
                 .map_err(JsValue::from)?;
             app.gpu.read(&texture)
         };
@@ -129,6 +133,11 @@ impl Viewer {
     /// What the last click on the canvas picked, in words (also shown in the toolbar).
     pub fn picked(&self) -> Option<String> {
         self.app.borrow().picked.clone()
+    }
+
+    /// How many section planes cut the model (`S` adds one, `Backspace` removes one).
+    pub fn sections(&self) -> usize {
+        self.app.borrow().sections.len()
     }
 
     /// The hidden-line style the page draws: off, dashed, dotted or solid.
@@ -226,6 +235,7 @@ impl App {
             style: Style::default(),
             edges: 0,
             hidden: 0,
+            sections: Vec::new(),
             pointers: Vec::new(),
             press: None,
             picked: None,
@@ -243,7 +253,9 @@ impl App {
             self.canvas.set_height(size.1);
         }
         self.gpu.resize(size);
-        let drawn = self.gpu.draw(&self.model, &self.orbit, &self.style);
+        let drawn = self
+            .gpu
+            .draw(&self.model, &self.orbit, &self.style, &self.sections);
         let mut errors = self.gpu.take_errors();
         if let Err(e) = drawn {
             errors.push(e);
@@ -262,12 +274,14 @@ impl App {
     fn show_status(&self) {
         let (w, h) = self.gpu.size();
         self.status.set_text_content(Some(&format!(
-            "{}: {} triangles, {} edges, outlines {}, hidden {}, width {:.1}; {w}×{h} on {}",
+            "{}: {} triangles, {} edges, outlines {}, hidden {}, sections {}, width {:.1}; \
+             {w}×{h} on {}",
             self.model.name,
             self.model.triangles(),
             EDGES[self.edges].0,
             if self.style.silhouettes { "on" } else { "off" },
             HIDDEN[self.hidden].0,
+            self.sections.len(),
             self.style.line_width,
             self.gpu.adapter,
         )));
@@ -718,6 +732,20 @@ fn wire_events(app: &Shared, root: &HtmlElement) -> Result<(), JsValue> {
                         sync("outlines", &|el| {
                             el.unchecked_ref::<HtmlInputElement>().set_checked(on)
                         });
+                    }
+                    "s" | "S" if a.sections.len() < wirepass::MAX_SECTIONS => {
+                        let plane = SectionPlane::across(&a.orbit);
+                        a.sections.push(plane);
+                    }
+                    k @ ("[" | "]") => {
+                        let steps = if k == "]" { 1.0 } else { -1.0 };
+                        let orbit = a.orbit;
+                        if let Some(plane) = a.sections.last_mut() {
+                            *plane = plane.nudged(&orbit, steps);
+                        }
+                    }
+                    "Backspace" => {
+                        a.sections.pop();
                     }
                     "+" | "=" | "-" => {
                         let step = if e.key() == "-" { -0.5 } else { 0.5 };

@@ -653,6 +653,53 @@ async fn the_viewer_page_draws_turns_and_shows_a_dropped_glb() {
         100.0 * shown
     );
     assert!(shown > 0.005, "the hidden lines are not shown ({shown})");
+
+    // `S` cuts the scene open through the orbit's centre: the section face shows; `]` moves
+    // the cut, `Backspace` takes it away again.
+    let press = |k: &str| {
+        let init = web_sys::KeyboardEventInit::new();
+        init.set_key(k);
+        let key =
+            web_sys::KeyboardEvent::new_with_keyboard_event_init_dict("keydown", &init).unwrap();
+        window.dispatch_event(&key).unwrap();
+    };
+    let section = wirepass::Style::default().section_color.to_srgb8();
+    let faces = |rgba: &[u8]| {
+        let n = rgba
+            .chunks_exact(4)
+            .filter(|p| (0..3).all(|k| p[k].abs_diff(section[k]) <= 2))
+            .count();
+        n as f64 / (rgba.len() / 4) as f64
+    };
+    let mut shots = Vec::new();
+    for (key, planes) in [("s", 1), ("]", 1), ("Backspace", 0)] {
+        let frames = viewer.frames();
+        press(key);
+        assert_eq!(viewer.sections(), planes, "after {key}");
+        until("a frame after a section key", 30.0, || {
+            viewer.frames() > frames
+        })
+        .await;
+        shots.push(viewer.snapshot().await.unwrap());
+    }
+    let (cut, moved, uncut) = (&shots[0], &shots[1], &shots[2]);
+    console_log!(
+        "section: {:.2} % section face, {:.2} % of the pixels changed; moved: {:.2} % changed",
+        100.0 * faces(cut),
+        100.0 * changed(&hidden, cut),
+        100.0 * changed(cut, moved)
+    );
+    assert!(
+        faces(cut) > faces(&hidden) + 0.004,
+        "no section face ({} cut, {} uncut)",
+        faces(cut),
+        faces(&hidden)
+    );
+    assert!(
+        changed(cut, moved) > 0.001,
+        "moving the cut changed nothing"
+    );
+    assert_eq!(changed(&hidden, uncut), 0.0, "the cut is not gone");
 }
 
 /// A frame's time in the page (the README quotes it beside the native one): not a test of
