@@ -1032,12 +1032,15 @@ fn class_at(x: vec2<f32>, near: f32, w: f32, reverse: f32, inst: u32, t: u32, n:
     let r = select(1, 2, frame.sections_on != 0u);
     let across = 2 * r + 1;
     for (var k = 0; k < across * across; k++) {
-        let id = id_at(centre + vec2<i32>(k % across - r, k / across - r));
+        let offset = vec2<i32>(k % across - r, k / across - r);
+        let id = id_at(centre + offset);
         if id.x >= HOST_ID || (id.x == inst && (id.y == t || id.y == n)) || all(id == last) {
             continue;
         }
         last = id;
-        if hides(locate(id.x, id.y, x, WALK_STEPS, true), inst, t, n, near, w, &front) {
+        // The outer ring's walks only cross the sheet's last few triangles to x.
+        let steps = select(WALK_STEPS, FOLD_STEPS, max(abs(offset.x), abs(offset.y)) > 1);
+        if hides(locate(id.x, id.y, x, steps, true), inst, t, n, near, w, &front) {
             return 1u;
         }
     }

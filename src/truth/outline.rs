@@ -570,7 +570,14 @@ impl Visibility<'_> {
         let class = |k: f64| {
             let q = point(k.clamp(inset, 1.0 - inset));
             let w = 1.0 / q.inv_w;
-            self.class(q.xy, (q.near_w * w, w), first, (t, n), behind_host, draw.cap)
+            self.class(
+                q.xy,
+                (q.near_w * w, w),
+                first,
+                (t, n),
+                behind_host,
+                draw.cap,
+            )
         };
 
         // Runs of one class, as (from, to, class) in parameters of p0 → p1.
@@ -682,7 +689,14 @@ impl Visibility<'_> {
             };
         }
         let (from, to) = self.rays.segment(x);
-        let own = [first + t, if n == NO_NEIGHBOUR { u32::MAX } else { first + n }];
+        let own = [
+            first + t,
+            if n == NO_NEIGHBOUR {
+                u32::MAX
+            } else {
+                first + n
+            },
+        ];
         let front = self.caster.cast_past(from, to, own).and_then(|hit| {
             let c = self.rays.clip(hit.point);
             edge_math::nearer_by(c.z, near, w, edge_math::CAP_MARGIN).then_some((hit, c))
@@ -719,13 +733,7 @@ impl Visibility<'_> {
 /// (`n` is `NO_NEIGHBOUR`), and a silhouette where the surface folds inwards (concave). A
 /// triangle faces away where its outward normal (its world winding times `mirror`, the sign
 /// of the transform's determinant) turns from the eye (`eye`, homogeneous world).
-fn capped(
-    caster: &RayCaster<'_>,
-    first: u32,
-    (t, n): (u32, u32),
-    eye: DVec4,
-    mirror: f64,
-) -> Cap {
+fn capped(caster: &RayCaster<'_>, first: u32, (t, n): (u32, u32), eye: DVec4, mirror: f64) -> Cap {
     let outward = |c: [DVec3; 3]| (c[1] - c[0]).cross(c[2] - c[0]) * mirror;
     let away = |c: [DVec3; 3]| outward(c).dot(edge_math::towards_eye(c[0], eye)) < 0.0;
     let own = caster.corners(first + t);
