@@ -564,6 +564,7 @@ fn lerp_projected(a: Projected, b: Projected, k: f32) -> Projected {
 
 // Visibility samples per pixel of edge length; each change between two is then bisected.
 const RUN_SAMPLES_PER_PX: f32 = 4.0;
+// Pixels inside a line's ends at which their class is taken (`seg_class`).
 const END_INSET: f32 = 1.0 / 256.0;
 // Steps of the walks from a line's own triangles' neighbours (`class_at`).
 const FOLD_STEPS: u32 = 4u;
