@@ -32,7 +32,7 @@ use crate::edge_math;
 use crate::mesh::adjacency::NO_NEIGHBOUR;
 use crate::mesh::patches::Patches;
 use crate::style::{depth_fade, line_intensity, line_key, line_reach};
-use crate::truth::rays::{Hit, HostMap, Line, ObjectStyle, RayCaster, Rays};
+use crate::truth::rays::{HostMap, Line, ObjectStyle, RayCaster, Rays};
 use crate::world::Shot;
 use glam::{DVec2, DVec3, DVec4};
 use rayon::prelude::*;
@@ -159,8 +159,6 @@ pub(crate) fn outline_map(
             let mesh = &world.meshes[object.mesh].mesh;
             let local = edge_math::local_eye(object.transform, eye);
             let first = caster.first_ids()[o];
-            // Outward normals: the world winding, turned where the transform mirrors.
-            let mirror = object.transform.determinant().signum();
             let listed = styles[o].listed_edges();
             let widths = (
                 styles[o].width,
@@ -289,7 +287,11 @@ pub(crate) fn outline_map(
                         cap: if sections.is_empty() {
                             Cap::None
                         } else {
-                            capped(caster, first, (t, n), eye, mirror)
+                            capped(
+                                caster,
+                                (first + t, (n != NO_NEIGHBOUR).then(|| first + n)),
+                                eye,
+                            )
                         },
                         ..draw
                     };
@@ -704,24 +706,11 @@ impl Visibility<'_> {
         match front {
             Some((_, c)) if edge_math::nearer(c.z, near, w) => Class::Hidden,
             _ if cap == Cap::None => Class::Visible,
-            Some((hit, _)) if self.faces_away(&hit) => Class::Hidden,
+            Some((hit, _)) if self.caster.faces_away(hit.id, hit.point, self.eye) => Class::Hidden,
             Some(_) => Class::Visible,
             None if cap == Cap::Inside => Class::Hidden,
             None => Class::Visible,
         }
-    }
-
-    /// Whether the triangle hit faces away from the eye: its outward normal (its world
-    /// winding, turned where its object's transform mirrors) against the eye.
-    fn faces_away(&self, hit: &Hit) -> bool {
-        let world = self.caster.world();
-        let mirror = world.objects[hit.object as usize]
-            .transform
-            .determinant()
-            .signum();
-        let c = self.caster.corners(hit.id);
-        let outward = (c[1] - c[0]).cross(c[2] - c[0]) * mirror;
-        outward.dot(edge_math::towards_eye(c[0], self.eye)) < 0.0
     }
 }
 
@@ -729,24 +718,23 @@ impl Visibility<'_> {
 /// and a line point that the eye's ray reaches from inside the solid lies behind that face
 /// (see [`Visibility::class`]). Where no other surface lies just in front of the point, the
 /// line's own triangles tell (twin of `capped` in outline.wgsl): the ray reaches from inside
-/// a line between two back faces (triangle `t` and its neighbour `n`), a back face's boundary
-/// (`n` is `NO_NEIGHBOUR`), and a silhouette where the surface folds inwards (concave). A
-/// triangle faces away where its outward normal (its world winding times `mirror`, the sign
-/// of the transform's determinant) turns from the eye (`eye`, homogeneous world).
-fn capped(caster: &RayCaster<'_>, first: u32, (t, n): (u32, u32), eye: DVec4, mirror: f64) -> Cap {
-    let outward = |c: [DVec3; 3]| (c[1] - c[0]).cross(c[2] - c[0]) * mirror;
-    let away = |c: [DVec3; 3]| outward(c).dot(edge_math::towards_eye(c[0], eye)) < 0.0;
-    let own = caster.corners(first + t);
-    let inside = if n == NO_NEIGHBOUR {
-        away(own)
-    } else {
-        let beyond = caster.corners(first + n);
-        let centroid = (beyond[0] + beyond[1] + beyond[2]) / 3.0;
-        let concave = outward(own).dot(centroid - own[0]) > 0.0;
-        match (away(own), away(beyond)) {
-            (true, true) => true,
-            (false, false) => false,
-            _ => concave,
+/// a line between two back faces (global triangle `t` and its neighbour `n`), a back face's
+/// boundary (`n` is `None`), and a silhouette where the surface folds inwards (concave);
+/// facing by [`RayCaster::faces_away`], from the eye `eye` (homogeneous world).
+fn capped(caster: &RayCaster<'_>, (t, n): (u32, Option<u32>), eye: DVec4) -> Cap {
+    let own = caster.corners(t);
+    let away = |id: u32| caster.faces_away(id, caster.corners(id)[0], eye);
+    let inside = match n {
+        None => away(t),
+        Some(n) => {
+            let beyond = caster.corners(n);
+            let centroid = (beyond[0] + beyond[1] + beyond[2]) / 3.0;
+            let concave = caster.outward(t).dot(centroid - own[0]) > 0.0;
+            match (away(t), away(n)) {
+                (true, true) => true,
+                (false, false) => false,
+                _ => concave,
+            }
         }
     };
     if inside {

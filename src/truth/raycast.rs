@@ -372,11 +372,8 @@ impl Truth<'_> {
         // The surface over the background at the fill opacity (twin of `see_through`).
         let (surface, alpha) = {
             // A back face seen through a section's cut is the section face (twin of
-            // `surface_pixel`): its outward normal (the world winding of its corners, turned
-            // where the transform mirrors) against the eye.
-            let face = (corners[1] - corners[0]).cross(corners[2] - corners[0])
-                * object.transform.determinant().signum();
-            let back = face.dot(edge_math::towards_eye(point, sh.eye)) < 0.0;
+            // `surface_pixel`).
+            let back = self.caster.faces_away(hit.id, point, sh.eye);
             let s = if st.sectioned && back {
                 sh.section_color
             } else {

@@ -193,6 +193,22 @@ impl<'a> RayCaster<'a> {
         self.corners[id as usize].map(|c| c + self.centre)
     }
 
+    /// The outward normal of global triangle `id`, not unit: its world winding, turned where
+    /// its object's transform mirrors, so a mirrored instance keeps its mesh's outside (twin
+    /// of `faces_away` in outline.wgsl).
+    pub fn outward(&self, id: u32) -> DVec3 {
+        let (object, _) = self.world.locate(&self.first_ids, id);
+        let mirror = self.world.objects[object].transform.determinant().signum();
+        let c = self.corners(id);
+        (c[1] - c[0]).cross(c[2] - c[0]) * mirror
+    }
+
+    /// Whether global triangle `id` faces away from `eye` (homogeneous world), seen at its
+    /// point `at`.
+    pub fn faces_away(&self, id: u32, at: DVec3, eye: DVec4) -> bool {
+        self.outward(id).dot(crate::edge_math::towards_eye(at, eye)) < 0.0
+    }
+
     /// The global id of each object's first triangle.
     pub fn first_ids(&self) -> &[u32] {
         &self.first_ids
