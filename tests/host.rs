@@ -1444,13 +1444,13 @@ fn live_objects(instance: &wgpu::Instance) -> [usize; 5] {
 /// Many frames, the size changing every 10 frames and instances added and removed, through
 /// the host's render pass with its depth: no wgpu object outlives its frame, GPU memory stays
 /// flat, and so does the process's resident memory where the driver's own stays flat.
-/// 280 frames (4 cycles of sizes) by default; `WIREPASS_SOAK_FRAMES` sets another count.
+/// 420 frames (6 cycles of sizes) by default; `WIREPASS_SOAK_FRAMES` sets another count.
 #[test]
 fn soak_memory_stays_flat_over_changing_frames() {
     let frames: usize = std::env::var("WIREPASS_SOAK_FRAMES")
         .ok()
         .and_then(|v| v.parse().ok())
-        .unwrap_or(280);
+        .unwrap_or(420);
     let (instance, ctx) = counted_device();
     let d = &ctx.device;
     let f = fixture();
@@ -1558,11 +1558,11 @@ fn soak_memory_stays_flat_over_changing_frames() {
             mib(*gpu)
         );
     }
-    assert!(peaks.len() >= 3, "{frames} frames make fewer than 3 cycles");
+    assert!(peaks.len() >= 4, "{frames} frames make fewer than 4 cycles");
     // The first cycle warms caches (pipelines, allocator blocks); from the second on, nothing
     // accumulates.
-    let (rss0, gpu0, live0) = peaks[1];
-    let (rss1, gpu1, live1) = *peaks.last().unwrap();
+    let (_, gpu0, live0) = peaks[1];
+    let (_, gpu1, live1) = *peaks.last().unwrap();
     assert_eq!(live1, live0, "wgpu objects accumulate over frames");
     assert!(
         gpu1 <= gpu0 + (1 << 20),
@@ -1573,13 +1573,19 @@ fn soak_memory_stays_flat_over_changing_frames() {
     // On lavapipe the process grows by about 0.35 MiB a frame while wgpu's registry and
     // allocator stay flat: heaptrack places the allocations inside libvulkan_lvp's command
     // thread. llvmpipe through GL, on the same frames, stays flat to the page, so resident
-    // memory is held flat there.
+    // memory is held flat there. A leak grows every cycle, so half the cycle-to-cycle steps
+    // must stay under 4 MiB: the process (after the other tests in it) steps up now and
+    // then, 35 MiB in one cycle of one run and 6.6 MiB in another, flat before and after.
     if ctx.adapter.get_info().backend == wgpu::Backend::Gl {
+        let steps: Vec<f64> = peaks[1..]
+            .windows(2)
+            .map(|w| mib(w[1].0) - mib(w[0].0))
+            .collect();
+        let mut sorted = steps.clone();
+        sorted.sort_by(f64::total_cmp);
         assert!(
-            rss1 <= rss0 + (16 << 20),
-            "resident memory grew from {:.1} to {:.1} MiB",
-            mib(rss0),
-            mib(rss1)
+            sorted[(sorted.len() - 1) / 2] < 4.0,
+            "resident memory grew from cycle to cycle by {steps:.1?} MiB"
         );
     }
 }
