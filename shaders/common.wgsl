@@ -123,6 +123,10 @@ const INSTANCE_HIDDEN_EDGES: u32 = 16u;
 const INSTANCE_LISTED_EDGES: u32 = 32u;
 // It has a phase table (`chain_phases`).
 const INSTANCE_PHASES: u32 = 64u;
+// Bit of a triangle's `info` (mesh_records::EdgeData): its patch crosses another surface of
+// the mesh (edge_pass.wgsl: its pixels take no lines of their own; outline.wgsl: its lines'
+// visibility is tested more widely).
+const INFO_CROSSED: u32 = 536870912u;
 
 // A colour packed as two pairs of f16 (src/gpu/frame.rs, pack_color).
 fn unpack_color(c: vec2<u32>) -> vec4<f32> {

@@ -171,7 +171,9 @@ fn empty_pixel(xy: vec2<u32>, inst: u32, outline: vec2<u32>) -> Pixel {
 }
 
 // Bits of `info` (mesh_store::EdgeData): the triangle's patch is larger than PATCH_TRIANGLES
-// (its drawn edges come from the outline pass), or is two triangles.
+// or crosses another surface (its drawn edges come from the outline pass), or is two
+// triangles. (INFO_CROSSED, in common.wgsl: the patch crosses another surface, and its pixels
+// take no lines of their own, which the crossing surface may hide right beside them.)
 const INFO_LARGE_PATCH: u32 = 2048u;
 const INFO_QUAD: u32 = 32768u;
 
@@ -427,8 +429,8 @@ struct Own {
 fn own_lines(s: Sample) -> Own {
     let flags = instances[slot(s.inst)].flags;
     let bits = info[instances[slot(s.inst)].triangle_base + s.tri];
-    // Patterned edges are drawn by the outline pass.
-    let edges = (flags & (INSTANCE_EDGES | INSTANCE_LISTED_EDGES)) == INSTANCE_EDGES;
+    // Patterned edges and those of crossed patches are drawn by the outline pass.
+    let edges = (flags & (INSTANCE_EDGES | INSTANCE_LISTED_EDGES)) == INSTANCE_EDGES && (bits & INFO_CROSSED) == 0u;
     let mask = select(0u, bits & 7u, edges);
     let near = vec3<f32>(s.clip0.z, s.clip1.z, s.clip2.z);
     let d = drawn_distances(s.lines, near, mask);

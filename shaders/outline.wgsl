@@ -572,7 +572,8 @@ const RUN_BISECTIONS: u32 = 12u;
 // An edge is drawn in pieces of at most this many pixels, each with up to MAX_RUNS visible
 // runs (more is beyond any real mesh at this scale; the last run then absorbs the rest).
 const PIECE_PX: f32 = 16.0;
-// Pixels this far past a line's reach still get its key (`splat_runs`).
+// Pixels this far past a line's reach still get its key (`splat_runs`); twin of
+// edge_math::REACH_SLACK.
 const REACH_SLACK: f32 = 1e-3;
 const MAX_RUNS: u32 = 8u;
 
@@ -934,8 +935,8 @@ fn splat_runs(seg: Segment, k0: f32, k1: f32, runs: ptr<function, array<vec2<f32
                     best_k = kr;
                 }
             }
-            // Within reach, with room for f32's rounding: every pixel the f64 definition
-            // reaches gets the line (which is of no intensity out there).
+            // Within reach, and the slack the f64 definition allows too (the line is of no
+            // intensity out there).
             if !(best < reach + REACH_SLACK) {
                 continue;
             }
@@ -1030,7 +1031,13 @@ fn class_at(x: vec2<f32>, near: f32, w: f32, reverse: f32, inst: u32, t: u32, n:
     // Through a section's cut the eye sees the inside of folded surfaces, where the sheet in
     // front of an interior silhouette thins out near a fold of its own: look two pixels
     // round for it there.
-    let r = select(1, 2, frame.sections_on != 0u);
+    // Where surfaces cross, the surface a line passes into may show only a few pixels away
+    // (where those in front of it end): look four pixels round (frame::CROSSING_BAND).
+    let base = instances[slot(inst)].triangle_base;
+    let bits = info[base + t] | select(0u, info[base + n], n != BACKGROUND_ID);
+    let crossed = (bits & INFO_CROSSED) != 0u;
+    let wide = frame.sections_on != 0u || crossed;
+    let r = select(select(1, 2, wide), 4, crossed);
     let across = 2 * r + 1;
     for (var k = 0; k < across * across; k++) {
         let offset = vec2<i32>(k % across - r, k / across - r);
@@ -1045,11 +1052,10 @@ fn class_at(x: vec2<f32>, near: f32, w: f32, reverse: f32, inst: u32, t: u32, n:
             return 1u;
         }
     }
-    if frame.sections_on != 0u {
+    if wide {
         // And the line's own triangles' other neighbours, and a few triangles on from them
         // that face the same way: a sheet that folds back over the line starts there (the
         // walks from the pixels stop at such folds).
-        let base = instances[slot(inst)].triangle_base;
         for (var j = 0u; j < 6u; j++) {
             let owner = select(n, t, j < 3u);
             if owner == BACKGROUND_ID {

@@ -146,6 +146,12 @@ pub fn nearer(a_near: f64, b_near: f64, b_w: f64) -> bool {
 /// a front face).
 pub const CAP_MARGIN: f64 = 1e-6;
 
+/// Twin of `REACH_SLACK` in outline.wgsl: pixels past a line's reach that still take its
+/// distance from the outline map (the line has no intensity there). Both implementations
+/// allow it, so that f32 rounding decides only for pixels within its own error of this
+/// boundary, not for all within a slack the GPU alone allows.
+pub const REACH_SLACK: f64 = 1e-3;
+
 /// Twin of `END_INSET` in outline.wgsl: pixels inside a line's ends at which the visibility
 /// of each end is tested. At a vertex every triangle round it agrees with the line only to
 /// rounding, so the end itself could flip to a class its line has nowhere else, and a run of

@@ -96,6 +96,12 @@ const INSTANCE_LISTED_EDGES: u32 = 32;
 /// `Instance.flags`: it has a phase table (`chain_phases`).
 const INSTANCE_PHASES: u32 = 64;
 
+/// Pixels the guard band grows by in a frame where a mesh crosses itself: the outline pass
+/// tests the visibility of their lines against the ids up to four pixels around each point
+/// (the surface that a line passes into may be visible only a few pixels away, where the
+/// surfaces in front of it end), not one.
+const CROSSING_BAND: u32 = 3;
+
 /// A linear RGBA colour as WGSL's `unpack2x16float` reads it from two words.
 fn pack_color(c: [f32; 4]) -> [u32; 2] {
     let h = |v: f32| u32::from(half::f16::from_f32(v).to_bits());
@@ -137,7 +143,8 @@ impl InstanceRecord {
 
 /// Pixels of guard band the deferred pass keeps around its output, from the widest line of
 /// the scene: lines whose edges lie just outside the output reach into it, the outline pass
-/// tests their visibility against the ids one pixel around each point, and the coverage
+/// tests their visibility against the ids one pixel around each point (a few more in a
+/// frame where a mesh crosses itself, which adds [`CROSSING_BAND`]), and the coverage
 /// search reads the ids around each pixel. So the output is the same whether the image is
 /// drawn whole or as tiles ([`Region`]). (An output within a band of the device's largest
 /// texture side gets what room is left.)
@@ -256,8 +263,14 @@ impl FrameRecords {
         super::targets::check_size(device, region.size)?;
         // Where the device's largest texture leaves no room for the whole band, a narrower one.
         let room = device.limits().max_texture_dimension_2d - region.size.0.max(region.size.1);
+        // Meshes that pass through themselves test their lines' visibility more widely.
+        let mut crossing = false;
+        for i in scene.instances.iter() {
+            crossing |= store.record(i.mesh)?.lines.crossed;
+        }
         let guard = if guarded {
-            guard_band(scene, style).min(room / 2)
+            let band = guard_band(scene, style);
+            (band + if crossing { CROSSING_BAND } else { 0 }).min(room / 2)
         } else {
             0
         };

@@ -24,6 +24,8 @@ pub(crate) struct MeshLines {
     pub small_patches: bool,
     /// Some drawn edge borders a large patch: the outline pass draws it.
     pub splat: bool,
+    /// Some patch crosses another surface of the mesh ([`Patches::crossed`]).
+    pub crossed: bool,
 }
 
 /// One mesh as the arena stores it.
@@ -155,6 +157,9 @@ const INFO_LARGE_PATCH: u32 = 1 << 11;
 /// First of the three bits of [`EdgeData::info`] that mark the edges the outline pass draws
 /// for a large patch ([`Patches::splat`]).
 const INFO_SPLAT_SHIFT: u32 = 12;
+/// Bit of [`EdgeData::info`]: the triangle's patch crosses another surface of the mesh
+/// ([`Patches::crossed`]): its pixels take their lines from the outline pass only.
+const INFO_CROSSED: u32 = 1 << 29;
 /// Bit of [`EdgeData::info`]: the triangle's patch is a quad (two triangles), which the edge
 /// pass searches without a queue.
 const INFO_QUAD: u32 = 1 << 15;
@@ -226,7 +231,8 @@ pub(crate) struct EdgeData {
     /// [`Mesh::outline_hints`], bits 8–10 the edges that may be drawn as outlines, bit 11
     /// a large patch, bits 12–14 the drawn edges the outline pass draws, bit 15 a patch of
     /// two triangles, bits 16–25 that quad's other triangle ([`quad_bits`]), bits 26–28 the
-    /// drawn edges in chains ([`INFO_CHAINED_SHIFT`]).
+    /// drawn edges in chains ([`INFO_CHAINED_SHIFT`]), bit 29 a patch that crosses another
+    /// surface ([`INFO_CROSSED`]).
     pub info: Vec<u32>,
     pub lines: MeshLines,
     /// The drawn edges' chains, as the outline pass's chain records.
@@ -243,7 +249,9 @@ impl EdgeData {
         for (s, &t) in order.iter().enumerate() {
             stored[t as usize] = s as u32;
         }
-        let patches = Patches::ordered(neighbours, &mask, |t, u| stored[t] < stored[u]);
+        let patches = Patches::ordered(neighbours, &mask, mesh.crossings(), |t, u| {
+            stored[t] < stored[u]
+        });
         let hints = mesh.outline_hints();
         let outline = mesh.outline_mask();
         let (chains, chained) = ChainRecords::new(mesh, &mask, &stored);
@@ -256,7 +264,8 @@ impl EdgeData {
                 } else {
                     0
                 };
-                let quad = if patches.size[t] == 2 {
+                let crossed = if patches.crossed[t] { INFO_CROSSED } else { 0 };
+                let quad = if patches.size[t] == 2 && !patches.crossed[t] {
                     quad_bits(mesh, &mask, &stored, t)
                 } else {
                     0
@@ -268,6 +277,7 @@ impl EdgeData {
                     | u32::from(patches.splat[t]) << INFO_SPLAT_SHIFT
                     | quad
                     | u32::from(chained[t]) << INFO_CHAINED_SHIFT
+                    | crossed
             })
             .collect();
         let lines = MeshLines {
@@ -276,6 +286,7 @@ impl EdgeData {
                 .zip(&patches.large)
                 .any(|(&m, &large)| m != ALL_EDGES && !large),
             splat: patches.splat.iter().any(|&b| b != 0),
+            crossed: patches.crossed.iter().any(|&c| c),
         };
         EdgeData {
             info,

@@ -6,6 +6,7 @@
 pub mod adjacency;
 pub(crate) mod chains;
 pub mod clusters;
+pub mod crossings;
 #[cfg(feature = "formats")]
 pub mod formats;
 mod par;
@@ -113,6 +114,8 @@ pub struct Mesh {
     /// Per cluster of triangles, what lets the outline pass skip it: see
     /// [`Mesh::outline_clusters`].
     outline_clusters: std::sync::OnceLock<clusters::Clusters>,
+    /// Per triangle, whether it crosses another: see [`Mesh::crossings`].
+    crossings: std::sync::OnceLock<Vec<bool>>,
 }
 
 impl Mesh {
@@ -196,6 +199,7 @@ impl Mesh {
             neighbours: Default::default(),
             outline_hints: Default::default(),
             outline_clusters: Default::default(),
+            crossings: Default::default(),
         })
     }
 
@@ -352,6 +356,13 @@ impl Mesh {
         self.outline_hints.get_or_init(|| {
             adjacency::outline_hints(&self.positions, &self.triangles, self.edge_neighbours())
         })
+    }
+
+    /// Per triangle, whether it crosses another triangle of the mesh (the mesh passes through
+    /// itself there): see [`crossings::crossing_triangles`]. Computed once, on first use.
+    pub fn crossings(&self) -> &[bool] {
+        self.crossings
+            .get_or_init(|| crossings::crossing_triangles(&self.positions, &self.triangles))
     }
 
     /// The triangles in clusters of [`clusters::CLUSTER_TRIANGLES`] nearby ones, with bounds

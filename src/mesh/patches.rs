@@ -4,7 +4,8 @@
 //! the patch bounds the search for it. Small patches (polygons: a quad is two triangles) are
 //! searched per pixel by the edge pass; the drawn edges of large ones (the faces of a
 //! tessellated CAD part in feature mode) are drawn by the outline pass into every pixel in
-//! reach, like outlines.
+//! reach, like outlines, and so are those of patches that cross another surface
+//! ([`super::crossings`]), whose lines may be hidden next to their visible pixels.
 
 use super::adjacency::NO_NEIGHBOUR;
 
@@ -16,19 +17,26 @@ pub const PATCH_TRIANGLES: usize = 16;
 /// A mesh's patches under one edge mask, as the passes use them.
 #[derive(Clone, Debug, Default)]
 pub struct Patches {
-    /// Per triangle, whether its patch has more than [`PATCH_TRIANGLES`] triangles.
+    /// Per triangle, whether its patch has more than [`PATCH_TRIANGLES`] triangles or is
+    /// [`Patches::crossed`]: its drawn edges are drawn by the outline pass.
     pub large: Vec<bool>,
-    /// Per triangle, the triangles in its patch ([`patch_sizes`]).
+    /// Per triangle, whether a triangle of its patch crosses another surface of the mesh: its
+    /// pixels take no line of their own, only the outline pass's, drawn where visible.
+    pub crossed: Vec<bool>,
+    /// Per triangle, how many triangles its patch has (the triangles joined to it across
+    /// undrawn edges, an edge counting as undrawn when either side leaves it out), counted
+    /// up to [`PATCH_TRIANGLES`] + 1.
     pub size: Vec<u8>,
     /// Per triangle, the drawn edges the outline pass draws ([`splat_edges`]).
     pub splat: Vec<u8>,
 }
 
 impl Patches {
-    /// The patches of a mesh with edge neighbours `neighbours` under `mask`; an edge both
+    /// The patches of a mesh with edge neighbours `neighbours` under `mask`, `crossing` its
+    /// triangles that cross others ([`super::crossings::crossing_triangles`]); an edge both
     /// sides draw is splatted from the side with the lower id.
-    pub fn new(neighbours: &[[u32; 3]], mask: &[u8]) -> Patches {
-        Patches::ordered(neighbours, mask, |t, u| t < u)
+    pub fn new(neighbours: &[[u32; 3]], mask: &[u8], crossing: &[bool]) -> Patches {
+        Patches::ordered(neighbours, mask, crossing, |t, u| t < u)
     }
 
     /// [`Patches::new`], splatting an edge both sides draw from side `t` where `before(t, u)`
@@ -36,22 +44,39 @@ impl Patches {
     pub fn ordered(
         neighbours: &[[u32; 3]],
         mask: &[u8],
+        crossing: &[bool],
         before: impl Fn(usize, usize) -> bool,
     ) -> Patches {
-        let size = patch_sizes(neighbours, mask);
+        let roots = patch_roots(neighbours, mask);
+        let mut count = vec![0u32; roots.len()];
+        let mut crossed_root = vec![false; roots.len()];
+        for (t, &r) in roots.iter().enumerate() {
+            count[r as usize] += 1;
+            crossed_root[r as usize] |= crossing[t];
+        }
+        let size: Vec<u8> = roots
+            .iter()
+            .map(|&r| count[r as usize].min(PATCH_TRIANGLES as u32 + 1) as u8)
+            .collect();
+        let crossed: Vec<bool> = roots.iter().map(|&r| crossed_root[r as usize]).collect();
         let large: Vec<bool> = size
             .iter()
-            .map(|&n| usize::from(n) > PATCH_TRIANGLES)
+            .zip(&crossed)
+            .map(|(&n, &c)| usize::from(n) > PATCH_TRIANGLES || c)
             .collect();
         let splat = splat_edges(neighbours, mask, &large, before);
-        Patches { large, size, splat }
+        Patches {
+            large,
+            crossed,
+            size,
+            splat,
+        }
     }
 }
 
-/// Per triangle, how many triangles its patch has (the triangles joined to it across undrawn
-/// edges, an edge counting as undrawn when either side leaves it out), counted up to
-/// [`PATCH_TRIANGLES`] + 1.
-pub fn patch_sizes(neighbours: &[[u32; 3]], mask: &[u8]) -> Vec<u8> {
+/// Per triangle, the lowest triangle of its patch (the triangles joined to it across undrawn
+/// edges, an edge counting as undrawn when either side leaves it out).
+fn patch_roots(neighbours: &[[u32; 3]], mask: &[u8]) -> Vec<u32> {
     let n = neighbours.len();
     let mut parent: Vec<u32> = (0..n as u32).collect();
     fn root(parent: &mut [u32], mut t: u32) -> u32 {
@@ -72,15 +97,7 @@ pub fn patch_sizes(neighbours: &[[u32; 3]], mask: &[u8]) -> Vec<u8> {
             }
         }
     }
-    let mut size = vec![0u32; n];
-    let roots: Vec<u32> = (0..n as u32).map(|t| root(&mut parent, t)).collect();
-    for &r in &roots {
-        size[r as usize] += 1;
-    }
-    roots
-        .iter()
-        .map(|&r| size[r as usize].min(PATCH_TRIANGLES as u32 + 1) as u8)
-        .collect()
+    (0..n as u32).map(|t| root(&mut parent, t)).collect()
 }
 
 /// Per triangle, the drawn edges (bit `i` for edge `i`) that the outline pass draws because a
@@ -150,7 +167,13 @@ mod tests {
         let mut mask = vec![0b001u8; n];
         mask[3] |= 0b010;
         mask[4] |= 0b100;
-        let Patches { large, size, splat } = Patches::new(&neighbours, &mask);
+        let Patches {
+            large,
+            crossed,
+            size,
+            splat,
+        } = Patches::new(&neighbours, &mask, &vec![false; n]);
+        assert!(crossed.iter().all(|&c| !c));
         assert!(size[..4].iter().all(|&n| n == 4));
         assert!(size[4..]
             .iter()
@@ -169,10 +192,39 @@ mod tests {
     fn a_side_that_leaves_an_edge_out_joins_it() {
         let neighbours = strip(PATCH_TRIANGLES + 1);
         let mut mask = vec![0b111u8; PATCH_TRIANGLES + 1];
-        assert!(Patches::new(&neighbours, &mask).large.iter().all(|&l| !l));
+        let none = vec![false; PATCH_TRIANGLES + 1];
+        assert!(Patches::new(&neighbours, &mask, &none)
+            .large
+            .iter()
+            .all(|&l| !l));
         for m in &mut mask[..PATCH_TRIANGLES] {
             *m &= !0b010;
         }
-        assert!(Patches::new(&neighbours, &mask).large.iter().all(|&l| l));
+        assert!(Patches::new(&neighbours, &mask, &none)
+            .large
+            .iter()
+            .all(|&l| l));
+    }
+
+    #[test]
+    fn a_crossing_triangle_marks_its_whole_patch() {
+        let n = 8;
+        let neighbours = strip(n);
+        // Two patches, 0..4 and 4..8, joined by the drawn edge between 3 and 4.
+        let mut mask = vec![0b001u8; n];
+        mask[3] |= 0b010;
+        mask[4] |= 0b100;
+        let mut crossing = vec![false; n];
+        crossing[1] = true;
+        let p = Patches::new(&neighbours, &mask, &crossing);
+        assert_eq!(
+            p.crossed,
+            [true, true, true, true, false, false, false, false]
+        );
+        assert_eq!(p.large, p.crossed);
+        // The crossed patch's drawn edges go to the outline pass, the drawn join once.
+        assert!(p.splat[..4].iter().all(|&b| b & 0b001 != 0));
+        assert_eq!(p.splat[3], 0b011);
+        assert_eq!(p.splat[4], 0b000);
     }
 }

@@ -279,6 +279,7 @@ pub fn default_scene() -> Mesh {
         neighbours: Default::default(),
         outline_hints: Default::default(),
         outline_clusters: Default::default(),
+        crossings: Default::default(),
     }
 }
 

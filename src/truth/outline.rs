@@ -362,7 +362,7 @@ fn splat(
                 for (x, out) in row.iter_mut().enumerate().take(x1).skip(x0) {
                     let p = DVec2::new(x as f64 + 0.5, cy);
                     let (d, at) = segment_distance(p, s.from, s.to);
-                    if !(d < reach) {
+                    if !(d < reach + edge_math::REACH_SLACK) {
                         continue;
                     }
                     let near_w = s.near_w[0] + (s.near_w[1] - s.near_w[0]) * at;
@@ -1052,7 +1052,11 @@ mod tests {
         let styles = ObjectStyle::of(&world, style);
         let mesh = &world.meshes[0].mesh;
         let masks = [mesh.edge_mask(EdgeSelection::All)];
-        let patches = [Patches::new(mesh.edge_neighbours(), &masks[0])];
+        let patches = [Patches::new(
+            mesh.edge_neighbours(),
+            &masks[0],
+            mesh.crossings(),
+        )];
         outline_map(&caster, &rays, &shot, &styles, (&patches, &masks), None)
     }
 

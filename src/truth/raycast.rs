@@ -111,7 +111,7 @@ pub fn draw_raycast_over(shot: &Shot<'_>, host: Option<&HostOccluders<'_>>) -> R
         .meshes
         .iter()
         .zip(&masks)
-        .map(|(m, mask)| Patches::new(m.mesh.edge_neighbours(), mask))
+        .map(|(m, mask)| Patches::new(m.mesh.edge_neighbours(), mask, m.mesh.crossings()))
         .collect();
     let eyes: Vec<DVec4> = world
         .objects
@@ -320,8 +320,10 @@ impl Truth<'_> {
         let tri = wm.mesh.triangles()[hit.tri as usize];
         let corners = self.caster.corners(hit.id);
         let clip: [DVec4; 3] = corners.map(|p| self.rays.clip(p));
-        // Patterned edges are in the outline map, drawn where they are visible.
-        let own_edges = st.edges && !st.listed_edges();
+        // Patterned edges and those of patches that cross another surface are in the outline
+        // map, drawn where they are visible.
+        let own_edges =
+            st.edges && !st.listed_edges() && !self.patches[object.mesh].crossed[hit.tri as usize];
         let mask = if own_edges {
             self.masks[object.mesh][hit.tri as usize]
         } else {

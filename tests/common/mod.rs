@@ -235,3 +235,42 @@ pub fn cylinder(n: u32) -> Mesh {
     }
     Mesh::new(p, None, tris, None).unwrap()
 }
+
+/// Per pixel of an image of `size` through `camera`, whether it lies within `radius` pixels
+/// of a drawn edge (under `edges`) of a patch that crosses another surface of the mesh: the
+/// lines of such patches are drawn by the outline pass where visible, over their neighbours
+/// and the background too, not by the own-triangle definition the forward methods share
+/// (`wirepass::mesh::patches::Patches::crossed`; `tests/crossings.rs` holds them to the
+/// ground truth).
+pub fn near_crossed(
+    mesh: &Mesh,
+    edges: EdgeSelection,
+    camera: &Camera,
+    size: (u32, u32),
+    radius: f64,
+) -> Vec<bool> {
+    let masks = mesh.edge_mask(edges);
+    let crossed =
+        wirepass::mesh::patches::Patches::new(mesh.edge_neighbours(), &masks, mesh.crossings())
+            .crossed;
+    let vp = camera.view_projection(size.0, size.1);
+    let extent = DVec2::new(f64::from(size.0), f64::from(size.1));
+    let mut near = vec![false; size.0 as usize * size.1 as usize];
+    for (t, tri) in mesh.triangles().iter().enumerate() {
+        if !crossed[t] {
+            continue;
+        }
+        let clip = tri.map(|v| vp * mesh.positions()[v as usize].as_dvec3().extend(1.0));
+        for i in (0..3).filter(|i| masks[t] & (1 << i) != 0) {
+            for (k, out) in near.iter_mut().enumerate() {
+                let pixel = DVec2::new(
+                    (k % size.0 as usize) as f64 + 0.5,
+                    (k / size.0 as usize) as f64 + 0.5,
+                );
+                *out |=
+                    edge_math::segment_distance(clip[i], clip[(i + 1) % 3], pixel, extent) < radius;
+            }
+        }
+    }
+    near
+}

@@ -1,0 +1,283 @@
+//! Triangles that cross others of the same mesh: a mesh that passes through itself (a head's
+//! eyes through it, a leg through a body, parts of an assembly modelled in one file). Where a
+//! surface crosses a triangle, the triangle's own lines may be hidden right next to its visible
+//! pixels with no outline between, so the passes draw the drawn edges of such triangles (and
+//! of their patches) only where they are visible ([`super::patches::Patches::crossed`]).
+//!
+//! Two triangles cross when their intersection is more than a point and they share no edge:
+//! triangles sharing one vertex cross when they meet along a segment from it (a fan folded
+//! through itself). Coplanar triangles never cross. The test is in f64 with a tolerance of
+//! 1e-9 of the mesh's size, so it errs towards "crossing" only for contacts far below a pixel,
+//! which costs the exact (outline-pass) path, never a wrong line.
+
+use glam::{DVec3, U64Vec3, Vec3};
+
+use super::par::*;
+
+/// Per triangle, whether it crosses another triangle of the mesh.
+pub fn crossing_triangles(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<bool> {
+    let n = triangles.len();
+    let mut crossing = vec![false; n];
+    if n < 2 {
+        return crossing;
+    }
+    let corners = |t: usize| triangles[t].map(|v| positions[v as usize].as_dvec3());
+    let boxes: Vec<[DVec3; 2]> = (0..n)
+        .map(|t| {
+            let [a, b, c] = corners(t);
+            [a.min(b).min(c), a.max(b).max(c)]
+        })
+        .collect();
+    let (lo, hi) = boxes
+        .iter()
+        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), b| {
+            (lo.min(b[0]), hi.max(b[1]))
+        });
+    let size = (hi - lo).max_element();
+    if size <= 0.0 {
+        return crossing;
+    }
+    let tolerance = 1e-9 * size;
+    // A grid of cells about the size of a typical triangle (the median of their largest
+    // extents), at most 2^20 cells a side.
+    let mut extents: Vec<f64> = boxes.iter().map(|b| (b[1] - b[0]).max_element()).collect();
+    let middle = extents.len() / 2;
+    let median = *extents
+        .select_nth_unstable_by(middle, |a, b| a.total_cmp(b))
+        .1;
+    let cell = median
+        .max(size / f64::from(1u32 << 20))
+        .max(f64::MIN_POSITIVE);
+    let cell_of = |p: DVec3| ((p - lo) / cell).floor().as_u64vec3();
+    // A triangle spanning more than this many cells (a large one among small ones) is tested
+    // against every other by its box instead.
+    const MOST_CELLS: u64 = 512;
+    let key = |c: U64Vec3| c.x | c.y << 21 | c.z << 42;
+    let spans: Vec<(U64Vec3, U64Vec3)> = boxes
+        .iter()
+        .map(|b| (cell_of(b[0]), cell_of(b[1])))
+        .collect();
+    let cells = |(a, b): (U64Vec3, U64Vec3)| (b - a + 1).element_product();
+    let mut entries: Vec<(u64, u32)> = Vec::with_capacity(n);
+    let mut large = Vec::new();
+    for (t, &span) in spans.iter().enumerate() {
+        if cells(span) > MOST_CELLS {
+            large.push(t);
+            continue;
+        }
+        for z in span.0.z..=span.1.z {
+            for y in span.0.y..=span.1.y {
+                for x in span.0.x..=span.1.x {
+                    entries.push((key(U64Vec3::new(x, y, z)), t as u32));
+                }
+            }
+        }
+    }
+    entries.par_sort_unstable();
+    let overlap = |t: usize, u: usize| {
+        let (a, b) = (boxes[t], boxes[u]);
+        a[0].cmple(b[1] + tolerance).all() && b[0].cmple(a[1] + tolerance).all()
+    };
+    let test = |t: usize, u: usize| {
+        overlap(t, u)
+            && !shares_an_edge(triangles[t], triangles[u], positions)
+            && cross(corners(t), corners(u), tolerance)
+    };
+    // Runs of one cell; a pair is tested in the cell that holds the low corner of its boxes'
+    // overlap, so once however many cells both span.
+    let mut runs = Vec::new();
+    let mut start = 0;
+    for i in 1..=entries.len() {
+        if i == entries.len() || entries[i].0 != entries[start].0 {
+            runs.push(start..i);
+            start = i;
+        }
+    }
+    let found: Vec<Vec<(u32, u32)>> = runs
+        .par_iter()
+        .map(|run| {
+            let run = &entries[run.clone()];
+            let here = run[0].0;
+            let mut pairs = Vec::new();
+            for (i, &(_, t)) in run.iter().enumerate() {
+                for &(_, u) in &run[i + 1..] {
+                    let (t, u) = (t as usize, u as usize);
+                    let low = boxes[t][0].max(boxes[u][0]);
+                    if key(cell_of(low).min(spans[t].1).min(spans[u].1)) == here && test(t, u) {
+                        pairs.push((t as u32, u as u32));
+                    }
+                }
+            }
+            pairs
+        })
+        .collect();
+    let mut is_large = vec![false; n];
+    for &t in &large {
+        is_large[t] = true;
+    }
+    let big: Vec<Vec<(u32, u32)>> = large
+        .par_iter()
+        .map(|&t| {
+            (0..n)
+                .filter(|&u| u != t && (!is_large[u] || u > t) && test(t, u))
+                .map(|u| (t as u32, u as u32))
+                .collect()
+        })
+        .collect();
+    for (t, u) in found.into_iter().chain(big).flatten() {
+        crossing[t as usize] = true;
+        crossing[u as usize] = true;
+    }
+    crossing
+}
+
+/// Whether two triangles share two corners by position (an edge, welded or not).
+fn shares_an_edge(t: [u32; 3], u: [u32; 3], positions: &[Vec3]) -> bool {
+    let at = |v: u32| positions[v as usize].to_array().map(f32::to_bits);
+    t.iter()
+        .filter(|&&a| u.iter().any(|&b| a == b || at(a) == at(b)))
+        .count()
+        >= 2
+}
+
+/// Whether triangles `t` and `u` meet in more than a point (by more than `tolerance`),
+/// coplanar ones never.
+pub fn cross(t: [DVec3; 3], u: [DVec3; 3], tolerance: f64) -> bool {
+    let (Some(nt), Some(nu)) = (plane(t), plane(u)) else {
+        return false;
+    };
+    let side = |n: DVec3, origin: DVec3, p: [DVec3; 3]| {
+        p.map(|q| {
+            let d = n.dot(q - origin);
+            if d.abs() <= tolerance {
+                0.0
+            } else {
+                d
+            }
+        })
+    };
+    let du = side(nt, t[0], u);
+    let dt = side(nu, u[0], t);
+    let apart = |d: [f64; 3]| d.iter().all(|&x| x > 0.0) || d.iter().all(|&x| x < 0.0);
+    let flat = |d: [f64; 3]| d.iter().all(|&x| x == 0.0);
+    if apart(du) || apart(dt) || flat(du) || flat(dt) {
+        return false;
+    }
+    let Some(along) = nt.cross(nu).try_normalize() else {
+        return false;
+    };
+    let (Some(a), Some(b)) = (span(t, dt, along), span(u, du, along)) else {
+        return false;
+    };
+    a.1.min(b.1) - a.0.max(b.0) > tolerance
+}
+
+/// A triangle's unit normal, none for a degenerate one.
+fn plane(p: [DVec3; 3]) -> Option<DVec3> {
+    (p[1] - p[0]).cross(p[2] - p[0]).try_normalize()
+}
+
+/// Where triangle `p`, its corners at signed distances `d` from another plane, meets that
+/// plane: the interval of positions along `along` (none when it does not meet it).
+fn span(p: [DVec3; 3], d: [f64; 3], along: DVec3) -> Option<(f64, f64)> {
+    let mut lo = f64::INFINITY;
+    let mut hi = f64::NEG_INFINITY;
+    let mut take = |q: DVec3| {
+        let s = along.dot(q);
+        lo = lo.min(s);
+        hi = hi.max(s);
+    };
+    for i in 0..3 {
+        let j = (i + 1) % 3;
+        if d[i] == 0.0 {
+            take(p[i]);
+        }
+        if d[i] * d[j] < 0.0 {
+            take(p[i] + (p[j] - p[i]) * (d[i] / (d[i] - d[j])));
+        }
+    }
+    (lo <= hi).then_some((lo, hi))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn box_mesh(centre: Vec3, half: f32, positions: &mut Vec<Vec3>, triangles: &mut Vec<[u32; 3]>) {
+        let base = positions.len() as u32;
+        for i in 0..8 {
+            let s = |bit: u32| if i & bit != 0 { half } else { -half };
+            positions.push(centre + Vec3::new(s(1), s(2), s(4)));
+        }
+        let quads = [
+            [0, 2, 3, 1],
+            [4, 5, 7, 6],
+            [0, 1, 5, 4],
+            [2, 6, 7, 3],
+            [0, 4, 6, 2],
+            [1, 3, 7, 5],
+        ];
+        for [a, b, c, d] in quads {
+            triangles.push([a + base, b + base, c + base]);
+            triangles.push([a + base, c + base, d + base]);
+        }
+    }
+
+    #[test]
+    fn a_closed_box_does_not_cross_itself() {
+        let (mut p, mut t) = (Vec::new(), Vec::new());
+        box_mesh(Vec3::ZERO, 1.0, &mut p, &mut t);
+        assert!(crossing_triangles(&p, &t).iter().all(|&c| !c));
+    }
+
+    #[test]
+    fn boxes_through_each_other_cross_where_their_faces_meet() {
+        let (mut p, mut t) = (Vec::new(), Vec::new());
+        box_mesh(Vec3::ZERO, 1.0, &mut p, &mut t);
+        box_mesh(Vec3::new(1.5, 0.3, 0.2), 1.0, &mut p, &mut t);
+        let crossing = crossing_triangles(&p, &t);
+        // The first box's +x face (triangles 10, 11) is crossed by the second's faces, and
+        // the second's -x face (its 8, 9: triangles 20, 21) by the first's.
+        assert!(crossing[10] || crossing[11]);
+        assert!(crossing[20] || crossing[21]);
+        // The first's -x face is far from the second box.
+        assert!(!crossing[8] && !crossing[9]);
+        // Disjoint boxes: nothing.
+        let (mut p, mut t) = (Vec::new(), Vec::new());
+        box_mesh(Vec3::ZERO, 1.0, &mut p, &mut t);
+        box_mesh(Vec3::new(2.5, 0.3, 0.2), 1.0, &mut p, &mut t);
+        assert!(crossing_triangles(&p, &t).iter().all(|&c| !c));
+    }
+
+    #[test]
+    fn triangles_sharing_a_corner_cross_only_when_they_pass_through_each_other() {
+        let o = DVec3::ZERO;
+        let t = [o, DVec3::X, DVec3::Y];
+        // Touching at the corner only.
+        assert!(!cross(
+            t,
+            [o, DVec3::new(-1.0, 0.0, 1.0), DVec3::new(0.0, -1.0, 1.0)],
+            1e-9
+        ));
+        // Through it, from the shared corner.
+        assert!(cross(
+            t,
+            [o, DVec3::new(1.0, 1.0, 1.0), DVec3::new(1.0, 1.0, -1.0)],
+            1e-9
+        ));
+        // Coplanar and overlapping: not a crossing.
+        assert!(!cross(
+            t,
+            [o, DVec3::new(0.5, 0.0, 0.0), DVec3::new(0.0, 0.5, 0.0)],
+            1e-9
+        ));
+        // A triangle piercing another's middle.
+        let pierce = [
+            DVec3::new(0.2, 0.2, -1.0),
+            DVec3::new(0.3, 0.2, 1.0),
+            DVec3::new(0.2, 0.3, 1.0),
+        ];
+        assert!(cross(t, pierce, 1e-9));
+        assert!(cross(pierce, t, 1e-9));
+    }
+}

@@ -1,0 +1,190 @@
+//! Surfaces that pass through each other: a mesh through itself (two boxes modelled in one
+//! file, Suzanne's eyes through its head). A line point
+//! that a nearer surface hides is not drawn, whatever patch it belongs to: the deferred
+//! pass matches the ground truth over every pixel, with ordinary, grazing, orthographic and
+//! eye-inside cameras and in every edge mode.
+
+mod common;
+
+use common::{load, shoot_world, worst_pixels};
+use glam::{DVec3, Vec3};
+use wirepass::tools::offline::Method;
+use wirepass::truth::accuracy::{distance_error, id_agreement};
+use wirepass::world::World;
+use wirepass::{EdgeSelection, Mesh, Style, View};
+
+const SIZE: (u32, u32) = (320, 240);
+
+/// A box of half-size `half` turned by `turn` (radians about y, then x) and moved to
+/// `centre`, appended to `positions` and `triangles` with its quads' diagonals undrawn.
+fn add_box(
+    centre: Vec3,
+    half: f32,
+    turn: (f32, f32),
+    positions: &mut Vec<Vec3>,
+    triangles: &mut Vec<[u32; 3]>,
+    polygon: &mut Vec<u8>,
+) {
+    let base = positions.len() as u32;
+    let rotation = glam::Quat::from_rotation_x(turn.1) * glam::Quat::from_rotation_y(turn.0);
+    for i in 0..8 {
+        let s = |bit: u32| if i & bit != 0 { half } else { -half };
+        positions.push(centre + rotation * Vec3::new(s(1), s(2), s(4)));
+    }
+    // Counter-clockwise seen from outside.
+    let quads = [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ];
+    for [a, b, c, d] in quads {
+        triangles.push([a + base, b + base, c + base]);
+        triangles.push([a + base, c + base, d + base]);
+        polygon.extend([0b011, 0b110]);
+    }
+}
+
+/// Two boxes through each other, one turned, as one mesh.
+fn two_boxes() -> Mesh {
+    let (mut p, mut t, mut m) = (Vec::new(), Vec::new(), Vec::new());
+    add_box(Vec3::ZERO, 1.0, (0.0, 0.0), &mut p, &mut t, &mut m);
+    add_box(
+        Vec3::new(0.9, 0.45, 0.35),
+        0.7,
+        (0.5, 0.35),
+        &mut p,
+        &mut t,
+        &mut m,
+    );
+    Mesh::new(p, None, t, Some(m)).unwrap()
+}
+
+fn perspective(eye: DVec3, target: DVec3) -> View {
+    wirepass::Camera {
+        eye: eye.as_vec3(),
+        target: target.as_vec3(),
+        up: Vec3::Y,
+        fov_y_deg: 50.0,
+        near: 0.02,
+        far: 100.0,
+    }
+    .to_view(f64::from(SIZE.0) / f64::from(SIZE.1))
+}
+
+/// The deferred frame against the ground truth over every pixel; returns how many pixels
+/// the truth draws a line in.
+fn check(name: &str, world: &World, view: View, style: &Style) -> usize {
+    let truth = shoot_world(world, view, style, SIZE, Method::Raycast);
+    let frame = shoot_world(world, view, style, SIZE, Method::Deferred);
+    let (ids, _) = id_agreement(&truth, &frame).unwrap();
+    let lines = distance_error(&truth, &frame).unwrap();
+    println!("{name}: id {ids:.5}, lines {lines:?}");
+    let worst = || worst_pixels(&truth, &frame, 0.01, 8);
+    assert!(ids >= 0.999, "{name}: id agreement {ids}");
+    assert!(lines.pixels > 0, "{name}: no line pixels");
+    assert!(lines.p99.unwrap() <= 0.01, "{name}: {lines:?}\n{}", worst());
+    assert!(lines.max.unwrap() <= 0.1, "{name}: {lines:?}\n{}", worst());
+    lines.pixels
+}
+
+/// Cameras that look at the crossing of the two boxes: ordinary, grazing along the first
+/// box's top face, orthographic, and from inside the first box.
+fn cameras(target: DVec3) -> Vec<(&'static str, View)> {
+    let aspect = f64::from(SIZE.0) / f64::from(SIZE.1);
+    vec![
+        ("ordinary", perspective(DVec3::new(3.0, 2.2, 3.6), target)),
+        ("grazing", perspective(DVec3::new(4.5, 1.03, 0.4), target)),
+        (
+            "orthographic",
+            View::orthographic(
+                (DVec3::new(2.0, 3.0, 2.5), target, DVec3::Y),
+                3.6,
+                aspect,
+                (-10.0, 10.0),
+            ),
+        ),
+        (
+            "eye inside",
+            perspective(DVec3::new(-0.6, 0.2, 0.3), DVec3::new(1.2, 0.5, 0.4)),
+        ),
+    ]
+}
+
+#[test]
+fn the_crossing_triangles_are_found() {
+    let boxes = two_boxes();
+    let crossing = boxes.crossings();
+    let count = crossing.iter().filter(|&&c| c).count();
+    println!("two boxes: {count} of {} triangles cross", crossing.len());
+    assert!(count >= 6 && count < crossing.len(), "{count}");
+    let suzanne = load("suzanne.obj");
+    let count = suzanne.crossings().iter().filter(|&&c| c).count();
+    println!(
+        "suzanne: {count} of {} triangles cross",
+        suzanne.triangle_count()
+    );
+    assert!(count > 0, "Suzanne's eyes pass through its head");
+    for name in ["fandisk.obj", "spot.obj"] {
+        let mesh = load(name);
+        let count = mesh.crossings().iter().filter(|&&c| c).count();
+        assert_eq!(
+            count, 0,
+            "{name}: a closed, embedded surface crosses nothing"
+        );
+    }
+}
+
+#[test]
+fn a_mesh_through_itself_draws_its_lines_only_where_they_are_visible() {
+    let target = DVec3::new(0.6, 0.3, 0.2);
+    for (edges, width) in [
+        (EdgeSelection::Polygon, 1.5),
+        (EdgeSelection::All, 1.5),
+        (EdgeSelection::Feature(30.0), 4.0),
+    ] {
+        let world = World::single(two_boxes(), edges);
+        let style = Style {
+            line_width: width,
+            ..Style::default()
+        };
+        for (camera, view) in cameras(target) {
+            check(
+                &format!("two boxes, {edges:?}, {camera}"),
+                &world,
+                view,
+                &style,
+            );
+        }
+    }
+}
+
+#[test]
+fn suzannes_eyes_through_its_head() {
+    let mesh = load("suzanne.obj");
+    let (lo, hi) = mesh.bounds_f64();
+    // Suzanne looks along +z; its eyes are about 0.7 in front of its centre.
+    let c = 0.5 * (lo + hi);
+    let world = World::single(mesh, EdgeSelection::Polygon);
+    let eyes = c + DVec3::new(0.0, 0.2, 0.7);
+    for (camera, view) in [
+        ("front", perspective(c + DVec3::new(0.8, 0.6, 3.0), eyes)),
+        ("close", perspective(c + DVec3::new(0.5, 0.45, 1.6), eyes)),
+        (
+            "inside",
+            perspective(
+                c + DVec3::new(0.1, 0.15, 0.1),
+                c + DVec3::new(0.5, 0.3, 0.9),
+            ),
+        ),
+    ] {
+        check(
+            &format!("suzanne, {camera}"),
+            &world,
+            view,
+            &Style::default(),
+        );
+    }
+}
