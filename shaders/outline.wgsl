@@ -320,10 +320,11 @@ fn outline_triangle(inst: u32, t: u32) {
     let patterned = select(0u, bits & 7u, (flags & INSTANCE_LISTED_EDGES) != 0u);
     let splat = select(0u, (bits >> 12u) & 7u, (flags & INSTANCE_EDGES) != 0u && patterned == 0u);
 #if HIDDEN
-    // Drawn edges: their hidden parts, wherever they are.
+    // Drawn edges: their hidden parts, wherever they are, where the instance draws them.
     let hidden_lines = (flags & INSTANCE_HIDDEN) != 0u;
     let hidden_edges = INSTANCE_EDGES | INSTANCE_HIDDEN_EDGES;
-    let drawn = patterned | select(0u, bits & 7u, (flags & hidden_edges) == hidden_edges && hidden_lines);
+    let hidden_drawn = select(0u, bits & 7u, (flags & hidden_edges) == hidden_edges && hidden_lines);
+    let drawn = patterned | hidden_drawn;
 #else
     let drawn = patterned;
 #endif
@@ -376,7 +377,7 @@ fn outline_triangle(inst: u32, t: u32) {
         let splats = (splat & (1u << i)) != 0u || ((patterned & (1u << i)) != 0u && lower);
         var mode = select(0u, DRAW_VISIBLE, outline || splats) | select(0u, DRAW_OUTLINE, outline);
 #if HIDDEN
-        let hidden = (outline && hidden_lines) || ((drawn & (1u << i)) != 0u && lower);
+        let hidden = (outline && hidden_lines) || ((hidden_drawn & (1u << i)) != 0u && lower);
         mode |= select(0u, DRAW_HIDDEN, hidden);
 #endif
         if mode != 0u {

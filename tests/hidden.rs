@@ -324,18 +324,45 @@ fn hidden_line_styles_per_instance() {
         1.0,
     );
     let view = perspective(&world, DVec3::new(2.5, 1.8, 3.2));
-    for (name, frame, cube, torus) in [
-        ("own and the frame's", &dashed, None, Some(Some(dotted))),
-        ("own and none", &dashed, Some(Some(dotted)), Some(None)),
+    // The torus's edges dashed in the last case: drawn by the outline pass, which must not
+    // draw hidden parts of them where the torus has no hidden lines.
+    let pattern = LinePattern::Dashed {
+        dash: 5.0,
+        gap: 3.0,
+    };
+    for (name, frame, cube, torus, torus_edges) in [
+        (
+            "own and the frame's",
+            &dashed,
+            None,
+            Some(Some(dotted)),
+            None,
+        ),
+        (
+            "own and none",
+            &dashed,
+            Some(Some(dotted)),
+            Some(None),
+            None,
+        ),
         (
             "one instance only",
             &Style::default(),
             None,
             Some(Some(dotted)),
+            None,
+        ),
+        (
+            "own and none, its edges dashed",
+            &Style::default(),
+            Some(Some(dotted)),
+            Some(None),
+            Some(pattern),
         ),
     ] {
         world.objects[0].style.hidden = cube;
         world.objects[1].style.hidden = torus;
+        world.objects[1].style.edge_pattern = torus_edges;
         check(name, &world, view, frame);
         // The hidden lines' colours: each instance's own, where the truth draws one.
         let truth = shoot_world(&world, view, frame, SIZE, Method::Raycast);
