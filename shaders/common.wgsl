@@ -118,11 +118,14 @@ const INSTANCE_OUTLINES: u32 = 2u;
 const INSTANCE_HIDDEN: u32 = 4u;
 const INSTANCE_BEHIND_HOST: u32 = 8u;
 const INSTANCE_HIDDEN_EDGES: u32 = 16u;
-// Its drawn edges are drawn by the outline pass (patterned, or cut by section planes), and
-// the edge pass leaves them.
+// Its drawn edges are drawn by the outline pass (patterned, cut by section planes, or perhaps
+// crossed by another instance), and the edge pass leaves them.
 const INSTANCE_LISTED_EDGES: u32 = 32u;
 // It has a phase table (`chain_phases`).
 const INSTANCE_PHASES: u32 = 64u;
+// Another instance may pass through it (scene::overlapping): its lines' visibility is tested
+// more widely (outline.wgsl, class_at).
+const INSTANCE_CROSSED: u32 = 128u;
 // Bit of a triangle's `info` (mesh_records::EdgeData): its patch crosses another surface of
 // the mesh (edge_pass.wgsl: its pixels take no lines of their own; outline.wgsl: its lines'
 // visibility is tested more widely).

@@ -1036,7 +1036,7 @@ fn class_at(x: vec2<f32>, near: f32, w: f32, reverse: f32, inst: u32, t: u32, n:
     // (where those in front of it end): look four pixels round (frame::CROSSING_BAND).
     let base = instances[slot(inst)].triangle_base;
     let bits = info[base + t] | select(0u, info[base + n], n != BACKGROUND_ID);
-    let crossed = (bits & INFO_CROSSED) != 0u;
+    let crossed = (bits & INFO_CROSSED) != 0u || (instances[slot(inst)].flags & INSTANCE_CROSSED) != 0u;
     let wide = frame.sections_on != 0u || crossed;
     let r = select(select(1, 2, wide), 4, crossed);
     let across = 2 * r + 1;

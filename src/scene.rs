@@ -255,6 +255,43 @@ pub fn check_transform(t: &DMat4, index: usize) -> Result<()> {
     Ok(())
 }
 
+/// Per placed object (its model-space bounds and model → world transform), whether its
+/// world-space bounds meet another's: the objects that may pass through each other, whose
+/// drawn edges both passes then draw only where they are visible (a surface crossing a
+/// triangle can hide its lines right beside its visible pixels, with no outline between),
+/// where they draw their outlines. With outlines drawn that is the same image where nothing
+/// crosses (a nearer surface's outline lies between a pixel and any of its lines the surface
+/// hides), so boxes that only touch count, and the test errs towards the exact path.
+pub fn overlapping(placed: &[((DVec3, DVec3), DMat4)]) -> Vec<bool> {
+    let boxes: Vec<(DVec3, DVec3)> = placed
+        .iter()
+        .map(|&((lo, hi), t)| {
+            (0..8).fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(a, b), k| {
+                let corner =
+                    DVec3::select(glam::BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0), hi, lo);
+                let p = t.transform_point3(corner);
+                (a.min(p), b.max(p))
+            })
+        })
+        .collect();
+    // Sweep along x.
+    let mut order: Vec<usize> = (0..boxes.len()).collect();
+    order.sort_by(|&a, &b| boxes[a].0.x.total_cmp(&boxes[b].0.x));
+    let mut meets = vec![false; boxes.len()];
+    for (k, &a) in order.iter().enumerate() {
+        for &b in &order[k + 1..] {
+            if boxes[b].0.x > boxes[a].1.x {
+                break;
+            }
+            if boxes[a].0.cmple(boxes[b].1).all() && boxes[b].0.cmple(boxes[a].1).all() {
+                meets[a] = true;
+                meets[b] = true;
+            }
+        }
+    }
+    meets
+}
+
 /// A frame's scene: the instances to draw and the view to draw them through.
 ///
 /// Every instance goes through one visibility pass and one edge pass, so instances occlude
@@ -421,6 +458,20 @@ pub fn validate_sections(sections: &[SectionPlane]) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn objects_meet_where_their_placed_bounds_do() {
+        let unit = (DVec3::splat(-1.0), DVec3::ONE);
+        let at = |x: f64| DMat4::from_translation(DVec3::new(x, 0.0, 0.0));
+        // Turned by 45°, its corners reach 1.41 from its centre.
+        let turned = at(2.3) * DMat4::from_rotation_z(std::f64::consts::FRAC_PI_4);
+        assert_eq!(overlapping(&[(unit, at(0.0)), (unit, at(2.3))]), [false; 2]);
+        assert_eq!(overlapping(&[(unit, at(0.0)), (unit, turned)]), [true; 2]);
+        assert_eq!(
+            overlapping(&[(unit, at(0.0)), (unit, at(5.0)), (unit, at(6.5))]),
+            [false, true, true]
+        );
+    }
 
     #[test]
     fn a_plane_across_an_orbit_cuts_away_the_half_nearer_the_eye() {

@@ -1,5 +1,5 @@
 //! Surfaces that pass through each other: a mesh through itself (two boxes modelled in one
-//! file, Suzanne's eyes through its head). A line point
+//! file, Suzanne's eyes through its head) and instances through each other. A line point
 //! that a nearer surface hides is not drawn, whatever patch it belongs to: the deferred
 //! pass matches the ground truth over every pixel, with ordinary, grazing, orthographic and
 //! eye-inside cameras and in every edge mode.
@@ -7,10 +7,11 @@
 mod common;
 
 use common::{load, shoot_world, worst_pixels};
-use glam::{DVec3, Vec3};
+use glam::{DMat4, DVec3, Vec3};
+use std::sync::Arc;
 use wirepass::tools::offline::Method;
 use wirepass::truth::accuracy::{distance_error, id_agreement};
-use wirepass::world::World;
+use wirepass::world::{Object, World, WorldMesh};
 use wirepass::{EdgeSelection, Mesh, Style, View};
 
 const SIZE: (u32, u32) = (320, 240);
@@ -187,4 +188,64 @@ fn suzannes_eyes_through_its_head() {
             &Style::default(),
         );
     }
+}
+
+#[test]
+fn instances_through_each_other() {
+    let (mut p, mut t, mut m) = (Vec::new(), Vec::new(), Vec::new());
+    add_box(Vec3::ZERO, 1.0, (0.0, 0.0), &mut p, &mut t, &mut m);
+    let cube = Mesh::new(p, None, t, Some(m)).unwrap();
+    let suzanne = load("suzanne.obj");
+    let (lo, hi) = suzanne.bounds_f64();
+    let centred = DMat4::from_translation(-0.5 * (lo + hi));
+    let world = World {
+        meshes: vec![
+            WorldMesh {
+                mesh: Arc::new(cube),
+                edges: EdgeSelection::Polygon,
+                name: "box".into(),
+            },
+            WorldMesh {
+                mesh: Arc::new(suzanne),
+                edges: EdgeSelection::Polygon,
+                name: "suzanne".into(),
+            },
+        ],
+        objects: vec![
+            Object::new(0, DMat4::IDENTITY),
+            Object::new(
+                0,
+                DMat4::from_translation(DVec3::new(0.9, 0.45, 0.35))
+                    * DMat4::from_euler(glam::EulerRot::YXZ, 0.5, 0.35, 0.0)
+                    * DMat4::from_scale(DVec3::splat(0.7)),
+            ),
+            // Mirrored, through the first box's -x face.
+            Object::new(
+                1,
+                DMat4::from_translation(DVec3::new(-1.2, 0.1, 0.3))
+                    * DMat4::from_scale(DVec3::new(-0.6, 0.6, 0.6))
+                    * centred,
+            ),
+        ],
+        sections: Vec::new(),
+    };
+    for (camera, view) in cameras(DVec3::new(0.2, 0.3, 0.1)) {
+        check(
+            &format!("instances, {camera}"),
+            &world,
+            view,
+            &Style::default(),
+        );
+    }
+    // Suzanne's head seen through the box's face it crosses, with hidden lines.
+    let hidden = Style {
+        hidden: Some(wirepass::HiddenLines::default()),
+        ..Style::default()
+    };
+    check(
+        "instances, hidden lines",
+        &world,
+        perspective(DVec3::new(-3.2, 1.2, 2.0), DVec3::new(-0.8, 0.2, 0.2)),
+        &hidden,
+    );
 }

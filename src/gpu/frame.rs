@@ -90,13 +90,17 @@ const INSTANCE_HIDDEN: u32 = 4;
 const INSTANCE_BEHIND_HOST: u32 = 8;
 /// `Instance.flags`: the hidden parts of its drawn edges are drawn, not only its outline's.
 const INSTANCE_HIDDEN_EDGES: u32 = 16;
-/// `Instance.flags`: its drawn edges are patterned, or cut by section planes, so the outline
-/// pass draws them (their visible runs) and the edge pass leaves them.
+/// `Instance.flags`: its drawn edges are patterned, cut by section planes or perhaps crossed
+/// by another instance, so the outline pass draws them (their visible runs) and the edge pass
+/// leaves them.
 const INSTANCE_LISTED_EDGES: u32 = 32;
 /// `Instance.flags`: it has a phase table (`chain_phases`).
 const INSTANCE_PHASES: u32 = 64;
+/// `Instance.flags`: another instance may pass through it ([`crate::scene::overlapping`]), so
+/// its lines' visibility is tested over a wider window ([`CROSSING_BAND`]).
+const INSTANCE_CROSSED: u32 = 128;
 
-/// Pixels the guard band grows by in a frame where a mesh crosses itself: the outline pass
+/// Pixels the guard band grows by in a frame where surfaces may cross: the outline pass
 /// tests the visibility of their lines against the ids up to four pixels around each point
 /// (the surface that a line passes into may be visible only a few pixels away, where the
 /// surfaces in front of it end), not one.
@@ -144,7 +148,7 @@ impl InstanceRecord {
 /// Pixels of guard band the deferred pass keeps around its output, from the widest line of
 /// the scene: lines whose edges lie just outside the output reach into it, the outline pass
 /// tests their visibility against the ids one pixel around each point (a few more in a
-/// frame where a mesh crosses itself, which adds [`CROSSING_BAND`]), and the coverage
+/// frame where surfaces may cross, which adds [`CROSSING_BAND`]), and the coverage
 /// search reads the ids around each pixel. So the output is the same whether the image is
 /// drawn whole or as tiles ([`Region`]). (An output within a band of the device's largest
 /// texture side gets what room is left.)
@@ -263,8 +267,20 @@ impl FrameRecords {
         super::targets::check_size(device, region.size)?;
         // Where the device's largest texture leaves no room for the whole band, a narrower one.
         let room = device.limits().max_texture_dimension_2d - region.size.0.max(region.size.1);
-        // Meshes that pass through themselves test their lines' visibility more widely.
-        let mut crossing = false;
+        // Instances that may pass through each other draw their edges where visible, where
+        // they draw outlines (without, a line may reach past the silhouette only so); they and
+        // meshes that pass through themselves test their lines' visibility more widely.
+        let placed: Vec<_> = scene
+            .instances
+            .iter()
+            .map(|i| store.record(i.mesh).map(|r| (r.bounds, i.transform)))
+            .collect::<Result<_>>()?;
+        let crossed: Vec<bool> = crate::scene::overlapping(&placed)
+            .into_iter()
+            .zip(scene.instances.iter())
+            .map(|(meets, i)| meets && i.style.outlines.unwrap_or(style.silhouettes))
+            .collect();
+        let mut crossing = crossed.contains(&true);
         for i in scene.instances.iter() {
             crossing |= store.record(i.mesh)?.lines.crossed;
         }
@@ -315,8 +331,10 @@ impl FrameRecords {
             let edge_pattern = s.edge_pattern_in(style).dash_period();
             let outline_pattern = s.outline_pattern_in(style).dash_period();
             let patterned_edges = draws_edges && edge_pattern[1] > 0.0;
-            // Section planes cut the drawn edges short: the outline pass draws them.
-            let listed_edges = patterned_edges || (draws_edges && !scene.sections.is_empty());
+            // Section planes cut the drawn edges short, and another instance may cross them:
+            // the outline pass draws them where they are visible.
+            let listed_edges = patterned_edges
+                || (draws_edges && (!scene.sections.is_empty() || crossed[i as usize]));
             // Cut lines too: every instance has them where a section plane crosses it.
             outlines |= hidden.is_some() || listed_edges || !scene.sections.is_empty();
             patterns |= patterned_edges
@@ -337,6 +355,11 @@ impl FrameRecords {
                 }
                 | if listed_edges {
                     INSTANCE_LISTED_EDGES
+                } else {
+                    0
+                }
+                | if crossed[i as usize] {
+                    INSTANCE_CROSSED
                 } else {
                     0
                 };

@@ -331,6 +331,9 @@ pub(crate) struct ObjectStyle {
     pub outline_pattern: [f64; 2],
     /// The world has section planes.
     pub sectioned: bool,
+    /// Its placed bounds meet another object's ([`crate::scene::overlapping`]), so the two
+    /// may pass through each other, and it draws its outline.
+    pub crossed: bool,
     /// The cut lines' width.
     pub section_width: f64,
     /// Its hidden lines, where it draws any lines.
@@ -340,17 +343,25 @@ pub(crate) struct ObjectStyle {
 }
 
 impl ObjectStyle {
-    /// Whether the object's drawn edges are in the outline map (dashed or dotted, or cut by
-    /// section planes), not measured from each pixel's own triangle.
+    /// Whether the object's drawn edges are in the outline map (dashed or dotted, cut by
+    /// section planes, or perhaps crossed by another object), not measured from each pixel's
+    /// own triangle.
     pub fn listed_edges(&self) -> bool {
-        self.edges && (self.edge_pattern[1] > 0.0 || self.sectioned)
+        self.edges && (self.edge_pattern[1] > 0.0 || self.sectioned || self.crossed)
     }
 
     pub fn of(world: &World, style: &style::Style) -> Vec<ObjectStyle> {
+        let placed: Vec<_> = world
+            .objects
+            .iter()
+            .map(|o| (world.meshes[o.mesh].mesh.bounds_f64(), o.transform))
+            .collect();
+        let crossed = crate::scene::overlapping(&placed);
         world
             .objects
             .iter()
-            .map(|o| ObjectStyle {
+            .zip(crossed)
+            .map(|(o, crossed)| ObjectStyle {
                 wire: o
                     .style
                     .wire_color
@@ -373,6 +384,7 @@ impl ObjectStyle {
                     .dash_period()
                     .map(f64::from),
                 sectioned: !world.sections.is_empty(),
+                crossed: crossed && o.style.outlines.unwrap_or(style.silhouettes),
                 section_width: f64::from(style.section_width()),
                 hidden: o.style.hidden_in(style).filter(|_| {
                     o.style.edges.unwrap_or(true) || o.style.outlines.unwrap_or(style.silhouettes)
