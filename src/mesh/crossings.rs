@@ -39,25 +39,37 @@ pub fn crossing_triangles(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<boo
     }
     let tolerance = 1e-9 * size;
     // A grid of cells about the size of a typical triangle (the median of their largest
-    // extents), at most 2^20 cells a side.
+    // extents), at most 2^20 cells a side, coarser where the triangles would fill more than
+    // 16 cells each on average.
     let mut extents: Vec<f64> = boxes.iter().map(|b| (b[1] - b[0]).max_element()).collect();
     let middle = extents.len() / 2;
     let median = *extents
         .select_nth_unstable_by(middle, |a, b| a.total_cmp(b))
         .1;
-    let cell = median
-        .max(size / f64::from(1u32 << 20))
-        .max(f64::MIN_POSITIVE);
-    let cell_of = |p: DVec3| ((p - lo) / cell).floor().as_u64vec3();
     // A triangle spanning more than this many cells (a large one among small ones) is tested
     // against every other by its box instead.
     const MOST_CELLS: u64 = 512;
-    let key = |c: U64Vec3| c.x | c.y << 21 | c.z << 42;
-    let spans: Vec<(U64Vec3, U64Vec3)> = boxes
-        .iter()
-        .map(|b| (cell_of(b[0]), cell_of(b[1])))
-        .collect();
     let cells = |(a, b): (U64Vec3, U64Vec3)| (b - a + 1).element_product();
+    let span_in = |cell: f64, b: &[DVec3; 2]| {
+        let at = |p: DVec3| ((p - lo) / cell).floor().as_u64vec3();
+        (at(b[0]), at(b[1]))
+    };
+    let mut cell = median
+        .max(size / f64::from(1u32 << 20))
+        .max(f64::MIN_POSITIVE);
+    while cell < size
+        && boxes
+            .iter()
+            .map(|b| cells(span_in(cell, b)))
+            .filter(|&c| c <= MOST_CELLS)
+            .sum::<u64>()
+            > 16 * n as u64
+    {
+        cell *= 2.0;
+    }
+    let cell_of = |p: DVec3| ((p - lo) / cell).floor().as_u64vec3();
+    let key = |c: U64Vec3| c.x | c.y << 21 | c.z << 42;
+    let spans: Vec<(U64Vec3, U64Vec3)> = boxes.iter().map(|b| span_in(cell, b)).collect();
     let mut entries: Vec<(u64, u32)> = Vec::with_capacity(n);
     let mut large = Vec::new();
     for (t, &span) in spans.iter().enumerate() {
@@ -247,6 +259,49 @@ mod tests {
         box_mesh(Vec3::ZERO, 1.0, &mut p, &mut t);
         box_mesh(Vec3::new(2.5, 0.3, 0.2), 1.0, &mut p, &mut t);
         assert!(crossing_triangles(&p, &t).iter().all(|&c| !c));
+    }
+
+    /// The grid finds what testing every pair finds, on a soup of small triangles and large
+    /// ones of several sizes (some spanning more cells than the grid takes, most of them
+    /// coarsening it).
+    #[test]
+    fn the_grid_finds_what_every_pair_finds() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f32 / (1u64 << 53) as f32
+        };
+        let (mut positions, mut triangles) = (Vec::new(), Vec::new());
+        for k in 0..2000 {
+            let scale = match k % 10 {
+                0 => 0.5,
+                1 => 0.1,
+                2 | 3 => 0.04,
+                _ => 0.01,
+            };
+            let centre = Vec3::new(next(), next(), next());
+            let base = positions.len() as u32;
+            for _ in 0..3 {
+                positions.push(centre + scale * Vec3::new(next(), next(), next()));
+            }
+            triangles.push([base, base + 1, base + 2]);
+        }
+        let found = crossing_triangles(&positions, &triangles);
+        let corners = |t: usize| triangles[t].map(|v| positions[v as usize].as_dvec3());
+        let mut expected = vec![false; triangles.len()];
+        for t in 0..triangles.len() {
+            for u in t + 1..triangles.len() {
+                if cross(corners(t), corners(u), 1e-9) {
+                    expected[t] = true;
+                    expected[u] = true;
+                }
+            }
+        }
+        let count = expected.iter().filter(|&&c| c).count();
+        assert!(count > 50, "{count}");
+        assert_eq!(found, expected);
     }
 
     #[test]
