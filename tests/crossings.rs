@@ -16,8 +16,9 @@ use wirepass::{EdgeSelection, Mesh, Style, View};
 
 const SIZE: (u32, u32) = (320, 240);
 
-/// A box of half-size `half` turned by `turn` (radians about y, then x) and moved to
-/// `centre`, appended to `positions` and `triangles` with its quads' diagonals undrawn.
+/// The unit cube's 12 triangles (`wirepass::mesh::cube`) at half-size `half`, turned by
+/// `turn` (radians about y, then x) and moved to `centre`, appended to `positions` and
+/// `triangles` with its quads' diagonals undrawn (`polygon`).
 fn add_box(
     centre: Vec3,
     half: f32,
@@ -26,26 +27,16 @@ fn add_box(
     triangles: &mut Vec<[u32; 3]>,
     polygon: &mut Vec<u8>,
 ) {
-    let base = positions.len() as u32;
+    let cube = wirepass::mesh::cube(12).unwrap();
     let rotation = glam::Quat::from_rotation_x(turn.1) * glam::Quat::from_rotation_y(turn.0);
-    for i in 0..8 {
-        let s = |bit: u32| if i & bit != 0 { half } else { -half };
-        positions.push(centre + rotation * Vec3::new(s(1), s(2), s(4)));
-    }
-    // Counter-clockwise seen from outside.
-    let quads = [
-        [0, 2, 3, 1],
-        [4, 5, 7, 6],
-        [0, 1, 5, 4],
-        [2, 6, 7, 3],
-        [0, 4, 6, 2],
-        [1, 3, 7, 5],
-    ];
-    for [a, b, c, d] in quads {
-        triangles.push([a + base, b + base, c + base]);
-        triangles.push([a + base, c + base, d + base]);
-        polygon.extend([0b011, 0b110]);
-    }
+    let base = positions.len() as u32;
+    positions.extend(
+        cube.positions()
+            .iter()
+            .map(|&p| centre + rotation * (half * p)),
+    );
+    triangles.extend(cube.triangles().iter().map(|t| t.map(|v| v + base)));
+    polygon.extend(cube.edge_mask(EdgeSelection::Polygon));
 }
 
 /// Two boxes through each other, one turned, as one mesh.

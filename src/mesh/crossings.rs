@@ -215,24 +215,12 @@ fn span(p: [DVec3; 3], d: [f64; 3], along: DVec3) -> Option<(f64, f64)> {
 mod tests {
     use super::*;
 
+    /// The unit cube's 12 triangles (`procedural::cube`) at `centre`, `half` its half size.
     fn box_mesh(centre: Vec3, half: f32, positions: &mut Vec<Vec3>, triangles: &mut Vec<[u32; 3]>) {
+        let cube = crate::mesh::cube(12).unwrap();
         let base = positions.len() as u32;
-        for i in 0..8 {
-            let s = |bit: u32| if i & bit != 0 { half } else { -half };
-            positions.push(centre + Vec3::new(s(1), s(2), s(4)));
-        }
-        let quads = [
-            [0, 2, 3, 1],
-            [4, 5, 7, 6],
-            [0, 1, 5, 4],
-            [2, 6, 7, 3],
-            [0, 4, 6, 2],
-            [1, 3, 7, 5],
-        ];
-        for [a, b, c, d] in quads {
-            triangles.push([a + base, b + base, c + base]);
-            triangles.push([a + base, c + base, d + base]);
-        }
+        positions.extend(cube.positions().iter().map(|&p| centre + half * p));
+        triangles.extend(cube.triangles().iter().map(|t| t.map(|v| v + base)));
     }
 
     #[test]
@@ -248,12 +236,12 @@ mod tests {
         box_mesh(Vec3::ZERO, 1.0, &mut p, &mut t);
         box_mesh(Vec3::new(1.5, 0.3, 0.2), 1.0, &mut p, &mut t);
         let crossing = crossing_triangles(&p, &t);
-        // The first box's +x face (triangles 10, 11) is crossed by the second's faces, and
-        // the second's -x face (its 8, 9: triangles 20, 21) by the first's.
-        assert!(crossing[10] || crossing[11]);
-        assert!(crossing[20] || crossing[21]);
+        // The first box's +x face (triangles 2, 3) is crossed by the second's faces, and the
+        // second's -x face (its 0, 1: triangles 12, 13) by the first's.
+        assert!(crossing[2] || crossing[3]);
+        assert!(crossing[12] || crossing[13]);
         // The first's -x face is far from the second box.
-        assert!(!crossing[8] && !crossing[9]);
+        assert!(!crossing[0] && !crossing[1]);
         // Disjoint boxes: nothing.
         let (mut p, mut t) = (Vec::new(), Vec::new());
         box_mesh(Vec3::ZERO, 1.0, &mut p, &mut t);
