@@ -270,20 +270,19 @@ impl FrameRecords {
         // Instances that may pass through each other draw their edges where visible, where
         // they draw outlines (without, a line may reach past the silhouette only so); they and
         // meshes that pass through themselves test their lines' visibility more widely.
-        let placed: Vec<_> = scene
-            .instances
-            .iter()
-            .map(|i| store.record(i.mesh).map(|r| (r.bounds, i.transform)))
-            .collect::<Result<_>>()?;
+        let mut placed = Vec::with_capacity(scene.instances.len());
+        let mut crossing = false;
+        for i in scene.instances.iter() {
+            let record = store.record(i.mesh)?;
+            placed.push((record.bounds, i.transform));
+            crossing |= record.lines.crossed;
+        }
         let crossed: Vec<bool> = crate::scene::overlapping(&placed)
             .into_iter()
             .zip(scene.instances.iter())
             .map(|(meets, i)| meets && i.style.outlines.unwrap_or(style.silhouettes))
             .collect();
-        let mut crossing = crossed.contains(&true);
-        for i in scene.instances.iter() {
-            crossing |= store.record(i.mesh)?.lines.crossed;
-        }
+        crossing |= crossed.contains(&true);
         let guard = if guarded {
             let band = guard_band(scene, style);
             (band + if crossing { CROSSING_BAND } else { 0 }).min(room / 2)
