@@ -56,7 +56,12 @@ struct Frame {
     sections_on: u32,
     // The cut lines' width in pixels and linear RGBA colour.
     section_width: f32,
+    // The frame's intersection segments (`intersections` in outline.wgsl), and their lines'
+    // width and colour.
+    intersections: u32,
+    intersection_width: f32,
     section_line_color: vec4<f32>,
+    intersection_line_color: vec4<f32>,
 }
 
 // Per instance (src/gpu/frame.rs, InstanceRecord). "Local" coordinates are the mesh

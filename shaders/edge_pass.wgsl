@@ -107,11 +107,14 @@ const LINE_CLASS_EDGE: u32 = 1u;
 const LINE_CLASS_OUTLINE: u32 = 2u;
 const LINE_CLASS_HIDDEN: u32 = 3u;
 const LINE_CLASS_CUT: u32 = 4u;
+const LINE_CLASS_INTERSECTION: u32 = 5u;
 
 // The class of the outline pass's line with owner word `owner` (COLORS; an edge without).
 fn owner_kind(owner: u32) -> u32 {
-    let line = select(LINE_CLASS_EDGE, LINE_CLASS_CUT, (owner & OWNER_CUT) != 0u);
-    return select(line, LINE_CLASS_OUTLINE, (owner & OWNER_OUTLINE) != 0u);
+    let kind = owner & OWNER_CLASS;
+    var line = select(LINE_CLASS_EDGE, LINE_CLASS_CUT, kind == OWNER_CUT);
+    line = select(line, LINE_CLASS_OUTLINE, kind == OWNER_OUTLINE);
+    return select(line, LINE_CLASS_INTERSECTION, kind == OWNER_INTERSECTION);
 }
 
 // The line the outline pass left in target pixel `xy`: its key (0 for none) and its owner

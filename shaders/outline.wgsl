@@ -34,6 +34,10 @@
 // drawn (in dashes); the edge pass then leaves its own triangles' edges. Every line ends
 // where a section plane cuts it (`edge_span`).
 //
+// Intersection lines (`frame.intersections` > 0): where two triangles of an instance's mesh
+// cross (src/mesh/crossings.rs found the pairs and their segments at upload), one invocation
+// per segment draws its visible runs, hidden by any surface but the two it lies on.
+//
 // Flags: COLORS (instances differ in line colour, or an outline's colour differs from the
 // edges': each pixel also keeps the greatest (intensity level, class, instance) word,
 // `OWNER_OUTLINE`, so the edge pass knows whose line it holds and of which class), HIDDEN,
@@ -301,6 +305,42 @@ fn outline_pieces_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_i
     }
 }
 
+// The frame's intersection segments (src/gpu/frame.rs, IntersectionRecord): where
+// triangles t and u of the instance in `slot` cross, from a to b in its local coordinates.
+struct Intersection {
+    a: vec3<f32>,
+    slot: u32,
+    b: vec3<f32>,
+    t: u32,
+    u: u32,
+}
+@group(0) @binding(28) var<storage, read> intersections: array<Intersection>;
+
+// One invocation per intersection segment: draws its visible runs, piece by piece (a
+// segment is no longer than its triangles, so few have more than one).
+@compute @workgroup_size(64)
+fn intersection_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let k = gid.x + gid.y * groups.x * CLUSTER_TRIANGLES;
+    if k >= frame.intersections {
+        return;
+    }
+    let s = intersections[k];
+    var c = clip_outline(s.slot, s.t, s.u, s.a, s.b, vec4<f32>(0.0, 1.0, 0.0, 1.0), NO_PLANE);
+    c.seg.crossing = true;
+    let reach = line_reach(frame.intersection_width);
+    let first = frame.target_origin - reach;
+    let last = frame.target_origin + frame.target_size + reach;
+    for (var piece = 0u; piece < c.pieces; piece++) {
+        let k0 = f32(piece) / f32(c.pieces);
+        let k1 = f32(piece + 1u) / f32(c.pieces);
+        let p = mix(c.seg.start.xy, c.seg.end.xy, k0);
+        let q = mix(c.seg.start.xy, c.seg.end.xy, k1);
+        if all(max(p, q) >= first) && all(min(p, q) <= last) {
+            draw_piece(c.seg, k0, k1, c.length_px, DRAW_VISIBLE | DRAW_INTERSECTION);
+        }
+    }
+}
+
 // Finds the outline edges of triangle t of instance `inst` and draws them.
 fn outline_triangle(inst: u32, t: u32) {
     let base = instances[slot(inst)].triangle_base;
@@ -525,12 +565,15 @@ const DRAW_CUT: u32 = 8u;
 const CUT_PLANE_SHIFT: u32 = 4u;
 // No section plane (`edge_span`'s `skip`).
 const NO_PLANE: u32 = 6u;
+// An intersection line, of its own class.
+const DRAW_INTERSECTION: u32 = 128u;
 
 // The classes of line splat_runs writes.
 const LINE_EDGE: u32 = 0u;
 const LINE_OUTLINE: u32 = 1u;
 const LINE_HIDDEN: u32 = 2u;
 const LINE_CUT: u32 = 3u;
+const LINE_INTERSECTION: u32 = 4u;
 
 // Narrows [range.x, range.y] to the parameters u where lo <= p0 + u d <= hi.
 fn keep_between(range: vec2<f32>, p0: f32, d: f32, lo: f32, hi: f32) -> vec2<f32> {
@@ -594,6 +637,8 @@ struct Segment {
     hidden_dir: f32,
     // How the eye's ray reaches the line where no other surface tells (`capped`).
     cap: u32,
+    // An intersection line (on t and on n, which cross there).
+    crossing: bool,
 }
 
 fn seg_at(s: Segment, k: f32) -> Projected {
@@ -610,7 +655,7 @@ fn seg_class(s: Segment, k: f32) -> u32 {
     let inset = min(END_INSET / max(distance(s.start.xy, s.end.xy), 1e-30), 0.5);
     let q = seg_at(s, clamp(k, inset, 1.0 - inset));
     let w = 1.0 / q.inv_w;
-    let c = class_at(q.xy, q.near_w * w, w, q.reverse, s.inst, s.t, s.n, s.cap);
+    let c = class_at(q.xy, q.near_w * w, w, q.reverse, s.inst, vec3<u32>(s.t, s.n, u32(s.crossing)), s.cap);
 #if HIDDEN
     let behind_host = (instances[slot(s.inst)].flags & INSTANCE_BEHIND_HOST) != 0u;
     return select(c, 1u, c == 2u && behind_host);
@@ -817,7 +862,8 @@ fn draw_piece(seg: Segment, k0: f32, k1: f32, length_px: f32, mode: u32) {
         }
     }
     if (mode & DRAW_VISIBLE) != 0u && count > 0u {
-        let kind = select(select(LINE_EDGE, LINE_OUTLINE, (mode & DRAW_OUTLINE) != 0u), LINE_CUT, (mode & DRAW_CUT) != 0u);
+        var kind = select(select(LINE_EDGE, LINE_OUTLINE, (mode & DRAW_OUTLINE) != 0u), LINE_CUT, (mode & DRAW_CUT) != 0u);
+        kind = select(kind, LINE_INTERSECTION, (mode & DRAW_INTERSECTION) != 0u);
         splat_runs(seg, k0, k1, &runs, count, kind);
     }
 #if HIDDEN
@@ -854,6 +900,7 @@ fn push_run(runs: ptr<function, array<vec2<f32>, MAX_RUNS>>, count: ptr<function
 fn splat_runs(seg: Segment, k0: f32, k1: f32, runs: ptr<function, array<vec2<f32>, MAX_RUNS>>, count: u32, kind: u32) {
     var width = select(instances[slot(seg.inst)].line_width, instances[slot(seg.inst)].outline_width, kind == LINE_OUTLINE);
     width = select(width, frame.section_width, kind == LINE_CUT);
+    width = select(width, frame.intersection_width, kind == LINE_INTERSECTION);
     var pattern = vec2<f32>(0.0);
     var phase = seg.phase;
     var phase_dir = seg.phase_dir;
@@ -861,7 +908,7 @@ fn splat_runs(seg: Segment, k0: f32, k1: f32, runs: ptr<function, array<vec2<f32
     let hidden = kind == LINE_HIDDEN;
 #if PATTERNS
     pattern = select(instances[slot(seg.inst)].edge_pattern, instances[slot(seg.inst)].outline_pattern, kind == LINE_OUTLINE);
-    pattern = select(pattern, vec2<f32>(0.0), kind == LINE_CUT);
+    pattern = select(pattern, vec2<f32>(0.0), kind == LINE_CUT || kind == LINE_INTERSECTION);
 #endif
 #if HIDDEN
     if hidden {
@@ -964,7 +1011,8 @@ fn splat_runs(seg: Segment, k0: f32, k1: f32, runs: ptr<function, array<vec2<f32
 #endif
 #if COLORS
             atomicMax(&acc_rw[2u * index], key);
-            let owner = select(select(0u, OWNER_OUTLINE, kind == LINE_OUTLINE), OWNER_CUT, kind == LINE_CUT);
+            var owner = select(select(0u, OWNER_OUTLINE, kind == LINE_OUTLINE), OWNER_CUT, kind == LINE_CUT);
+            owner = select(owner, OWNER_INTERSECTION, kind == LINE_INTERSECTION);
             atomicMax(&acc_rw[2u * index + 1u], (key & 0xfff00000u) | owner | seg.inst);
 #else
             atomicMax(&acc_rw[index], key);
@@ -1004,6 +1052,7 @@ fn mark_outline_tiles(first_m: i32, last_m: i32, first_o: i32, last_o: i32, majo
 }
 
 // Whether the edge's point at screen point x (near row `near`, w `w`, reverse depth `reverse`)
+// on triangles `line.xy` (t and n) of `inst` (`line.z` 1 for an intersection line)
 // is visible (0), hidden by a triangle other than t and n of `inst` that covers x nearer
 // than the point (1), or by the host (2, host_hides_point). The candidates are the triangles the
 // rasterizer gave the 3×3 pixel centres around x (5×5, and the line's triangles' other
@@ -1020,7 +1069,9 @@ fn mark_outline_tiles(first_m: i32, last_m: i32, first_o: i32, last_o: i32, majo
 // surface in front of it (within HIDDEN_MARGIN) faces away, the ray came out of the solid
 // through it; where that surface faces the eye, it went in there; where none is nearer by
 // CAP_MARGIN, the line's own triangles tell (CAP_INSIDE).
-fn class_at(x: vec2<f32>, near: f32, w: f32, reverse: f32, inst: u32, t: u32, n: u32, cap: u32) -> u32 {
+fn class_at(x: vec2<f32>, near: f32, w: f32, reverse: f32, inst: u32, line: vec3<u32>, cap: u32) -> u32 {
+    let t = line.x;
+    let n = line.y;
     let centre = vec2<i32>(floor(x - frame.target_origin));
     if host_hides_point(x - frame.target_origin, reverse) {
         return 2u;
@@ -1038,7 +1089,9 @@ fn class_at(x: vec2<f32>, near: f32, w: f32, reverse: f32, inst: u32, t: u32, n:
     let bits = info[base + t] | select(0u, info[base + n], n != BACKGROUND_ID);
     let crossed = (bits & INFO_CROSSED) != 0u || (instances[slot(inst)].flags & INSTANCE_CROSSED) != 0u;
     let wide = frame.sections_on != 0u || crossed;
-    let r = select(select(1, 2, wide), 4, crossed);
+    // An intersection line lies on both surfaces that cross there, so no surface passes
+    // into view beyond it: it takes a section's window.
+    let r = select(select(select(1, 2, wide), 4, crossed), 2, line.z != 0u);
     let across = 2 * r + 1;
     for (var k = 0; k < across * across; k++) {
         let offset = vec2<i32>(k % across - r, k / across - r);

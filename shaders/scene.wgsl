@@ -43,20 +43,26 @@ fn outline_tile_count() -> u32 {
     return ((size.x + 7u) / 8u) * ((size.y + 7u) / 8u);
 }
 
-// The bits of the outline pass's owner word (COLORS: intensity level << 20 | a class bit |
-// instance slot) that mark an outline's line (the instance's outline colour, not its line
-// colour) and a section's cut line (the frame's section line colour); the slot's bits.
+// The class bits of the outline pass's owner word (COLORS: intensity level << 20 | class
+// bits | instance slot): an outline's line (the instance's outline colour, not its line
+// colour), a section's cut line (the frame's section line colour), both for an
+// intersection line (the frame's intersection line colour; of equal intensity, it wins
+// over the others); then the slot's bits.
 const OWNER_OUTLINE: u32 = 0x80000u;
 const OWNER_CUT: u32 = 0x40000u;
+const OWNER_INTERSECTION: u32 = 0xc0000u;
+const OWNER_CLASS: u32 = 0xc0000u;
 const OWNER_INSTANCE: u32 = 0x3ffffu;
 
 // The colour of the outline pass's line whose owner word is `owner`: the owning instance's
-// outline colour for an outline, the section line colour for a cut line, its line colour
-// for a drawn edge.
+// outline colour for an outline, the section line colour for a cut line, the intersection
+// line colour for an intersection line, its line colour for a drawn edge.
 fn owner_color(owner: u32) -> vec4<f32> {
     let i = slot(owner & OWNER_INSTANCE);
-    let line = select(instances[i].wire_color, frame.section_line_color, (owner & OWNER_CUT) != 0u);
-    return select(line, unpack_color(instances[i].outline_color), (owner & OWNER_OUTLINE) != 0u);
+    let kind = owner & OWNER_CLASS;
+    var line = select(instances[i].wire_color, frame.section_line_color, kind == OWNER_CUT);
+    line = select(line, unpack_color(instances[i].outline_color), kind == OWNER_OUTLINE);
+    return select(line, frame.intersection_line_color, kind == OWNER_INTERSECTION);
 }
 
 // Word offset of the hidden lines (HIDDEN): the greatest `line_key` per target pixel (with

@@ -77,6 +77,16 @@ pub struct Style {
     /// Width of the cut lines in pixels; `None` draws them at
     /// [`line_width`](Self::line_width).
     pub section_line_width: Option<f32>,
+    /// Whether to draw intersection lines: where surfaces of a mesh pass through each other
+    /// (a part modelled through another, an interference fit in an assembly held in one
+    /// mesh), the curve along which they meet, where it is visible. Found once per mesh, in
+    /// its own coordinates, when it is uploaded ([`Mesh::intersections`](crate::Mesh::intersections)).
+    pub intersection_lines: bool,
+    /// Colour of the intersection lines.
+    pub intersection_line_color: Color,
+    /// Width of the intersection lines in pixels; `None` draws them at
+    /// [`line_width`](Self::line_width).
+    pub intersection_line_width: Option<f32>,
     /// Share of ambient light, 0..1; the rest comes from the key light.
     pub ambient: f32,
     /// Direction towards the key light in view space (x right, y up, z towards the viewer),
@@ -390,6 +400,10 @@ impl Default for Style {
             // #5a1e0f.
             section_line_color: Color([0.102, 0.013, 0.005, 1.0]),
             section_line_width: None,
+            intersection_lines: false,
+            // #e8262a.
+            intersection_line_color: Color([0.807, 0.019, 0.023, 1.0]),
+            intersection_line_width: None,
             ambient: 0.3,
             light_view_dir: Vec3::new(-0.4, 0.6, 1.0),
             outline_color: None,
@@ -409,6 +423,12 @@ impl Style {
     pub fn section_width(&self) -> f32 {
         self.section_line_width.unwrap_or(self.line_width)
     }
+
+    /// The width of the intersection lines:
+    /// [`intersection_line_width`](Self::intersection_line_width), else the line width.
+    pub fn intersection_width(&self) -> f32 {
+        self.intersection_line_width.unwrap_or(self.line_width)
+    }
 }
 
 impl Style {
@@ -418,6 +438,7 @@ impl Style {
             ("line", Some(self.line_width)),
             ("outline", self.outline_width),
             ("section line", self.section_line_width),
+            ("intersection line", self.intersection_line_width),
         ];
         for (what, w) in widths {
             if let Some(w) = w.filter(|w| !(*w >= 0.0 && *w <= MAX_LINE_WIDTH)) {

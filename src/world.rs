@@ -274,4 +274,6 @@ pub enum LineClass {
     Hidden = 3,
     /// A section's cut line ([`SectionPlane`]).
     Cut = 4,
+    /// An intersection line ([`Style::intersection_lines`](crate::Style::intersection_lines)).
+    Intersection = 5,
 }

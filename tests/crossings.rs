@@ -2,7 +2,8 @@
 //! file, Suzanne's eyes through its head) and instances through each other. A line point
 //! that a nearer surface hides is not drawn, whatever patch it belongs to: the deferred
 //! pass matches the ground truth over every pixel, with ordinary, grazing, orthographic and
-//! eye-inside cameras and in every edge mode.
+//! eye-inside cameras and in every edge mode. Intersection lines (where the surfaces meet)
+//! match the ground truth the same way, and their class too.
 
 mod common;
 
@@ -11,7 +12,7 @@ use glam::{DMat4, DVec3, Vec3};
 use std::sync::Arc;
 use wirepass::tools::offline::Method;
 use wirepass::truth::accuracy::{distance_error, id_agreement};
-use wirepass::world::{Object, World, WorldMesh};
+use wirepass::world::{LineClass, Object, World, WorldMesh};
 use wirepass::{EdgeSelection, Mesh, Style, View};
 
 const SIZE: (u32, u32) = (320, 240);
@@ -67,10 +68,20 @@ fn perspective(eye: DVec3, target: DVec3) -> View {
 }
 
 /// The deferred frame against the ground truth over every pixel; returns how many pixels
-/// the truth draws a line in.
-fn check(name: &str, world: &World, view: View, style: &Style) -> usize {
+/// the truth draws a line in, and how many of them an intersection line colours most
+/// (where the frame's line there is of that class too, within a pixel in 200).
+fn check(name: &str, world: &World, view: View, style: &Style) -> (usize, usize) {
     let truth = shoot_world(world, view, style, SIZE, Method::Raycast);
     let frame = shoot_world(world, view, style, SIZE, Method::Deferred);
+    let class = LineClass::Intersection as u8;
+    let crossing = (0..truth.line_class.len()).filter(|&i| truth.line_class[i] == class);
+    let (count, agree) = crossing.fold((0, 0), |(n, a), i| {
+        (n + 1, a + usize::from(frame.line_class[i] == class))
+    });
+    assert!(
+        200 * agree >= 199 * count,
+        "{name}: {agree} of {count} intersection-line pixels agree"
+    );
     let (ids, _) = id_agreement(&truth, &frame).unwrap();
     let lines = distance_error(&truth, &frame).unwrap();
     println!("{name}: id {ids:.5}, lines {lines:?}");
@@ -79,7 +90,7 @@ fn check(name: &str, world: &World, view: View, style: &Style) -> usize {
     assert!(lines.pixels > 0, "{name}: no line pixels");
     assert!(lines.p99.unwrap() <= 0.01, "{name}: {lines:?}\n{}", worst());
     assert!(lines.max.unwrap() <= 0.1, "{name}: {lines:?}\n{}", worst());
-    lines.pixels
+    (lines.pixels, count)
 }
 
 /// Cameras that look at the crossing of the two boxes: ordinary, grazing along the first
@@ -239,4 +250,64 @@ fn instances_through_each_other() {
         perspective(DVec3::new(-3.2, 1.2, 2.0), DVec3::new(-0.8, 0.2, 0.2)),
         &hidden,
     );
+}
+
+/// Intersection lines, where the surfaces of a mesh meet: the two boxes (thin and wide lines,
+/// every camera; every polygon edge or the box edges) and Suzanne's eyes, against the ground truth.
+#[test]
+fn intersection_lines_are_drawn_where_visible() {
+    let target = DVec3::new(0.6, 0.3, 0.2);
+    for (edges, width) in [
+        (EdgeSelection::Polygon, 1.5),
+        (EdgeSelection::Feature(30.0), 3.0),
+    ] {
+        let world = World::single(two_boxes(), edges);
+        let style = Style {
+            intersection_lines: true,
+            intersection_line_width: Some(width),
+            ..Style::default()
+        };
+        let mut drawn = 0;
+        for (camera, view) in cameras(target) {
+            let (_, crossing) = check(
+                &format!("two boxes, intersection lines, {edges:?}, {camera}"),
+                &world,
+                view,
+                &style,
+            );
+            drawn += usize::from(crossing > 0);
+        }
+        // From inside the first box its walls hide the second's crossing; the other
+        // cameras see it.
+        assert!(
+            drawn >= 3,
+            "{edges:?}: {drawn} views draw intersection lines"
+        );
+    }
+    let mesh = load("suzanne.obj");
+    let (lo, hi) = mesh.bounds_f64();
+    let c = 0.5 * (lo + hi);
+    let world = World::single(mesh, EdgeSelection::Polygon);
+    let eyes = c + DVec3::new(0.0, 0.2, 0.7);
+    let style = Style {
+        intersection_lines: true,
+        intersection_line_width: Some(2.0),
+        ..Style::default()
+    };
+    for (camera, view) in [
+        ("front", perspective(c + DVec3::new(0.8, 0.6, 3.0), eyes)),
+        ("close", perspective(c + DVec3::new(0.5, 0.45, 1.6), eyes)),
+        ("grazing", perspective(c + DVec3::new(3.0, 0.3, 0.9), eyes)),
+    ] {
+        let (_, crossing) = check(
+            &format!("suzanne, intersection lines, {camera}"),
+            &world,
+            view,
+            &style,
+        );
+        assert!(
+            crossing > 0,
+            "{camera}: the eyes' intersection lines are drawn"
+        );
+    }
 }

@@ -132,6 +132,16 @@ struct SceneArgs {
     /// Width of the cut lines in pixels [default: the line width].
     #[arg(long, allow_hyphen_values = true)]
     section_line_width: Option<f32>,
+    /// Draw intersection lines: where surfaces of a mesh pass through each other, the curve
+    /// along which they meet. Only deferred and raycast draw them.
+    #[arg(long)]
+    intersections: bool,
+    /// Colour of the intersection lines, #rrggbb[aa] (sRGB).
+    #[arg(long, default_value = "#e8262a")]
+    intersection_color: String,
+    /// Width of the intersection lines in pixels [default: the line width].
+    #[arg(long, allow_hyphen_values = true)]
+    intersection_width: Option<f32>,
     #[command(flatten)]
     camera: CameraArgs,
 }
@@ -218,6 +228,9 @@ impl SceneArgs {
             section_color: Color::from_hex(&self.section_color)?,
             section_line_color: Color::from_hex(&self.section_line_color)?,
             section_line_width: self.section_line_width,
+            intersection_lines: self.intersections,
+            intersection_line_color: Color::from_hex(&self.intersection_color)?,
+            intersection_line_width: self.intersection_width,
             silhouettes: self.silhouettes,
             depth_fade: self.depth_fade,
             ..Style::default()

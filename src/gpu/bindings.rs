@@ -50,6 +50,8 @@ pub(crate) enum Res {
     Chains = 26,
     /// The frame's instances whose chains `chain_phases` visits (`frame::ChainWork`).
     ChainWork = 27,
+    /// The frame's intersection segments (`frame::IntersectionRecord`).
+    Intersections = 28,
     /// The host's own depth texture, which the host-depth pass resolves into [`Res::HostDepth`]
     /// (read as unfilterable float; multisampled or not).
     HostSource = 30,
@@ -350,6 +352,7 @@ pub(crate) fn bind_group(
             Clusters => store.clusters.as_entire_binding(),
             Chains => store.chains.as_entire_binding(),
             ChainWork => f.chain_work.as_entire_binding(),
+            Intersections => f.intersections.as_entire_binding(),
             Ids => wgpu::BindingResource::TextureView(sources.ids.ok_or_else(|| missing(r))?),
             HostDepth => {
                 wgpu::BindingResource::TextureView(sources.host_depth.ok_or_else(|| missing(r))?)
@@ -476,6 +479,7 @@ mod tests {
             "tiles" => Tiles,
             "chains" => Chains,
             "chain_work" => ChainWork,
+            "intersections" => Intersections,
             "host_source" => HostSource,
             "host" => HostParams,
             "host_out" => HostOut,

@@ -516,7 +516,8 @@ impl DeferredPass {
         };
         let variant = self.variant(frame);
         if variant.outlines {
-            self.outline.warm_up(device, variant)?;
+            let intersections = frame.data.intersections() > 0;
+            self.outline.warm_up(device, variant, intersections)?;
         }
         self.edge.pipelines(device, mode, variant)?;
         Ok(())

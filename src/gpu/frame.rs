@@ -40,8 +40,10 @@ pub(crate) struct FrameUniforms {
     sections: [[f32; 4]; MAX_SECTIONS],
     sections_on: u32,
     section_width: f32,
-    _pad_sections: [u32; 2],
+    intersections: u32,
+    intersection_width: f32,
     section_line_color: [f32; 4],
+    intersection_line_color: [f32; 4],
 }
 
 /// Mirror of WGSL `struct Instance`; field order and padding match it.
@@ -167,6 +169,7 @@ pub fn guard_band(scene: &Scene<'_>, style: &Style) -> u32 {
         .flatten()
         .chain(style.outline_width)
         .chain((!scene.sections.is_empty()).then(|| style.section_width()))
+        .chain(style.intersection_lines.then(|| style.intersection_width()))
         .fold(style.line_width, f32::max);
     (crate::style::line_reach(f64::from(widest)).ceil() as u32).saturating_add(2)
 }
@@ -212,6 +215,9 @@ pub(crate) struct FrameData {
     /// The instances whose chains' pattern positions `chain_phases` finds ([`ChainWork`]),
     /// at least one (empty) entry, for binding.
     pub chain_work: wgpu::Buffer,
+    /// The frame's intersection segments ([`IntersectionRecord`]), at least one (empty)
+    /// record, for binding.
+    pub intersections: wgpu::Buffer,
     /// Whether the instance buffer can be bound as a uniform array of
     /// [`UNIFORM_INSTANCE_CAPACITY`] records.
     pub uniform_instances: bool,
@@ -236,6 +242,21 @@ pub(crate) struct FrameRecords {
     pub patterns: bool,
     pub mixed_colors: bool,
     pub chain_work: Vec<ChainWork>,
+    pub intersections: Vec<IntersectionRecord>,
+}
+
+/// One intersection segment of a frame (`struct Intersection` in outline.wgsl): where
+/// triangles `t` and `u` of the instance in `slot` cross, its ends `a`, `b` in the
+/// instance's local (stored) coordinates.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub(crate) struct IntersectionRecord {
+    a: [f32; 3],
+    slot: u32,
+    b: [f32; 3],
+    t: u32,
+    u: u32,
+    _pad: [u32; 3],
 }
 
 /// An instance whose drawn edges' chains carry a dashed or dotted hidden-line pattern: its
@@ -437,10 +458,33 @@ impl FrameRecords {
             .ok()
             .filter(|_| u32::try_from(chains).is_ok())
             .ok_or_else(too_many_chains)?;
+        // Intersection lines: every crossing pair of every instance's mesh.
+        let mut intersections = Vec::new();
+        if style.intersection_lines {
+            for (slot, &i) in order.iter().enumerate() {
+                let mesh = store.record(scene.instances[i as usize].mesh)?;
+                intersections.extend(mesh.intersections.iter().map(|c| IntersectionRecord {
+                    a: c.ends[0],
+                    slot: slot as u32,
+                    b: c.ends[1],
+                    t: c.t,
+                    u: c.u,
+                    _pad: [0; 3],
+                }));
+            }
+        }
+        let intersections_count = u32::try_from(intersections.len()).map_err(|_| {
+            Error::InvalidScene(format!(
+                "{} intersection segments over all instances",
+                intersections.len()
+            ))
+        })?;
+        outlines |= !intersections.is_empty();
         // The edge pass must know whose line, and of which class, each outline-pass pixel
         // holds where colours differ between instances or between an outline and its edges.
         // Likewise for hidden lines whose colours differ between instances.
         let mixed_colors = !scene.sections.is_empty()
+            || !intersections.is_empty()
             || records
                 .windows(2)
                 .any(|w| w[0].wire_color != w[1].wire_color)
@@ -502,8 +546,10 @@ impl FrameRecords {
             sections: section_planes(&view, &scene.sections)?,
             sections_on: u32::from(!scene.sections.is_empty()),
             section_width: style.section_width(),
-            _pad_sections: [0; 2],
+            intersections: intersections_count,
+            intersection_width: style.intersection_width(),
             section_line_color: style.section_line_color.0,
+            intersection_line_color: style.intersection_line_color.0,
         };
         Ok(FrameRecords {
             uniforms,
@@ -519,6 +565,7 @@ impl FrameRecords {
             patterns,
             mixed_colors,
             chain_work,
+            intersections,
         })
     }
 }
@@ -579,6 +626,7 @@ impl FrameData {
             region,
             mixed_colors,
             chain_work,
+            intersections,
         } = built;
         let frame = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("wirepass frame"),
@@ -614,10 +662,23 @@ impl FrameData {
             contents: &work,
             usage: wgpu::BufferUsages::STORAGE,
         });
+        let mut segments: Vec<u8> = bytemuck::cast_slice(&intersections).to_vec();
+        segments.resize(
+            segments
+                .len()
+                .max(std::mem::size_of::<IntersectionRecord>()),
+            0,
+        );
+        let intersections = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("wirepass intersections"),
+            contents: &segments,
+            usage: wgpu::BufferUsages::STORAGE,
+        });
         FrameData {
             uniforms,
             frame,
             chain_work,
+            intersections,
             instances,
             draws,
             order,
@@ -642,6 +703,11 @@ impl FrameData {
     /// Whether the frame has section planes.
     pub fn sections(&self) -> bool {
         self.uniforms.sections_on != 0
+    }
+
+    /// The frame's intersection segments.
+    pub fn intersections(&self) -> u32 {
+        self.uniforms.intersections
     }
 
     /// Words of the outline buffer's phase tables, and the chains `chain_phases` visits.
@@ -774,7 +840,8 @@ mod tests {
     fn records_match_their_wgsl_layout() {
         assert_eq!(std::mem::size_of::<InstanceRecord>(), 272);
         assert!(u64::from(UNIFORM_INSTANCE_CAPACITY) * INSTANCE_BYTES <= 65536);
-        assert_eq!(std::mem::size_of::<FrameUniforms>(), 320);
+        assert_eq!(std::mem::size_of::<FrameUniforms>(), 336);
+        assert_eq!(std::mem::size_of::<IntersectionRecord>(), 48);
         let r = InstanceRecord::zeroed_for_test();
         let base = &r as *const _ as usize;
         assert_eq!(
@@ -842,6 +909,7 @@ mod tests {
             bounds: (DVec3::ZERO, DVec3::ZERO),
             lines: Default::default(),
             bounds_of_clusters: vec![].into(),
+            intersections: vec![].into(),
         };
         let transform = DMat4::from_scale_rotation_translation(
             DVec3::new(-1.0, 2.0, 0.5),

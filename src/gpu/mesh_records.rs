@@ -42,6 +42,16 @@ pub(crate) struct MeshData {
     pub order: Arc<[u32]>,
     pub bounds: (DVec3, DVec3),
     pub chains: ChainRecords,
+    pub intersections: Arc<[StoredCrossing]>,
+}
+
+/// Two triangles of a mesh that cross ([`Mesh::intersections`]) as the outline pass draws
+/// their intersection line: their stored ids, and the segment's ends in stored coordinates.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct StoredCrossing {
+    pub t: u32,
+    pub u: u32,
+    pub ends: [[f32; 3]; 2],
 }
 
 impl MeshData {
@@ -89,7 +99,17 @@ impl MeshData {
             .collect();
         let bounds: Arc<[[f32; 8]]> = bounds.into();
         let edges = EdgeData::new(mesh, edges, &order);
+        let intersections = mesh
+            .intersections()
+            .iter()
+            .map(|c| StoredCrossing {
+                t: stored[c.t as usize],
+                u: stored[c.u as usize],
+                ends: c.ends.map(|p| ((p - origin) / scale).as_vec3().to_array()),
+            })
+            .collect();
         MeshData {
+            intersections,
             vertices,
             indices,
             neighbours,

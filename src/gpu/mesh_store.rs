@@ -18,7 +18,9 @@
 // `!(a > b)` is deliberate throughout: NaN must take the rejecting branch.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-use super::mesh_records::{cluster_records, EdgeData, MeshData, MeshLines, MAX_MESH_TRIANGLES};
+use super::mesh_records::{
+    cluster_records, EdgeData, MeshData, MeshLines, StoredCrossing, MAX_MESH_TRIANGLES,
+};
 use crate::error::{Error, Result};
 use crate::mesh::{EdgeSelection, Mesh};
 use glam::{DMat4, DVec3};
@@ -73,6 +75,8 @@ pub(crate) struct MeshRecord {
     pub lines: MeshLines,
     /// Per cluster, its bounds without the splat flag (see [`cluster_records`]).
     pub bounds_of_clusters: Arc<[[f32; 8]]>,
+    /// Its crossing triangles and their intersection lines.
+    pub intersections: Arc<[StoredCrossing]>,
 }
 
 impl MeshRecord {
@@ -322,6 +326,7 @@ impl MeshStore {
             bounds: data.bounds,
             lines: data.lines,
             bounds_of_clusters: data.bounds_of_clusters,
+            intersections: data.intersections,
         };
         let slot = match self.free_slots.pop() {
             Some(s) => s,

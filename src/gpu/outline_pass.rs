@@ -3,7 +3,8 @@
 //! pixel within reach of their visible runs. Three dispatches: a cull of the clusters that
 //! may hold such an edge, one invocation per listed triangle listing the edges' pieces, one
 //! per piece drawing it; before them, for dashed or dotted lines, one invocation per chain
-//! of drawn edges finding where the patterns stand along it.
+//! of drawn edges finding where the patterns stand along it; after them, with intersection
+//! lines, one invocation per intersection segment drawing it.
 
 use super::bindings::{self, dispatch, store_resources, Compute, Res, Size, Sources};
 use super::frame::FrameData;
@@ -12,7 +13,7 @@ use super::variants::Variant;
 use super::{shaders, GpuTimer};
 use crate::error::{Error, Result};
 use std::collections::HashMap;
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, OnceLock};
 
 /// Workgroup size of the outline pass.
 const GROUP: u32 = 64;
@@ -25,6 +26,11 @@ struct OutlinePipelines {
     pieces: Compute,
     /// Finds the patterns' positions along every chain (PATTERNS).
     phases: Option<Compute>,
+    /// Draws the intersection segments, one a lane: built on first use, as few frames
+    /// draw them.
+    intersections: OnceLock<Compute>,
+    module: wgpu::ShaderModule,
+    resources: Vec<Res>,
 }
 
 /// Where the piece dispatch's size lies in a frame's cluster list buffer: after the cluster
@@ -41,9 +47,39 @@ pub(crate) struct OutlinePass {
 }
 
 impl OutlinePass {
-    /// Builds the pipelines of variant `v` now, if they are not built yet.
-    pub(crate) fn warm_up(&self, device: &wgpu::Device, v: Variant) -> Result<()> {
-        self.pipelines(device, v).map(drop)
+    /// Builds the pipelines of variant `v` now (with `intersections`, the intersection
+    /// lines' too), if they are not built yet.
+    pub(crate) fn warm_up(
+        &self,
+        device: &wgpu::Device,
+        v: Variant,
+        intersections: bool,
+    ) -> Result<()> {
+        let p = self.pipelines(device, v)?;
+        if intersections {
+            self.intersections(device, &p)?;
+        }
+        Ok(())
+    }
+
+    /// The intersection lines' pipeline of the set `p`, built on first use.
+    fn intersections<'p>(
+        &self,
+        device: &wgpu::Device,
+        p: &'p OutlinePipelines,
+    ) -> Result<&'p Compute> {
+        if let Some(c) = p.intersections.get() {
+            return Ok(c);
+        }
+        let scope = crate::gpu::validation::Validation::begin(device);
+        let entry = "intersection_main";
+        let c = Compute::new(device, &p.module, entry, p.resources.clone(), self.format)?;
+        if let Some(e) = scope.end() {
+            return Err(Error::Device(format!(
+                "building the intersection lines: {e}"
+            )));
+        }
+        Ok(p.intersections.get_or_init(|| c))
     }
 
     /// How many pipeline sets the cache holds.
@@ -97,6 +133,8 @@ impl OutlinePass {
             draw_res.clone(),
             self.format,
         )?;
+        let mut resources = draw_res.clone();
+        resources.push(Res::Intersections);
         draw_res.push(Res::Cull);
         let draw = Compute::new(device, &module, "outline_main", draw_res, self.format)?;
         let phases = if v.patterns {
@@ -127,6 +165,9 @@ impl OutlinePass {
             draw,
             pieces,
             phases,
+            intersections: OnceLock::new(),
+            module,
+            resources,
         });
         cache.insert(v, p.clone());
         Ok(p)
@@ -183,7 +224,20 @@ impl OutlinePass {
         encoder.copy_buffer_to_buffer(&t.acc, t.acc_pieces, list, size_at, LIST_HEADER);
         let names = ("wirepass outline pieces", "outline.pieces");
         let size = Size::Indirect(list, size_at);
-        dispatch(encoder, timer, names, (&p.pieces, &pieces), size);
+        dispatch(
+            encoder,
+            timer.as_deref_mut(),
+            names,
+            (&p.pieces, &pieces),
+            size,
+        );
+        let segments = data.intersections();
+        if segments > 0 {
+            let pipeline = self.intersections(device, &p)?;
+            let group = pipeline.bind(device, sources)?;
+            let names = ("wirepass intersection lines", "outline.intersections");
+            dispatch(encoder, timer, names, (pipeline, &group), grid(segments));
+        }
         Ok(())
     }
 }

@@ -9,17 +9,48 @@
 //! through itself). Coplanar triangles never cross. The test is in f64 with a tolerance of
 //! 1e-9 of the mesh's size, so it errs towards "crossing" only for contacts far below a pixel,
 //! which costs the exact (outline-pass) path, never a wrong line.
+//!
+//! Where two triangles cross, they meet along a segment: together, the segments are the
+//! mesh's intersection lines ([`Style::intersection_lines`](crate::Style::intersection_lines)),
+//! the curves where its surfaces pass through each other.
 
 use glam::{DVec3, U64Vec3, Vec3};
 
 use super::par::*;
 
+/// Two triangles of a mesh that cross (`t < u`), and the segment along which they meet, in
+/// the mesh's coordinates.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Crossing {
+    /// The lower triangle id.
+    pub t: u32,
+    /// The higher.
+    pub u: u32,
+    /// The segment's ends.
+    pub ends: [DVec3; 2],
+}
+
 /// Per triangle, whether it crosses another triangle of the mesh.
 pub fn crossing_triangles(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<bool> {
+    flag_crossing(triangles.len(), &crossings(positions, triangles))
+}
+
+/// Per triangle of `count`, whether one of `crossings` holds it.
+pub fn flag_crossing(count: usize, crossings: &[Crossing]) -> Vec<bool> {
+    let mut crossing = vec![false; count];
+    for c in crossings {
+        crossing[c.t as usize] = true;
+        crossing[c.u as usize] = true;
+    }
+    crossing
+}
+
+/// The pairs of triangles of a mesh that cross, each once (`t < u`), sorted, with the
+/// segments along which they meet.
+pub fn crossings(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Crossing> {
     let n = triangles.len();
-    let mut crossing = vec![false; n];
     if n < 2 {
-        return crossing;
+        return Vec::new();
     }
     let corners = |t: usize| triangles[t].map(|v| positions[v as usize].as_dvec3());
     let boxes: Vec<[DVec3; 2]> = (0..n)
@@ -34,8 +65,8 @@ pub fn crossing_triangles(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<boo
             (lo.min(b[0]), hi.max(b[1]))
         });
     let size = (hi - lo).max_element();
-    if size <= 0.0 {
-        return crossing;
+    if !(size > 0.0) {
+        return Vec::new();
     }
     let tolerance = 1e-9 * size;
     // A grid of cells about the size of a typical triangle (the median of their largest
@@ -90,10 +121,13 @@ pub fn crossing_triangles(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<boo
         let (a, b) = (boxes[t], boxes[u]);
         a[0].cmple(b[1] + tolerance).all() && b[0].cmple(a[1] + tolerance).all()
     };
-    let test = |t: usize, u: usize| {
-        overlap(t, u)
-            && !shares_an_edge(triangles[t], triangles[u], positions)
-            && cross(corners(t), corners(u), tolerance)
+    let test = |t: usize, u: usize| -> Option<Crossing> {
+        if !overlap(t, u) || shares_an_edge(triangles[t], triangles[u], positions) {
+            return None;
+        }
+        let ends = crossing_segment(corners(t), corners(u), tolerance)?;
+        let (t, u) = (t.min(u) as u32, t.max(u) as u32);
+        Some(Crossing { t, u, ends })
     };
     // Runs of one cell; a pair is tested in the cell that holds the low corner of its boxes'
     // overlap, so once however many cells both span.
@@ -105,7 +139,7 @@ pub fn crossing_triangles(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<boo
             start = i;
         }
     }
-    let found: Vec<Vec<(u32, u32)>> = runs
+    let found: Vec<Vec<Crossing>> = runs
         .par_iter()
         .map(|run| {
             let run = &entries[run.clone()];
@@ -115,8 +149,8 @@ pub fn crossing_triangles(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<boo
                 for &(_, u) in &run[i + 1..] {
                     let (t, u) = (t as usize, u as usize);
                     let low = boxes[t][0].max(boxes[u][0]);
-                    if key(cell_of(low).min(spans[t].1).min(spans[u].1)) == here && test(t, u) {
-                        pairs.push((t as u32, u as u32));
+                    if key(cell_of(low).min(spans[t].1).min(spans[u].1)) == here {
+                        pairs.extend(test(t, u));
                     }
                 }
             }
@@ -127,20 +161,18 @@ pub fn crossing_triangles(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<boo
     for &t in &large {
         is_large[t] = true;
     }
-    let big: Vec<Vec<(u32, u32)>> = large
+    let big: Vec<Vec<Crossing>> = large
         .par_iter()
         .map(|&t| {
             (0..n)
-                .filter(|&u| u != t && (!is_large[u] || u > t) && test(t, u))
-                .map(|u| (t as u32, u as u32))
+                .filter(|&u| u != t && (!is_large[u] || u > t))
+                .filter_map(|u| test(t, u))
                 .collect()
         })
         .collect();
-    for (t, u) in found.into_iter().chain(big).flatten() {
-        crossing[t as usize] = true;
-        crossing[u as usize] = true;
-    }
-    crossing
+    let mut all: Vec<Crossing> = found.into_iter().chain(big).flatten().collect();
+    all.sort_unstable_by_key(|c| (c.t, c.u));
+    all
 }
 
 /// Whether two triangles share two corners by position (an edge, welded or not).
@@ -155,9 +187,14 @@ fn shares_an_edge(t: [u32; 3], u: [u32; 3], positions: &[Vec3]) -> bool {
 /// Whether triangles `t` and `u` meet in more than a point (by more than `tolerance`),
 /// coplanar ones never.
 pub fn cross(t: [DVec3; 3], u: [DVec3; 3], tolerance: f64) -> bool {
-    let (Some(nt), Some(nu)) = (plane(t), plane(u)) else {
-        return false;
-    };
+    crossing_segment(t, u, tolerance).is_some()
+}
+
+/// The segment along which triangles `t` and `u` meet, where they meet in more than a point
+/// (by more than `tolerance`); coplanar ones never. Its ends are where one triangle's edges
+/// pass through the other's plane, or the other's edges through the first's.
+pub fn crossing_segment(t: [DVec3; 3], u: [DVec3; 3], tolerance: f64) -> Option<[DVec3; 2]> {
+    let (nt, nu) = (plane(t)?, plane(u)?);
     let side = |n: DVec3, origin: DVec3, p: [DVec3; 3]| {
         p.map(|q| {
             let d = n.dot(q - origin);
@@ -173,15 +210,14 @@ pub fn cross(t: [DVec3; 3], u: [DVec3; 3], tolerance: f64) -> bool {
     let apart = |d: [f64; 3]| d.iter().all(|&x| x > 0.0) || d.iter().all(|&x| x < 0.0);
     let flat = |d: [f64; 3]| d.iter().all(|&x| x == 0.0);
     if apart(du) || apart(dt) || flat(du) || flat(dt) {
-        return false;
+        return None;
     }
-    let Some(along) = nt.cross(nu).try_normalize() else {
-        return false;
-    };
-    let (Some(a), Some(b)) = (span(t, dt, along), span(u, du, along)) else {
-        return false;
-    };
-    a.1.min(b.1) - a.0.max(b.0) > tolerance
+    let along = nt.cross(nu).try_normalize()?;
+    let (a, b) = (span(t, dt, along)?, span(u, du, along)?);
+    // The overlap of the two intervals, each end taken from the triangle that bounds it.
+    let start = if a.0 .0 >= b.0 .0 { a.0 } else { b.0 };
+    let end = if a.1 .0 <= b.1 .0 { a.1 } else { b.1 };
+    (end.0 - start.0 > tolerance).then_some([start.1, end.1])
 }
 
 /// A triangle's unit normal, none for a degenerate one.
@@ -190,14 +226,20 @@ fn plane(p: [DVec3; 3]) -> Option<DVec3> {
 }
 
 /// Where triangle `p`, its corners at signed distances `d` from another plane, meets that
-/// plane: the interval of positions along `along` (none when it does not meet it).
-fn span(p: [DVec3; 3], d: [f64; 3], along: DVec3) -> Option<(f64, f64)> {
-    let mut lo = f64::INFINITY;
-    let mut hi = f64::NEG_INFINITY;
+/// plane: the interval of positions along `along`, each end with its point (none when it
+/// does not meet it).
+#[allow(clippy::type_complexity)]
+fn span(p: [DVec3; 3], d: [f64; 3], along: DVec3) -> Option<((f64, DVec3), (f64, DVec3))> {
+    let mut lo = (f64::INFINITY, DVec3::ZERO);
+    let mut hi = (f64::NEG_INFINITY, DVec3::ZERO);
     let mut take = |q: DVec3| {
         let s = along.dot(q);
-        lo = lo.min(s);
-        hi = hi.max(s);
+        if s < lo.0 {
+            lo = (s, q);
+        }
+        if s > hi.0 {
+            hi = (s, q);
+        }
     };
     for i in 0..3 {
         let j = (i + 1) % 3;
@@ -208,7 +250,7 @@ fn span(p: [DVec3; 3], d: [f64; 3], along: DVec3) -> Option<(f64, f64)> {
             take(p[i] + (p[j] - p[i]) * (d[i] / (d[i] - d[j])));
         }
     }
-    (lo <= hi).then_some((lo, hi))
+    (lo.0 <= hi.0).then_some((lo, hi))
 }
 
 #[cfg(test)]
@@ -247,6 +289,32 @@ mod tests {
         box_mesh(Vec3::ZERO, 1.0, &mut p, &mut t);
         box_mesh(Vec3::new(2.5, 0.3, 0.2), 1.0, &mut p, &mut t);
         assert!(crossing_triangles(&p, &t).iter().all(|&c| !c));
+    }
+
+    /// Two boxes through each other meet along six straight pieces of their faces, 8.0
+    /// long in all (worked out by hand from the boxes' faces); every segment lies on both
+    /// surfaces.
+    #[test]
+    fn boxes_through_each_other_meet_along_their_intersection_curve() {
+        let (mut p, mut t) = (Vec::new(), Vec::new());
+        box_mesh(Vec3::ZERO, 1.0, &mut p, &mut t);
+        // (Its corners are f32: within 1e-6 of the f64 box.)
+        let (c, h) = (DVec3::new(1.5, 0.3, 0.2), 1.0);
+        box_mesh(c.as_vec3(), h as f32, &mut p, &mut t);
+        let found = crossings(&p, &t);
+        let length: f64 = found.iter().map(|c| c.ends[0].distance(c.ends[1])).sum();
+        assert!((length - 8.0).abs() < 1e-6, "{length}");
+        // On a box's surface: inside or on it, and on one of its faces.
+        let on_box = |q: DVec3, centre: DVec3, half: f64| {
+            let r = (q - centre).abs();
+            (r.max_element() - half).abs() < 1e-6
+        };
+        for k in &found {
+            assert!(k.t < 12 && k.u >= 12, "{k:?}");
+            for q in k.ends {
+                assert!(on_box(q, DVec3::ZERO, 1.0) && on_box(q, c, h), "{q}");
+            }
+        }
     }
 
     /// The grid finds what testing every pair finds, on a soup of small triangles and large

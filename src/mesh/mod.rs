@@ -114,8 +114,9 @@ pub struct Mesh {
     /// Per cluster of triangles, what lets the outline pass skip it: see
     /// [`Mesh::outline_clusters`].
     outline_clusters: std::sync::OnceLock<clusters::Clusters>,
-    /// Per triangle, whether it crosses another: see [`Mesh::crossings`].
-    crossings: std::sync::OnceLock<Vec<bool>>,
+    /// The crossing pairs, and per triangle whether it crosses another: see
+    /// [`Mesh::crossings`].
+    crossings: std::sync::OnceLock<(Vec<crossings::Crossing>, Vec<bool>)>,
 }
 
 impl Mesh {
@@ -361,8 +362,21 @@ impl Mesh {
     /// Per triangle, whether it crosses another triangle of the mesh (the mesh passes through
     /// itself there): see [`crossings::crossing_triangles`]. Computed once, on first use.
     pub fn crossings(&self) -> &[bool] {
-        self.crossings
-            .get_or_init(|| crossings::crossing_triangles(&self.positions, &self.triangles))
+        &self.crossing_pairs().1
+    }
+
+    /// The pairs of triangles that cross, and the segments along which they meet: the
+    /// mesh's intersection lines ([`crossings::crossings`]). Computed once, on first use.
+    pub fn intersections(&self) -> &[crossings::Crossing] {
+        &self.crossing_pairs().0
+    }
+
+    fn crossing_pairs(&self) -> &(Vec<crossings::Crossing>, Vec<bool>) {
+        self.crossings.get_or_init(|| {
+            let pairs = crossings::crossings(&self.positions, &self.triangles);
+            let flags = crossings::flag_crossing(self.triangles.len(), &pairs);
+            (pairs, flags)
+        })
     }
 
     /// The triangles in clusters of [`clusters::CLUSTER_TRIANGLES`] nearby ones, with bounds

@@ -20,6 +20,11 @@
 //! hidden parts runs along each chain of drawn edges (`src/mesh/chains.rs`): an edge's
 //! dashes start where the chain's projected length before it leaves the pattern.
 //!
+//! With intersection lines on ([`Style::intersection_lines`](crate::Style::intersection_lines)),
+//! the segments along which an object's crossing triangles meet
+//! ([`Mesh::intersections`](crate::Mesh::intersections)) are drawn where visible, hidden by
+//! any surface but the two they lie on.
+//!
 //! Visibility along an edge is found by casting a ray through points every 1/8 pixel of its
 //! projection and bisecting each change to 2⁻³⁰ of the edge. The GPU pass does the same at
 //! 1/4 pixel, testing each point against the triangles rasterized around it instead of a ray
@@ -98,6 +103,8 @@ struct Stretch {
     outline: bool,
     /// A section's cut line.
     cut: bool,
+    /// An intersection line.
+    intersection: bool,
     /// A hidden line drawn over the host's surface ([`HiddenLines::behind_host`]).
     ///
     /// [`HiddenLines::behind_host`]: crate::HiddenLines::behind_host
@@ -114,6 +121,8 @@ struct Draw {
     outline: bool,
     /// A cut line: where section plane k meets the triangle.
     cut: Option<usize>,
+    /// An intersection line: crossing k of the mesh ([`crate::Mesh::intersections`]).
+    crossing: Option<usize>,
     /// How the eye's ray reaches it, in a frame with section planes ([`capped`]).
     cap: Cap,
 }
@@ -152,7 +161,10 @@ pub(crate) fn outline_map(
         .objects
         .iter()
         .enumerate()
-        .filter(|(o, _)| styles[*o].outlines || styles[*o].edges || styles[*o].sectioned)
+        .filter(|(o, _)| {
+            let s = &styles[*o];
+            s.outlines || s.edges || s.sectioned || shot.style.intersection_lines
+        })
         .flat_map(|(o, object)| {
             let hidden = styles[o].hidden;
             let hidden_edges = hidden.is_some_and(|h| h.edges);
@@ -164,6 +176,7 @@ pub(crate) fn outline_map(
                 styles[o].width,
                 styles[o].outline_width,
                 styles[o].section_width,
+                f64::from(shot.style.intersection_width()),
             );
             let patterns = (styles[o].edge_pattern, styles[o].outline_pattern);
             let tris = mesh.triangles();
@@ -175,6 +188,7 @@ pub(crate) fn outline_map(
                     hidden: hidden.is_some(),
                     outline: true,
                     cut: None,
+                    crossing: None,
                     cap: Cap::None,
                 };
                 edges.extend(outline_edges(mesh, local).into_iter().map(|e| (e, outline)));
@@ -186,6 +200,7 @@ pub(crate) fn outline_map(
                     hidden: hidden_edges,
                     outline: false,
                     cut: None,
+                    crossing: None,
                     cap: Cap::None,
                 };
                 edges.extend(splat.iter().enumerate().flat_map(|(t, &bits)| {
@@ -203,6 +218,7 @@ pub(crate) fn outline_map(
                     hidden: hidden_edges,
                     outline: false,
                     cut: None,
+                    crossing: None,
                     cap: Cap::None,
                 };
                 edges.extend((0..tris.len() as u32).flat_map(|t| {
@@ -227,10 +243,26 @@ pub(crate) fn outline_map(
                                 hidden: false,
                                 outline: false,
                                 cut: Some(k),
+                                crossing: None,
                                 cap: Cap::None,
                             };
                             ((t, 3 + k as u32), draw)
                         })
+                }));
+            }
+            // Intersection lines, each (lower triangle, 3 + MAX_SECTIONS + crossing).
+            if shot.style.intersection_lines {
+                let first_key = 3 + crate::scene::MAX_SECTIONS as u32;
+                edges.extend(mesh.intersections().iter().enumerate().map(|(k, c)| {
+                    let draw = Draw {
+                        visible: true,
+                        hidden: false,
+                        outline: false,
+                        cut: None,
+                        crossing: Some(k),
+                        cap: Cap::None,
+                    };
+                    ((c.t, first_key + k as u32), draw)
                 }));
             }
             // One entry per edge, drawing all that any of its entries asks.
@@ -261,6 +293,18 @@ pub(crate) fn outline_map(
             merged
                 .into_par_iter()
                 .map(move |((t, i), draw)| {
+                    if let Some(k) = draw.crossing {
+                        let c = mesh.intersections()[k];
+                        let ends = c.ends.map(|p| object.transform.transform_point3(p));
+                        let lines = (([0.0; 2], (0.0, true)), (0.0, true));
+                        return view.stretches(
+                            first,
+                            (c.t, c.u, (ends[0], ends[1])),
+                            (o as u32, widths),
+                            draw,
+                            (lines, None),
+                        );
+                    }
                     if let Some(k) = draw.cut {
                         let corners = caster.corners(first + t);
                         let ends = cut_segment(corners, &world.sections[k]).unwrap_or_default();
@@ -382,11 +426,13 @@ fn splat(
                         object: s.object,
                         outline: s.outline,
                         cut: s.cut,
+                        intersection: s.intersection,
                     };
                     // The greatest key gives the distance and intensity; whose line it is
                     // (object and class) goes, as the GPU's owner word does, to the greatest
-                    // (intensity level, outline), the greatest key among equals.
-                    let owner = |l: &Line| (l.key >> 20, l.outline, l.cut);
+                    // (intensity level, class: intersection, outline, cut, edge), the
+                    // greatest key among equals.
+                    let owner = |l: &Line| (l.key >> 20, l.intersection, l.outline, l.cut);
                     *out = Some(match *out {
                         None => line,
                         Some(l) => {
@@ -396,6 +442,7 @@ fn splat(
                                     object: other.object,
                                     outline: other.outline,
                                     cut: other.cut,
+                                    intersection: other.intersection,
                                     ..keep
                                 }
                             } else {
@@ -534,7 +581,10 @@ impl Visibility<'_> {
         &self,
         first: u32,
         (t, n, (a, b)): (u32, u32, (DVec3, DVec3)),
-        (object, (edge_width, outline_width, section_width)): (u32, (f64, f64, f64)),
+        (object, (edge_width, outline_width, section_width, intersection_width)): (
+            u32,
+            (f64, f64, f64, f64),
+        ),
         draw: Draw,
         (((visible_pattern, visible_anchor), hidden_anchor), hidden): (
             (([f64; 2], (f64, bool)), (f64, bool)),
@@ -550,6 +600,8 @@ impl Visibility<'_> {
         let size = self.rays.size();
         let width = if draw.cut.is_some() {
             section_width
+        } else if draw.crossing.is_some() {
+            intersection_width
         } else if draw.outline {
             outline_width
         } else {
@@ -610,7 +662,7 @@ impl Visibility<'_> {
         }
         runs.push((start, u.1, last.1));
 
-        let cut = draw.cut.is_some();
+        let (cut, intersection) = (draw.cut.is_some(), draw.crossing.is_some());
         let stretch = |(k0, k1): (f64, f64), width: f64, (outline, over_host): (bool, bool)| {
             let (q0, q1) = (point(k0), point(k1));
             Stretch {
@@ -623,6 +675,7 @@ impl Visibility<'_> {
                 width,
                 outline,
                 cut,
+                intersection,
                 over_host,
             }
         };

@@ -60,6 +60,8 @@ fn class_of(l: &Line) -> LineClass {
         LineClass::Outline
     } else if l.cut {
         LineClass::Cut
+    } else if l.intersection {
+        LineClass::Intersection
     } else {
         LineClass::Edge
     }
@@ -222,6 +224,7 @@ struct Shading {
     /// lines (linear RGBA).
     section_color: [f64; 3],
     section_line: [f64; 4],
+    intersection_line: [f64; 4],
 }
 
 impl Shading {
@@ -237,6 +240,7 @@ impl Shading {
             fill_opacity: f64::from(s.fill_opacity),
             section_color: [0, 1, 2].map(|k| f64::from(s.section_color.0[k])),
             section_line: s.section_line_color.0.map(f64::from),
+            intersection_line: s.intersection_line_color.0.map(f64::from),
         }
     }
 }
@@ -261,6 +265,8 @@ impl Truth<'_> {
             st.outline
         } else if l.cut {
             self.shading.section_line
+        } else if l.intersection {
+            self.shading.intersection_line
         } else {
             st.wire
         }

@@ -662,4 +662,6 @@ pub struct Line {
     pub outline: bool,
     /// Whether it is a section's cut line (drawn in the section line colour).
     pub cut: bool,
+    /// Whether it is an intersection line (drawn in the intersection line colour).
+    pub intersection: bool,
 }

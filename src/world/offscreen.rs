@@ -204,10 +204,10 @@ pub async fn read_rendering(
         .map(|w| [w[0], w[1]])
         .collect();
     let mut r = maps_rendering(shot, (size, up), order, rgba, &raw, &diagnostic)?;
-    // The a channel: 0..=4 as `LineClass`.
+    // The a channel: 0..=5 as `LineClass`.
     r.line_class = diagnostic
         .iter()
-        .map(|t| t[3].clamp(0.0, 4.0) as u8)
+        .map(|t| t[3].clamp(0.0, 5.0) as u8)
         .collect();
     Ok(r)
 }
