@@ -65,7 +65,7 @@ pub fn crossings(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Crossing> {
             (lo.min(b[0]), hi.max(b[1]))
         });
     let size = (hi - lo).max_element();
-    if !(size > 0.0) {
+    if size <= 0.0 {
         return Vec::new();
     }
     let tolerance = 1e-9 * size;

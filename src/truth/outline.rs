@@ -1184,6 +1184,7 @@ mod tests {
             hidden: true,
             outline: true,
             cut: None,
+            crossing: None,
             cap: Cap::None,
         };
         let hidden = crate::HiddenLines {
@@ -1196,7 +1197,7 @@ mod tests {
         let corners = caster.corners(0);
         let edge = (0, NO_NEIGHBOUR, (corners[1], corners[2]));
         let lines = (([0.0; 2], (0.0, true)), (0.0, true));
-        let widths = (0, (1.5, 1.5, 1.5));
+        let widths = (0, (1.5, 1.5, 1.5, 1.5));
         let (s, h) = vis.stretches(0, edge, widths, draw, (lines, Some(hidden)));
         assert_eq!(s.len(), 1, "{s:?}");
         let top_of_near = {
