@@ -250,6 +250,22 @@ fn instances_through_each_other() {
         perspective(DVec3::new(-3.2, 1.2, 2.0), DVec3::new(-0.8, 0.2, 0.2)),
         &hidden,
     );
+    // The mirrored Suzanne's eyes, their intersection lines drawn through its transform.
+    let crossings = Style {
+        intersection_lines: true,
+        intersection_line_width: Some(2.0),
+        ..Style::default()
+    };
+    let (_, crossing) = check(
+        "instances, intersection lines",
+        &world,
+        perspective(DVec3::new(-1.3, 0.3, 2.8), DVec3::new(-1.2, 0.15, 0.3)),
+        &crossings,
+    );
+    assert!(
+        crossing > 0,
+        "the mirrored eyes' intersection lines are drawn"
+    );
 }
 
 /// Intersection lines, where the surfaces of a mesh meet: the two boxes (thin and wide lines,
