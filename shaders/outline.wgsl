@@ -328,17 +328,23 @@ fn intersection_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num
     var c = clip_outline(s.slot, s.t, s.u, s.a, s.b, vec4<f32>(0.0, 1.0, 0.0, 1.0), NO_PLANE);
     c.seg.crossing = true;
     let reach = line_reach(frame.intersection_width);
-    let first = frame.target_origin - reach;
-    let last = frame.target_origin + frame.target_size + reach;
     for (var piece = 0u; piece < c.pieces; piece++) {
         let k0 = f32(piece) / f32(c.pieces);
         let k1 = f32(piece + 1u) / f32(c.pieces);
-        let p = mix(c.seg.start.xy, c.seg.end.xy, k0);
-        let q = mix(c.seg.start.xy, c.seg.end.xy, k1);
-        if all(max(p, q) >= first) && all(min(p, q) <= last) {
+        if piece_reaches_targets(c.seg, k0, k1, reach) {
             draw_piece(c.seg, k0, k1, c.length_px, DRAW_VISIBLE | DRAW_INTERSECTION);
         }
     }
+}
+
+// Whether the piece of `seg` between parameters k0 and k1 lies within `reach` of the
+// targets (of a tile).
+fn piece_reaches_targets(seg: Segment, k0: f32, k1: f32, reach: f32) -> bool {
+    let p = mix(seg.start.xy, seg.end.xy, k0);
+    let q = mix(seg.start.xy, seg.end.xy, k1);
+    let first = frame.target_origin - reach;
+    let last = frame.target_origin + frame.target_size + reach;
+    return all(max(p, q) >= first) && all(min(p, q) <= last);
 }
 
 // Finds the outline edges of triangle t of instance `inst` and draws them.
@@ -760,8 +766,6 @@ fn list_outline(inst: u32, t: u32, i: u32, n: u32, a: vec3<f32>, b: vec3<f32>, m
 #if HIDDEN
     reach = max(reach, select(0.0, line_reach(instances[slot(inst)].hidden_width), (mode & DRAW_HIDDEN) != 0u));
 #endif
-    let first = frame.target_origin - reach;
-    let last = frame.target_origin + frame.target_size + reach;
     let list = piece_list();
     let room = piece_room(list);
     // An item holds the piece count in 16 bits; a longer edge is drawn here whole.
@@ -769,9 +773,7 @@ fn list_outline(inst: u32, t: u32, i: u32, n: u32, a: vec3<f32>, b: vec3<f32>, m
     for (var piece = 0u; piece < c.pieces; piece++) {
         let k0 = f32(piece) / f32(c.pieces);
         let k1 = f32(piece + 1u) / f32(c.pieces);
-        let p = mix(c.seg.start.xy, c.seg.end.xy, k0);
-        let q = mix(c.seg.start.xy, c.seg.end.xy, k1);
-        if !(all(max(p, q) >= first) && all(min(p, q) <= last)) {
+        if !piece_reaches_targets(c.seg, k0, k1, reach) {
             continue;
         }
         var k = room;

@@ -655,25 +655,8 @@ impl FrameData {
             contents: &contents,
             usage,
         });
-        let mut work: Vec<u8> = bytemuck::cast_slice(&chain_work).to_vec();
-        work.resize(work.len().max(16), 0);
-        let chain_work = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("wirepass chain work"),
-            contents: &work,
-            usage: wgpu::BufferUsages::STORAGE,
-        });
-        let mut segments: Vec<u8> = bytemuck::cast_slice(&intersections).to_vec();
-        segments.resize(
-            segments
-                .len()
-                .max(std::mem::size_of::<IntersectionRecord>()),
-            0,
-        );
-        let intersections = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("wirepass intersections"),
-            contents: &segments,
-            usage: wgpu::BufferUsages::STORAGE,
-        });
+        let chain_work = storage_list(device, "wirepass chain work", &chain_work);
+        let intersections = storage_list(device, "wirepass intersections", &intersections);
         FrameData {
             uniforms,
             frame,
@@ -808,6 +791,18 @@ fn instance_record(
         edge_pattern: [0.0; 2],
         outline_pattern: [0.0; 2],
     }
+}
+
+/// A read-only storage buffer holding `items`, or one zeroed item where there are none
+/// (a binding needs a non-empty buffer).
+fn storage_list<T: bytemuck::Pod>(device: &wgpu::Device, label: &str, items: &[T]) -> wgpu::Buffer {
+    let mut contents: Vec<u8> = bytemuck::cast_slice(items).to_vec();
+    contents.resize(contents.len().max(std::mem::size_of::<T>()), 0);
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents: &contents,
+        usage: wgpu::BufferUsages::STORAGE,
+    })
 }
 
 /// `record` drawing the hidden lines `hidden`, if any.
