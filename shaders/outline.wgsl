@@ -620,8 +620,13 @@ const END_INSET: f32 = 1.0 / 256.0;
 const FOLD_STEPS: u32 = 4u;
 const RUN_BISECTIONS: u32 = 12u;
 // An edge is drawn in pieces of at most this many pixels, each with up to MAX_RUNS visible
-// runs (more is beyond any real mesh at this scale; the last run then absorbs the rest).
+// runs (more is beyond any real mesh at this scale; the last run then absorbs the rest). On
+// a GPU (SHORT_PIECES) shorter pieces give a frame's few outline edges more lanes.
+#if SHORT_PIECES
+const PIECE_PX: f32 = 1.0;
+#else
 const PIECE_PX: f32 = 16.0;
+#endif
 // Pixels this far past a line's reach still get its key (`splat_runs`); twin of
 // edge_math::REACH_SLACK.
 const REACH_SLACK: f32 = 1e-3;

@@ -100,7 +100,7 @@ pub use camera::{Camera, DepthRange, View};
 pub use error::{Error, Result};
 pub use gpu::{
     Canvas, Composite, DeferredPass, HostDepth, MeshId, MeshStore, OutputTarget, PassOptions,
-    PreparedFrame, RenderTarget, TriangleIds,
+    PreparedFrame, RenderTarget, TriangleIds, Tuning,
 };
 pub use mesh::{EdgeSelection, Mesh};
 pub use scene::{Highlight, Instance, InstanceStyle, Scene, SectionPlane, MAX_SECTIONS};

@@ -6,11 +6,14 @@ mod common;
 use common::{camera, cpu_distance, framing, gpu, load, near_crossed, shoot};
 use glam::{DMat4, Vec3};
 use wirepass::gpu::{
-    DeferredPass, EncodeOptions, MeshStore, OutputTarget, PassOptions, PreparedFrame,
+    DeferredPass, EncodeOptions, MeshStore, OutputTarget, PassOptions, PreparedFrame, Tuning,
 };
-use wirepass::tools::offline::Method;
+use wirepass::tools::compare::metrics;
+use wirepass::tools::offline::{draw_deferred_with, Method, Uploaded};
 use wirepass::world::{Rendering, BACKGROUND};
-use wirepass::{Camera, EdgeSelection, Instance, Mesh, Scene, Style};
+use wirepass::{
+    Camera, Color, EdgeSelection, HiddenLines, Instance, LinePattern, Mesh, Scene, Style,
+};
 
 /// Draws without outlines: the tests here check each triangle's own edges against the CPU
 /// definition; outlines are checked against the ground truth (tests/ground_truth.rs,
@@ -656,4 +659,131 @@ fn async_readback_reads_what_the_blocking_one_reads() {
     assert_eq!(work, awaited);
     assert!(work.tiles > 0 && work.outline_clusters > 0, "{work:?}");
     ctx.finish().unwrap();
+}
+
+/// The GPU tuning (outline edges in pieces of 1 px, the background written by a dispatch),
+/// which the software adapters the tests run on never pick by themselves, draws to the
+/// bounds the software tuning does: against the ground truth on every pixel (outlines over
+/// the background, dashed hidden lines, the eye inside, a grazing view), and the two images
+/// a step of 8 bits apart at most. It lists the outline edges in many more pieces.
+#[test]
+fn gpu_tuning_draws_what_the_software_tuning_draws() {
+    let ctx = gpu();
+    let device = &ctx.device;
+    let fandisk = load("fandisk.obj");
+    let suzanne = load("suzanne.obj");
+    let torus = wirepass::mesh::torus(3000).unwrap();
+    let size = (200, 150);
+    let hidden = |pattern| {
+        Some(HiddenLines {
+            pattern,
+            color: Color([0.8, 0.1, 0.1, 1.0]),
+            width: 1.0,
+            behind_host: false,
+            edges: true,
+        })
+    };
+    let wide = Style {
+        line_width: 3.0,
+        hidden: hidden(LinePattern::Dashed {
+            dash: 6.0,
+            gap: 4.0,
+        }),
+        ..Style::default()
+    };
+    let dotted = Style {
+        hidden: hidden(LinePattern::Dotted { spacing: 4.0 }),
+        ..Style::default()
+    };
+    // From the head's centre, up and to the side, through the eyes' sockets.
+    let (lo, hi) = suzanne.bounds();
+    let centre = (lo + hi) * 0.5;
+    let inside = camera(centre, centre + Vec3::new(-0.3, 0.4, 0.2), 1e-3, 10.0);
+    let grazing = camera(Vec3::new(3.0, 0.25, 0.4), Vec3::ZERO, 0.05, 20.0);
+    let cases = [
+        (
+            "fandisk",
+            &fandisk,
+            framing(&fandisk, size),
+            wide,
+            EdgeSelection::Feature(30.0),
+        ),
+        (
+            "suzanne inside",
+            &suzanne,
+            inside,
+            dotted,
+            EdgeSelection::Polygon,
+        ),
+        (
+            "torus grazing",
+            &torus,
+            grazing,
+            Style::default(),
+            EdgeSelection::Polygon,
+        ),
+    ];
+    for (name, mesh, cam, style, edges) in cases {
+        let scene = common::TestScene::new(mesh, cam, style, size, edges);
+        let shot = scene.shot();
+        let truth = scene.draw(Method::Raycast);
+        let up = Uploaded::new(device, &ctx.queue, shot.world).unwrap();
+        let frames = [Tuning::Software, Tuning::Gpu].map(|tuning| {
+            let options = PassOptions {
+                tuning,
+                ..PassOptions::default()
+            };
+            let pass = DeferredPass::new(device, options)
+                .unwrap()
+                .with_diagnostics();
+            let frame = draw_deferred_with(ctx, &shot, &up, pass).unwrap();
+            let m = metrics(&truth, &frame).unwrap();
+            println!("{name} {tuning:?}: {m:?}");
+            assert!(m.id_agreement >= 0.999, "{name} {tuning:?}: {m:?}");
+            for d in [&m.distance_error_px, &m.hidden_distance_error_px] {
+                assert!(d.p99.unwrap_or(0.0) <= 0.01, "{name} {tuning:?}: {m:?}");
+                assert!(d.max.unwrap_or(0.0) <= 0.1, "{name} {tuning:?}: {m:?}");
+            }
+            frame
+        });
+        let apart = (0..frames[0].ids.len())
+            .filter(|&i| common::channel_difference(&frames[0], &frames[1], i) > 1)
+            .count();
+        assert_eq!(apart, 0, "{name}: pixels more than a step apart");
+    }
+
+    // The pieces: up to a pixel of outline each on the GPU, up to 16 px in software (most of
+    // fandisk's outline edges are shorter than that here).
+    let cam = framing(&fandisk, size);
+    let aspect = f64::from(size.0) / f64::from(size.1);
+    let (store, scene) = single(&fandisk, EdgeSelection::Feature(30.0), cam.to_view(aspect));
+    let pieces = [Tuning::Software, Tuning::Gpu].map(|tuning| {
+        let options = PassOptions {
+            tuning,
+            ..PassOptions::default()
+        };
+        let mut pass = DeferredPass::new(device, options).unwrap();
+        let frame = pass
+            .prepare(device, &store, &scene, &Style::default(), size)
+            .unwrap();
+        let mut encoder = device.create_command_encoder(&Default::default());
+        use wirepass::wgpu::TextureUsages as U;
+        let usage = U::STORAGE_BINDING | U::RENDER_ATTACHMENT;
+        let out = wirepass::gpu::texture_2d(device, "out", size, pass.output_format(), usage);
+        let view = out.create_view(&Default::default());
+        pass.encode(
+            device,
+            &mut encoder,
+            &store,
+            &frame,
+            OutputTarget::Shaded(&view),
+        )
+        .unwrap();
+        ctx.queue.submit([encoder.finish()]);
+        frame.edge_work(device, &ctx.queue).unwrap().outline_pieces
+    });
+    assert!(
+        pieces[0] > 50 && 2 * pieces[1] > 3 * pieces[0],
+        "pieces {pieces:?}"
+    );
 }

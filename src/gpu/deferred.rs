@@ -59,7 +59,7 @@ pub struct EdgeWork {
     /// Clusters of 64 triangles the outline pass's cull listed (those that may hold an
     /// outline edge from the eye, or a drawn edge of a large patch), 0 where it did not run.
     pub outline_clusters: u32,
-    /// Pieces (up to 16 px) of outline edges the outline pass listed or found beyond its
+    /// Pieces (up to 16 px, or 1 px for [`Tuning::Gpu`](super::Tuning::Gpu)) of outline edges the outline pass listed or found beyond its
     /// list's room, 0 where it did not run.
     pub outline_pieces: u32,
     /// How many of them its piece list has room for; it draws the others where it finds
@@ -310,6 +310,7 @@ impl DeferredPass {
                  (Rgba8Unorm, Rgba16Float, Rgba32Float)"
             )));
         }
+        let software = options.tuning.software(device);
         let scope = crate::gpu::validation::Validation::begin(device);
         let visibility = Visibility::new(device, pulled)?;
         let composite = match &options.render_target {
@@ -329,8 +330,8 @@ impl DeferredPass {
             format,
             visibility,
             host: HostImport::new(),
-            outline: OutlinePass::new(format),
-            edge: EdgePass::new(device, format)?,
+            outline: OutlinePass::new(format, software),
+            edge: EdgePass::new(device, format, software)?,
             composite,
             results: AtomicU64::new(0),
             reset,

@@ -31,6 +31,8 @@ pub(crate) struct EdgePipelines {
 pub(crate) struct EdgePass {
     /// The format of the storage outputs.
     format: wgpu::TextureFormat,
+    /// Whether a clear lays the background down where it can ([`Tuning`](super::Tuning)).
+    clear: bool,
     cache: Mutex<HashMap<(Mode, Variant), Arc<EdgePipelines>>>,
     /// The benchmark floor's pipeline ([`OutputTarget::Floor`](super::OutputTarget::Floor)).
     #[cfg(feature = "diagnostics")]
@@ -44,12 +46,17 @@ impl EdgePass {
         self.cache.lock().map_or(0, |c| c.len())
     }
 
-    /// The pass for storage outputs of `format`; its pipelines come on first use (the
-    /// floor's, a diagnostics build's, now).
+    /// The pass for storage outputs of `format`, clearing the background where it can
+    /// (`clear`); its pipelines come on first use (the floor's, a diagnostics build's, now).
     #[cfg_attr(not(feature = "diagnostics"), allow(unused_variables))]
-    pub(crate) fn new(device: &wgpu::Device, format: wgpu::TextureFormat) -> Result<Self> {
+    pub(crate) fn new(
+        device: &wgpu::Device,
+        format: wgpu::TextureFormat,
+        clear: bool,
+    ) -> Result<Self> {
         Ok(Self {
             format,
+            clear,
             cache: Mutex::default(),
             #[cfg(feature = "diagnostics")]
             floor: Compute::new(
@@ -63,9 +70,9 @@ impl EdgePass {
     }
 
     /// The value every output pixel without a triangle or a line gets, as a clear colour,
-    /// where that is one value (Shade: the background, encoded as store_pixel encodes it;
-    /// Result: transparent) and the output `texture` can be cleared whole (RENDER_ATTACHMENT
-    /// usage, one mip level: the storage view writes that level).
+    /// where the pass clears and that is one value (Shade: the background, encoded as
+    /// store_pixel encodes it; Result: transparent) and the output `texture` can be cleared
+    /// whole (RENDER_ATTACHMENT usage, one mip level: the storage view writes that level).
     fn background_clear(
         &self,
         mode: Mode,
@@ -73,7 +80,9 @@ impl EdgePass {
         data: &FrameData,
     ) -> Option<wgpu::Color> {
         let usage = texture.usage();
-        if !usage.contains(wgpu::TextureUsages::RENDER_ATTACHMENT) || texture.mip_level_count() != 1
+        if !self.clear
+            || !usage.contains(wgpu::TextureUsages::RENDER_ATTACHMENT)
+            || texture.mip_level_count() != 1
         {
             return None;
         }

@@ -55,7 +55,7 @@ pub(crate) use frame::light_world_dir;
 pub(crate) use host_depth::depth_quantum;
 pub use mesh_store::{MeshId, MeshStore};
 // For the tools' OpenGL baseline, which draws the same store and records.
-pub use options::{OutputTarget, PassOptions, TriangleIds};
+pub use options::{OutputTarget, PassOptions, TriangleIds, Tuning};
 pub use pick::{
     EdgeSnap, InstanceHit, Location, PickView, Picked, PickedIds, RectPick, VertexSnap,
 };

@@ -43,6 +43,8 @@ pub(crate) fn piece_size_at(data: &FrameData) -> u64 {
 pub(crate) struct OutlinePass {
     /// The format the pipelines' layouts name for the (unused) colour output.
     format: wgpu::TextureFormat,
+    /// Whether outline edges are drawn in pieces of 1 px, not 16 ([`Tuning`](super::Tuning)).
+    short_pieces: bool,
     cache: Mutex<HashMap<Variant, Arc<OutlinePipelines>>>,
 }
 
@@ -88,9 +90,12 @@ impl OutlinePass {
         self.cache.lock().map_or(0, |c| c.len())
     }
 
-    pub(crate) fn new(format: wgpu::TextureFormat) -> Self {
+    /// The pass, drawing outline edges in pieces for a software rasterizer (`software`) or
+    /// for a GPU.
+    pub(crate) fn new(format: wgpu::TextureFormat, software: bool) -> Self {
         Self {
             format,
+            short_pieces: !software,
             cache: Mutex::default(),
         }
     }
@@ -104,7 +109,11 @@ impl OutlinePass {
             return Ok(p.clone());
         }
         let scope = crate::gpu::validation::Validation::begin(device);
-        let source = shaders::outline_source(&v.flags());
+        let mut flags = v.flags();
+        if self.short_pieces {
+            flags.push("SHORT_PIECES");
+        }
+        let source = shaders::outline_source(&flags);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("wirepass outline pass"),
             source: wgpu::ShaderSource::Wgsl(source.into()),
@@ -176,7 +185,7 @@ impl OutlinePass {
     /// The outline pass: `outline_cull` lists the (instance, cluster) pairs that may hold
     /// an outline edge, on a 2D grid of workgroups (huge scenes need more than one dimension
     /// allows); `outline_main` then visits their triangles, dispatched indirectly with the
-    /// size the cull leaves, and lists the pieces (up to 16 px) of their outline edges;
+    /// size the cull leaves, and lists the pieces (up to 16 px, or 1 px) of their outline edges;
     /// `outline_pieces_main` draws those, one a lane.
     pub(crate) fn encode(
         &self,

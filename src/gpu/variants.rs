@@ -184,8 +184,14 @@ pub fn shader_modules() -> Vec<(String, String)> {
         }
     }
     for v in variants.iter().filter(|v| v.outlines) {
-        let flags = v.flags();
-        out.push((format!("outline {flags:?}"), outline_source(&flags)));
+        // Both tunings (`Tuning`): SHORT_PIECES is the GPU's.
+        for short in [false, true] {
+            let mut flags = v.flags();
+            if short {
+                flags.push("SHORT_PIECES");
+            }
+            out.push((format!("outline {flags:?}"), outline_source(&flags)));
+        }
     }
     for split in [false, true] {
         for format in [
