@@ -630,6 +630,9 @@ const PIECE_PX: f32 = 16.0;
 // Pixels this far past a line's reach still get its key (`splat_runs`); twin of
 // edge_math::REACH_SLACK.
 const REACH_SLACK: f32 = 1e-3;
+// A dash reaching this many pixels past a run's end is drawn from the end (the pattern's
+// first dash starts where a chain's first edge ends); twin of edge_math::DASH_SLACK.
+const DASH_SLACK: f32 = 1e-3;
 const MAX_RUNS: u32 = 8u;
 
 // The screen segment of an outline edge, clipped to the view and the targets.
@@ -978,7 +981,7 @@ fn splat_runs(seg: Segment, k0: f32, k1: f32, runs: ptr<function, array<vec2<f32
                 if pattern.y > 0.0 && scale != 0.0 {
                     let sa = phase + scale * run.x;
                     let sb = phase + scale * run.y;
-                    let sr = dash_nearest(phase + scale * k, min(sa, sb), max(sa, sb), pattern.x, pattern.y);
+                    let sr = dash_nearest(phase + scale * k, min(sa, sb) - DASH_SLACK, max(sa, sb) + DASH_SLACK, pattern.x, pattern.y);
                     if sr == NO_EDGE {
                         continue;
                     }

@@ -152,6 +152,14 @@ pub const CAP_MARGIN: f64 = 1e-6;
 /// boundary, not for all within a slack the GPU alone allows.
 pub const REACH_SLACK: f64 = 1e-3;
 
+/// Twin of `DASH_SLACK` in outline.wgsl: a dash (or dot) of a line pattern that reaches
+/// within this many pixels of a drawn run of the line (a visible or hidden part of it, up to
+/// its edge's end) is drawn from the run's nearest point. The pattern starts with a dash at
+/// a chain's first vertex, which is where the run of its first edge ends: the two meet
+/// exactly by definition and only to rounding in f32, so without the slack a dot there is
+/// drawn or not by the last bit.
+pub const DASH_SLACK: f64 = 1e-3;
+
 /// Twin of `END_INSET` in outline.wgsl: pixels inside a line's ends at which the visibility
 /// of each end is tested. At a vertex every triangle round it agrees with the line only to
 /// rounding, so the end itself could flip to a class its line has nowhere else, and a run of

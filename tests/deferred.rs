@@ -740,9 +740,12 @@ fn gpu_tuning_draws_what_the_software_tuning_draws() {
             let m = metrics(&truth, &frame).unwrap();
             println!("{name} {tuning:?}: {m:?}");
             assert!(m.id_agreement >= 0.999, "{name} {tuning:?}: {m:?}");
+            let hidden = wirepass::truth::accuracy::hidden_distance_errors(&truth, &frame).unwrap();
+            let worst = common::worst_pixels(&truth, &frame, 0.01, 5)
+                + &common::worst_of(&truth, &frame, (&hidden, |r| &r.hidden_distance), 0.01, 5);
             for d in [&m.distance_error_px, &m.hidden_distance_error_px] {
-                assert!(d.p99.unwrap_or(0.0) <= 0.01, "{name} {tuning:?}: {m:?}");
-                assert!(d.max.unwrap_or(0.0) <= 0.1, "{name} {tuning:?}: {m:?}");
+                let within = d.p99.unwrap_or(0.0) <= 0.01 && d.max.unwrap_or(0.0) <= 0.1;
+                assert!(within, "{name} {tuning:?}: {m:?}{worst}");
             }
             frame
         });

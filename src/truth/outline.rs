@@ -819,7 +819,8 @@ fn cut_segment(c: [DVec3; 3], plane: &crate::SectionPlane) -> Option<(DVec3, DVe
 /// an edge's parameter, where the whole (clipped) edge is `full` pixels long on screen and
 /// the pattern stands at `start` at parameter 0 (`a_first`) or 1 and runs towards the other
 /// end. Dashes are the cores `[j·period, j·period + dash]` of pattern position, for every
-/// integer j; a dot is a dash of no length.
+/// integer j; a dot is a dash of no length. A dash within [`edge_math::DASH_SLACK`] of the
+/// run is drawn from the run's nearest point.
 fn dashes(
     (k0, k1): (f64, f64),
     full: f64,
@@ -843,10 +844,13 @@ fn dashes(
         (a.min(b), a.max(b))
     };
     let mut out = Vec::new();
+    let slack = edge_math::DASH_SLACK;
     let mut j = (s0 / period).floor() - 1.0;
-    while j * period <= s1 {
-        let (from, to) = ((j * period).max(s0), (j * period + dash).min(s1));
-        if from <= to {
+    while j * period <= s1 + slack {
+        if j * period + dash >= s0 - slack {
+            // Clamped into the run: a dash just beyond it is drawn from its nearest point.
+            let from = (j * period).clamp(s0, s1);
+            let to = (j * period + dash).clamp(s0, s1);
             let (ka, kb) = (parameter(from), parameter(to));
             out.push((ka.min(kb), ka.max(kb)));
         }
