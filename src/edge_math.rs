@@ -83,14 +83,26 @@ pub fn local_eye(model: glam::DMat4, eye: DVec4) -> DVec4 {
 /// (homogeneous, as [`towards_eye`] takes it) when both triangles lie on the same side of the
 /// plane through the eye and the edge (so on screen they fold onto one side of it).
 /// Independent of winding, so mirrored instances have the same silhouettes; an edge-on
-/// triangle counts as folded.
+/// triangle counts as folded, and so does one within [`EDGE_ON`] of edge-on.
 #[allow(clippy::neg_cmp_op_on_partial_ord)] // as in WGSL: NaN sides count as folded
 pub fn is_silhouette(a: DVec3, b: DVec3, c: DVec3, d: DVec3, eye: DVec4) -> bool {
     let to_eye = towards_eye(a, eye);
-    let side_c = to_eye.dot((b - a).cross(c - a));
-    let side_d = to_eye.dot((b - a).cross(d - a));
-    !(side_c * side_d < 0.0)
+    let (normal_c, normal_d) = ((b - a).cross(c - a), (b - a).cross(d - a));
+    let (side_c, side_d) = (to_eye.dot(normal_c), to_eye.dot(normal_d));
+    let scale = EDGE_ON * to_eye.length();
+    let edge_on =
+        side_c.abs() <= scale * normal_c.length() || side_d.abs() <= scale * normal_d.length();
+    edge_on || !(side_c * side_d < 0.0)
 }
+
+/// Twin of `EDGE_ON` in common.wgsl: the sine of the angle between the direction to the eye
+/// and a triangle's plane within which [`is_silhouette`] takes the triangle as edge-on. The
+/// eye in a face's plane (a box seen along a face, an axis-aligned orthographic view) puts
+/// the face at 0 only to rounding, which f32 and f64 round differently: an edge between a
+/// front face and such a face was an outline in one and a plain edge in the other. Below
+/// the clusters' `SPREAD_MARGIN`, so no cull skips such a fold.
+pub const EDGE_ON: f64 = 1e-5;
+const _: () = assert!(EDGE_ON < crate::mesh::clusters::SPREAD_MARGIN / 2.0);
 
 /// Twin of `HIDDEN_MARGIN` in scene.wgsl: how much nearer a surface must be than a point of
 /// a line, in near-row units relative to the point's, to hide it. Triangles that meet at an

@@ -5,11 +5,12 @@
 mod common;
 
 use common::{framing, load, TestScene};
+use glam::{DVec3, Vec3};
 use wirepass::style::{line_intensity, DepthFade};
 use wirepass::tools::compare::metrics;
 use wirepass::tools::offline::Method;
 use wirepass::world::Rendering;
-use wirepass::{EdgeSelection, Mesh, Style};
+use wirepass::{EdgeSelection, Mesh, Style, View};
 
 const SIZE: (u32, u32) = (256, 256);
 
@@ -166,5 +167,69 @@ fn lines_fade_with_depth_in_every_method() {
             "{method:?}: in front of the fade {near}"
         );
         assert!(far > 10_000.0, "{method:?}: behind the fade {far}");
+    }
+}
+
+/// A box with the eye in the plane of a face, and seen along its axes orthographically: the
+/// faces seen exactly edge-on fold, so the edges they share with the faces in view are
+/// outlines, drawn at full width over the background. Edge-on only to rounding, such a face
+/// made those edges outlines in f32 and plain edges in the ground truth's f64 (or the other
+/// way round): the outline's outer half was missing (errors up to 1.8 px).
+#[test]
+fn faces_seen_edge_on_fold_into_outlines() {
+    let cube = wirepass::mesh::cube(12).unwrap();
+    let aspect = f64::from(SIZE.0) / f64::from(SIZE.1);
+    let perspective =
+        |eye: Vec3, target: Vec3| common::camera(eye, target, 0.1, 20.0).to_view(aspect);
+    let orthographic = |eye: DVec3, up: DVec3| {
+        View::orthographic((eye, DVec3::ZERO, up), 3.0, aspect, (0.1, 20.0))
+    };
+    let views = [
+        (
+            "eye in a side's plane",
+            perspective(Vec3::new(-1.0, 0.5, 2.2), Vec3::new(-1.2, 0.2, 0.3)),
+        ),
+        (
+            "eye in the top's plane",
+            perspective(Vec3::new(0.3, 1.0, 3.0), Vec3::new(0.0, 0.6, 0.0)),
+        ),
+        (
+            "orthographic, along z",
+            orthographic(DVec3::new(0.0, 0.0, 5.0), DVec3::Y),
+        ),
+        (
+            "orthographic, along x, rolled",
+            orthographic(DVec3::new(5.0, 0.0, 0.0), DVec3::new(0.0, 1.0, 0.6)),
+        ),
+    ];
+    for (name, view) in views {
+        let mut scene = TestScene::new(
+            &cube,
+            framing(&cube, SIZE),
+            Style::default(),
+            SIZE,
+            EdgeSelection::Polygon,
+        );
+        scene.view = view;
+        let truth = draw(&scene, Method::Raycast);
+        let deferred = draw(&scene, Method::Deferred);
+        let m = metrics(&truth, &deferred).unwrap();
+        println!("{name}: {m:?}");
+        assert!(m.id_agreement >= 0.999, "{name}: {m:?}");
+        let d = &m.distance_error_px;
+        let within = d.p99.unwrap_or(0.0) <= 0.01 && d.max.unwrap_or(0.0) <= 0.1;
+        assert!(
+            within,
+            "{name}: {m:?}{}",
+            common::worst_pixels(&truth, &deferred, 0.01, 5)
+        );
+        // The outline's core over the background, along the box's whole silhouette.
+        let outer = (0..truth.ids.len())
+            .filter(|&i| truth.ids[i] == u32::MAX && truth.edge_distance[i] < 0.5)
+            .count();
+        assert!(
+            outer > 100,
+            "{name}: {outer} background pixels in the outline's core"
+        );
     }
 }

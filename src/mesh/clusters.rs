@@ -26,8 +26,10 @@ pub const CLUSTER_TRIANGLES: usize = 64;
 /// both skip conditions of [`may_fold`] whatever the eye.
 pub const ALWAYS: f64 = 4.0;
 
-/// Added to each spread for the GPU's f32 rounding of centres, axes and the eye, in radians.
-const SPREAD_MARGIN: f64 = 1e-4;
+/// Added to each spread for the GPU's f32 rounding of centres, axes and the eye, in radians;
+/// it also covers the angle within which a triangle counts as edge-on, so folded
+/// (`edge_math::EDGE_ON`).
+pub(crate) const SPREAD_MARGIN: f64 = 1e-4;
 
 /// A cluster's bounds, in mesh coordinates.
 #[derive(Clone, Copy, Debug, PartialEq)]
