@@ -117,6 +117,9 @@ impl View {
     }
 }
 
+/// A FLIP difference: `[mean, p99]`.
+type Flip = [f32; 2];
+
 /// Measured FLIP difference against the references, per case: `[mean, p99]` on lavapipe
 /// (Mesa 22.3.6, Vulkan; the adapter the references are blessed on) and on llvmpipe through
 /// wgpu's GL backend (`WGPU_BACKEND=gl`), rounded up to 1e-5. Both adapters render the same
@@ -133,7 +136,7 @@ impl View {
 /// (deferred mean up to 0.0054 / p99 0.031), and where surfaces pass through each other
 /// (Suzanne's eyes) its rasterizer gives a few pixels the other surface.
 #[rustfmt::skip]
-const MEASURED: &[(&str, [f32; 2], [f32; 2], [f32; 2])] = &[
+const MEASURED: &[(&str, Flip, Flip, Flip)] = &[
     // (case, lavapipe [mean, p99], llvmpipe-GL [mean, p99], NVIDIA H200 [mean, p99])
     ("fandisk_deferred_feature30_framing", [0.0, 0.0], [0.00001, 0.00007], [0.00038, 0.00733]),
     ("fandisk_deferred_feature30_inside", [0.0, 0.0], [0.00001, 0.00000], [0.00453, 0.02213]),
