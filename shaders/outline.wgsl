@@ -374,11 +374,13 @@ fn outline_triangle(inst: u32, t: u32) {
 #else
     let drawn = patterned;
 #endif
-    // Decoded as adjacency::fold_bound: 0 flat, 2^(q - 14) with a margin, 15 never skip.
+    // Decoded as adjacency::fold_bound: 0 flat, 2^(q - 14) with a margin, 15 never skip;
+    // each with 2e-5 (adjacency::EDGE_ON_MARGIN): a triangle within EDGE_ON of edge-on has
+    // every edge an outline.
     let q = (bits >> 4u) & 15u;
-    var fold_bound = exp2(f32(q) - 14.0) * 1.01 + 1e-6;
+    var fold_bound = exp2(f32(q) - 14.0) * 1.01 + 1e-6 + 2e-5;
     if q == 0u {
-        fold_bound = 1e-6;
+        fold_bound = 1e-6 + 2e-5;
     } else if q == 15u {
         fold_bound = 2.0;
     }

@@ -100,9 +100,11 @@ pub fn is_silhouette(a: DVec3, b: DVec3, c: DVec3, d: DVec3, eye: DVec4) -> bool
 /// eye in a face's plane (a box seen along a face, an axis-aligned orthographic view) puts
 /// the face at 0 only to rounding, which f32 and f64 round differently: an edge between a
 /// front face and such a face was an outline in one and a plain edge in the other. Below
-/// the clusters' `SPREAD_MARGIN`, so no cull skips such a fold.
+/// the clusters' `SPREAD_MARGIN` and the outline hints' `EDGE_ON_MARGIN`, so no cull skips
+/// such a fold.
 pub const EDGE_ON: f64 = 1e-5;
 const _: () = assert!(EDGE_ON < crate::mesh::clusters::SPREAD_MARGIN / 2.0);
+const _: () = assert!(EDGE_ON < crate::mesh::adjacency::EDGE_ON_MARGIN / 1.5);
 
 /// Twin of `HIDDEN_MARGIN` in scene.wgsl: how much nearer a surface must be than a point of
 /// a line, in near-row units relative to the point's, to hide it. Triangles that meet at an

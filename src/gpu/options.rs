@@ -59,8 +59,8 @@ pub enum TriangleIds {
 /// are sampled at other points); they differ in speed.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Tuning {
-    /// [`Software`](Tuning::Software) on a CPU adapter (`wgpu::DeviceType::Cpu`: lavapipe,
-    /// llvmpipe, SwiftShader), [`Gpu`](Tuning::Gpu) elsewhere.
+    /// [`Software`](Tuning::Software) on an adapter that reports `wgpu::DeviceType::Cpu`
+    /// (lavapipe and llvmpipe do), [`Gpu`](Tuning::Gpu) elsewhere.
     #[default]
     Auto,
     /// For a software rasterizer: a clear lays the background down where the output allows

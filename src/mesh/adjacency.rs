@@ -11,14 +11,19 @@ pub const NO_NEIGHBOUR: u32 = u32::MAX;
 /// The fold bound code meaning "may be a silhouette from any view".
 pub const ANY_FOLD: u8 = 15;
 
+/// Added to every [`fold_bound`]: a triangle seen within `edge_math::EDGE_ON` of edge-on
+/// counts as folded, so each of its edges is an outline however flat the surface.
+pub const EDGE_ON_MARGIN: f64 = 2e-5;
+
 /// The bound on sin(fold) that code `q` of [`outline_hints`] stands for: 0 for flat, then
 /// powers of two from 2⁻¹³ to 1, and above 1 (never skip) for [`ANY_FOLD`]; with a 1 %
-/// and 10⁻⁶ margin for f32 rounding. Twin of the decoding in outline.wgsl.
+/// and 10⁻⁶ margin for f32 rounding, and [`EDGE_ON_MARGIN`]. Twin of the decoding in
+/// outline.wgsl.
 pub fn fold_bound(q: u8) -> f64 {
     match q {
-        0 => 1e-6,
+        0 => 1e-6 + EDGE_ON_MARGIN,
         ANY_FOLD.. => 2.0,
-        _ => (f64::from(q) - 14.0).exp2() * 1.01 + 1e-6,
+        _ => (f64::from(q) - 14.0).exp2() * 1.01 + 1e-6 + EDGE_ON_MARGIN,
     }
 }
 
