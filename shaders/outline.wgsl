@@ -255,6 +255,9 @@ fn cut_plane(mode: u32) -> u32 {
     return select(NO_PLANE, (mode >> CUT_PLANE_SHIFT) & 7u, (mode & DRAW_CUT) != 0u);
 }
 
+// Twin of adjacency::EDGE_ON_MARGIN: added to every decoded fold bound.
+const EDGE_ON_MARGIN: f32 = 2e-5;
+
 // Triangles per cluster, and invocations per workgroup of both entry points.
 const CLUSTER_TRIANGLES: u32 = 64u;
 
@@ -375,12 +378,12 @@ fn outline_triangle(inst: u32, t: u32) {
     let drawn = patterned;
 #endif
     // Decoded as adjacency::fold_bound: 0 flat, 2^(q - 14) with a margin, 15 never skip;
-    // each with 2e-5 (adjacency::EDGE_ON_MARGIN): a triangle within EDGE_ON of edge-on has
-    // every edge an outline.
+    // each with EDGE_ON_MARGIN: a triangle within EDGE_ON of edge-on has every edge an
+    // outline.
     let q = (bits >> 4u) & 15u;
-    var fold_bound = exp2(f32(q) - 14.0) * 1.01 + 1e-6 + 2e-5;
+    var fold_bound = exp2(f32(q) - 14.0) * 1.01 + 1e-6 + EDGE_ON_MARGIN;
     if q == 0u {
-        fold_bound = 1e-6 + 2e-5;
+        fold_bound = 1e-6 + EDGE_ON_MARGIN;
     } else if q == 15u {
         fold_bound = 2.0;
     }

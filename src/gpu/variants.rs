@@ -184,12 +184,9 @@ pub fn shader_modules() -> Vec<(String, String)> {
         }
     }
     for v in variants.iter().filter(|v| v.outlines) {
-        // Both tunings (`Tuning`): SHORT_PIECES is the GPU's.
+        // Both tunings (`Tuning`).
         for short in [false, true] {
-            let mut flags = v.flags();
-            if short {
-                flags.push("SHORT_PIECES");
-            }
+            let flags = super::outline_pass::outline_flags(*v, short);
             out.push((format!("outline {flags:?}"), outline_source(&flags)));
         }
     }
