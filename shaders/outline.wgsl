@@ -5,7 +5,7 @@
 // boundary, or a silhouette: see `is_silhouette`) at half width. Outline triangles are nearly
 // edge-on and often own no pixel centre at all, so they cannot be found from the ids around a
 // pixel; instead one invocation per triangle finds its outline edges and lists their pieces
-// (up to 16 px each), and then one invocation per piece finds its visible runs (points every
+// (`piece_px`), and then one invocation per piece finds its visible runs (points every
 // 1/4 px tested, changes bisected) and writes into every pixel within the line's reach the
 // key (`line_key`) of the nearest visible run. Only triangles of the clusters that
 // `outline_cull` lists are visited, so the pass reads few triangles beyond those near an
@@ -274,37 +274,89 @@ fn outline_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocati
     }
 }
 
+// A listed piece (`list_piece`): its instance, its triangle (or, DRAW_INTERSECTION in
+// `mode`, its intersection segment), its edge, how it is drawn, and which of how many pieces
+// of the edge it is.
+struct Listed {
+    inst: u32,
+    t: u32,
+    i: u32,
+    mode: u32,
+    piece: u32,
+    pieces: u32,
+}
+
+// Lists a piece for outline_pieces_main (or crossing_pieces_main) to draw: false where the
+// list is full, and the caller draws it itself.
+fn list_piece(item: Listed) -> bool {
+    let list = piece_list();
+    let k = atomicAdd(&acc_rw[list + 3u], 1u);
+    if k >= piece_room(list) {
+        return false;
+    }
+    let at = list + 4u + PIECE_WORDS * k;
+    atomicStore(&acc_rw[at], item.inst);
+    atomicStore(&acc_rw[at + 1u], item.t);
+    atomicStore(&acc_rw[at + 2u], item.i | (item.mode << 2u));
+    atomicStore(&acc_rw[at + 3u], item.piece | (item.pieces << 16u));
+    let size = list_size(k, 64u);
+    atomicMax(&acc_rw[list], size.x);
+    atomicMax(&acc_rw[list + 1u], size.y);
+    return true;
+}
+
+// The piece a lane of the piece dispatch draws: the list's k-th, where k is below the list's
+// count (which includes the pieces found beyond the list's room, drawn where they were found).
+fn listed_piece(group: vec3<u32>, lane: u32, item: ptr<function, Listed>) -> bool {
+    let k = list_group(group) * 64u + lane;
+    let list = piece_list();
+    if k >= min(atomicLoad(&acc_rw[list + 3u]), piece_room(list)) {
+        return false;
+    }
+    let at = list + 4u + PIECE_WORDS * k;
+    let word = atomicLoad(&acc_rw[at + 2u]);
+    let piece = atomicLoad(&acc_rw[at + 3u]);
+    *item = Listed(atomicLoad(&acc_rw[at]), atomicLoad(&acc_rw[at + 1u]), word & 3u, word >> 2u, piece & 0xffffu, piece >> 16u);
+    return true;
+}
+
+// The segment of a listed piece's edge (an outline, a drawn edge or a cut line), its
+// pattern anchored.
+fn listed_edge(item: Listed) -> Clipped {
+    let inst = item.inst;
+    let t = item.t;
+    let i = item.i;
+    let mode = item.mode;
+    let base = instances[slot(inst)].triangle_base;
+    let v = corners(base + t) + instances[slot(inst)].vertex_base;
+    var a = vertex_at(v[i]).xyz;
+    var b = vertex_at(v[(i + 1u) % 3u]).xyz;
+    var n = neighbour(base + t, i);
+    // A cut line: where its plane meets the triangle.
+    if (mode & DRAW_CUT) != 0u {
+        let cut = cut_segment(inst, vertex_at(v.x).xyz, vertex_at(v.y).xyz, vertex_at(v.z).xyz, cut_plane(mode));
+        a = cut[0];
+        b = cut[1];
+        n = BACKGROUND_ID;
+    }
+    let anchor = pattern_anchor(inst, t, i, a, b, mode);
+    var c = clip_outline(inst, t, n, a, b, anchor, cut_plane(mode), false);
+    c.seg.cap = capped(inst, t, i, mode);
+    return c;
+}
+
+// Draws the listed piece `item` of the segment `c`.
+fn draw_listed(item: Listed, c: Clipped) {
+    let pieces = f32(item.pieces);
+    draw_piece(c.seg, f32(item.piece) / pieces, f32(item.piece + 1u) / pieces, c.length_px, item.mode);
+}
+
 // One invocation per listed piece: draws it.
 @compute @workgroup_size(64)
 fn outline_pieces_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
-    let k = list_group(group) * 64u + lane;
-    let list = piece_list();
-    // The count includes the pieces found beyond the list's room, which were drawn where
-    // they were found.
-    if k < min(atomicLoad(&acc_rw[list + 3u]), piece_room(list)) {
-        let at = list + 4u + PIECE_WORDS * k;
-        let inst = atomicLoad(&acc_rw[at]);
-        let t = atomicLoad(&acc_rw[at + 1u]);
-        let word = atomicLoad(&acc_rw[at + 2u]);
-        let i = word & 3u;
-        let piece = atomicLoad(&acc_rw[at + 3u]) & 0xffffu;
-        let base = instances[slot(inst)].triangle_base;
-        let v = corners(base + t) + instances[slot(inst)].vertex_base;
-        let mode = word >> 2u;
-        var a = vertex_at(v[i]).xyz;
-        var b = vertex_at(v[(i + 1u) % 3u]).xyz;
-        var n = neighbour(base + t, i);
-        // A cut line: where its plane meets the triangle.
-        if (mode & DRAW_CUT) != 0u {
-            let cut = cut_segment(inst, vertex_at(v.x).xyz, vertex_at(v.y).xyz, vertex_at(v.z).xyz, cut_plane(mode));
-            a = cut[0];
-            b = cut[1];
-            n = BACKGROUND_ID;
-        }
-        let anchor = pattern_anchor(inst, t, i, a, b, mode);
-        var c = clip_outline(inst, t, n, a, b, anchor, cut_plane(mode));
-        c.seg.cap = capped(inst, t, i, mode);
-        draw_piece(c.seg, f32(piece) / f32(c.pieces), f32(piece + 1u) / f32(c.pieces), c.length_px, mode);
+    var item: Listed;
+    if listed_piece(group, lane, &item) {
+        draw_listed(item, listed_edge(item));
     }
 }
 
@@ -319,24 +371,46 @@ struct Intersection {
 }
 @group(0) @binding(28) var<storage, read> intersections: array<Intersection>;
 
-// One invocation per intersection segment: draws its visible runs, piece by piece (a
-// segment is no longer than its triangles, so few have more than one).
+// Intersection segment k on screen.
+fn clip_intersection(k: u32) -> Clipped {
+    let s = intersections[k];
+    return clip_outline(s.slot, s.t, s.u, s.a, s.b, vec4<f32>(0.0, 1.0, 0.0, 1.0), NO_PLANE, true);
+}
+
+// One invocation per intersection segment: lists its pieces that reach the targets, after
+// the outline edges' (a segment is no longer than its triangles, so few have more than one).
 @compute @workgroup_size(64)
 fn intersection_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let k = gid.x + gid.y * groups.x * CLUSTER_TRIANGLES;
     if k >= frame.intersections {
         return;
     }
-    let s = intersections[k];
-    var c = clip_outline(s.slot, s.t, s.u, s.a, s.b, vec4<f32>(0.0, 1.0, 0.0, 1.0), NO_PLANE);
-    c.seg.crossing = true;
+    let c = clip_intersection(k);
     let reach = line_reach(frame.intersection_width);
+    let mode = DRAW_VISIBLE | DRAW_INTERSECTION;
+    // An item holds the piece count in 16 bits; a longer segment is drawn here whole.
+    let listable = c.pieces <= 0xffffu;
     for (var piece = 0u; piece < c.pieces; piece++) {
         let k0 = f32(piece) / f32(c.pieces);
         let k1 = f32(piece + 1u) / f32(c.pieces);
-        if piece_reaches_targets(c.seg, k0, k1, reach) {
-            draw_piece(c.seg, k0, k1, c.length_px, DRAW_VISIBLE | DRAW_INTERSECTION);
+        if piece_reaches_targets(c.seg, k0, k1, reach) && !(listable && list_piece(Listed(c.seg.inst, k, 0u, mode, piece, c.pieces))) {
+            draw_piece(c.seg, k0, k1, c.length_px, mode);
         }
+    }
+}
+
+// outline_pieces_main for a frame with intersection lines: its list holds their pieces too.
+@compute @workgroup_size(64)
+fn crossing_pieces_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+    var item: Listed;
+    if listed_piece(group, lane, &item) {
+        var c: Clipped;
+        if (item.mode & DRAW_INTERSECTION) != 0u {
+            c = clip_intersection(item.t);
+        } else {
+            c = listed_edge(item);
+        }
+        draw_listed(item, c);
     }
 }
 
@@ -617,28 +691,31 @@ fn lerp_projected(a: Projected, b: Projected, k: f32) -> Projected {
     return Projected(mix(a.xy, b.xy, k), mix(a.inv_w, b.inv_w, k), mix(a.near_w, b.near_w, k), mix(a.reverse, b.reverse, k), mix(a.fade_w, b.fade_w, k));
 }
 
-// Visibility samples per pixel of edge length; each change between two is then bisected.
-const RUN_SAMPLES_PER_PX: f32 = 4.0;
 // Pixels inside a line's ends at which their class is taken (`seg_class`).
 const END_INSET: f32 = 1.0 / 256.0;
-// Steps of the walks from a line's own triangles' neighbours (`class_at`).
-const FOLD_STEPS: u32 = 4u;
-const RUN_BISECTIONS: u32 = 12u;
-// An edge is drawn in pieces of at most this many pixels, each with up to MAX_RUNS visible
-// runs (more is beyond any real mesh at this scale; the last run then absorbs the rest). On
-// a GPU (SHORT_PIECES) shorter pieces give a frame's few outline edges more lanes.
+// The loops' constants (RUN_SAMPLES_PER_PX visibility samples per pixel of edge length, each
+// change between two then bisected RUN_BISECTIONS times; FOLD_STEPS and WALK_STEPS; up to
+// MAX_RUNS visible runs a piece, the last absorbing the rest) and the pieces' lengths on a
+// software rasterizer (SOFTWARE_PIECE_PX) are declared from src/gpu/loop_budget.rs:
+// llvmpipe caps the loop iterations of a batch of lanes, and a piece's loops must keep under
+// the cap.
+
+// The length in pixels of the pieces of a line whose visibility window (`line_window`) has
+// radius r: on a GPU (SHORT_PIECES) 1 px, which gives a frame's few outline edges more
+// lanes; on a software rasterizer the longest that keeps under its loop cap.
+fn piece_px(r: i32) -> f32 {
 #if SHORT_PIECES
-const PIECE_PX: f32 = 1.0;
+    return 1.0;
 #else
-const PIECE_PX: f32 = 16.0;
+    return select(select(SOFTWARE_PIECE_PX.z, SOFTWARE_PIECE_PX.y, r <= 2), SOFTWARE_PIECE_PX.x, r <= 1);
 #endif
+}
 // Pixels this far past a line's reach still get its key (`splat_runs`); twin of
 // edge_math::REACH_SLACK.
 const REACH_SLACK: f32 = 1e-3;
 // A dash reaching this many pixels past a run's end is drawn from the end (the pattern's
 // first dash starts where a chain's first edge ends); twin of edge_math::DASH_SLACK.
 const DASH_SLACK: f32 = 1e-3;
-const MAX_RUNS: u32 = 8u;
 
 // The screen segment of an outline edge, clipped to the view and the targets.
 struct Segment {
@@ -734,7 +811,7 @@ struct Clipped {
     pieces: u32,
 }
 
-fn clip_outline(inst: u32, t: u32, n: u32, a: vec3<f32>, b: vec3<f32>, anchor: vec4<f32>, skip: u32) -> Clipped {
+fn clip_outline(inst: u32, t: u32, n: u32, a: vec3<f32>, b: vec3<f32>, anchor: vec4<f32>, skip: u32, crossing: bool) -> Clipped {
     var c: Clipped;
     c.pieces = 0u;
     let span = edge_span(inst, a, b, skip);
@@ -756,13 +833,14 @@ fn clip_outline(inst: u32, t: u32, n: u32, a: vec3<f32>, b: vec3<f32>, anchor: v
     c.seg.inst = inst;
     c.seg.t = t;
     c.seg.n = n;
+    c.seg.crossing = crossing;
     let full = length(d);
     c.seg.phase = anchor.x + select((1.0 - u.x) * full, u.x * full, anchor.y > 0.0);
     c.seg.phase_dir = anchor.y;
     c.seg.hidden_phase = anchor.z + select((1.0 - u.x) * full, u.x * full, anchor.w > 0.0);
     c.seg.hidden_dir = anchor.w;
     c.length_px = length(c.seg.end.xy - c.seg.start.xy);
-    c.pieces = max(u32(ceil(c.length_px / PIECE_PX)), 1u);
+    c.pieces = max(u32(ceil(c.length_px / piece_px(line_window(inst, t, n, crossing).r))), 1u);
     return c;
 }
 
@@ -772,15 +850,13 @@ fn clip_outline(inst: u32, t: u32, n: u32, a: vec3<f32>, b: vec3<f32>, anchor: v
 fn list_outline(inst: u32, t: u32, i: u32, n: u32, a: vec3<f32>, b: vec3<f32>, mode: u32) {
     // The pattern's anchor only matters where a piece is drawn here (the piece pass finds it
     // for the pieces it draws): looking it up for every listed edge would cost every lane.
-    let c = clip_outline(inst, t, n, a, b, vec4<f32>(0.0, 1.0, 0.0, 1.0), cut_plane(mode));
+    let c = clip_outline(inst, t, n, a, b, vec4<f32>(0.0, 1.0, 0.0, 1.0), cut_plane(mode), false);
     var visible_width = select(instances[slot(inst)].line_width, instances[slot(inst)].outline_width, (mode & DRAW_OUTLINE) != 0u);
     visible_width = select(visible_width, frame.section_width, (mode & DRAW_CUT) != 0u);
     var reach = select(0.0, line_reach(visible_width), (mode & DRAW_VISIBLE) != 0u);
 #if HIDDEN
     reach = max(reach, select(0.0, line_reach(instances[slot(inst)].hidden_width), (mode & DRAW_HIDDEN) != 0u));
 #endif
-    let list = piece_list();
-    let room = piece_room(list);
     // An item holds the piece count in 16 bits; a longer edge is drawn here whole.
     let listable = c.pieces <= 0xffffu;
     for (var piece = 0u; piece < c.pieces; piece++) {
@@ -789,21 +865,8 @@ fn list_outline(inst: u32, t: u32, i: u32, n: u32, a: vec3<f32>, b: vec3<f32>, m
         if !piece_reaches_targets(c.seg, k0, k1, reach) {
             continue;
         }
-        var k = room;
-        if listable {
-            k = atomicAdd(&acc_rw[list + 3u], 1u);
-        }
-        if k < room {
-            let at = list + 4u + PIECE_WORDS * k;
-            atomicStore(&acc_rw[at], inst);
-            atomicStore(&acc_rw[at + 1u], t);
-            atomicStore(&acc_rw[at + 2u], i | (mode << 2u));
-            atomicStore(&acc_rw[at + 3u], piece | (c.pieces << 16u));
-            let size = list_size(k, 64u);
-            atomicMax(&acc_rw[list], size.x);
-            atomicMax(&acc_rw[list + 1u], size.y);
-        } else {
-            var anchored = clip_outline(inst, t, n, a, b, pattern_anchor(inst, t, i, a, b, mode), cut_plane(mode));
+        if !(listable && list_piece(Listed(inst, t, i, mode, piece, c.pieces))) {
+            var anchored = clip_outline(inst, t, n, a, b, pattern_anchor(inst, t, i, a, b, mode), cut_plane(mode), false);
             anchored.seg.cap = capped(inst, t, i, mode);
             draw_piece(anchored.seg, k0, k1, c.length_px, mode);
         }
@@ -1095,18 +1158,10 @@ fn class_at(x: vec2<f32>, near: f32, w: f32, reverse: f32, inst: u32, line: vec3
     // The nearest surface in front of the point within HIDDEN_MARGIN: its near row, and 1
     // where it faces away (where none is, the line's own triangles tell).
     var front = vec2<f32>(near, select(0.0, 1.0, cap == CAP_INSIDE));
-    // Through a section's cut the eye sees the inside of folded surfaces, where the sheet in
-    // front of an interior silhouette thins out near a fold of its own: look two pixels
-    // round for it there.
-    // Where surfaces cross, the surface a line passes into may show only a few pixels away
-    // (where those in front of it end): look four pixels round (frame::CROSSING_BAND).
     let base = instances[slot(inst)].triangle_base;
-    let bits = info[base + t] | select(0u, info[base + n], n != BACKGROUND_ID);
-    let crossed = (bits & INFO_CROSSED) != 0u || (instances[slot(inst)].flags & INSTANCE_CROSSED) != 0u;
-    let wide = frame.sections_on != 0u || crossed;
-    // An intersection line lies on both surfaces that cross there, so no surface passes
-    // into view beyond it: it takes a section's window.
-    let r = select(select(select(1, 2, wide), 4, crossed), 2, line.z != 0u);
+    let window = line_window(inst, t, n, line.z != 0u);
+    let wide = window.wide;
+    let r = window.r;
     let across = 2 * r + 1;
     for (var k = 0; k < across * across; k++) {
         let offset = vec2<i32>(k % across - r, k / across - r);
@@ -1140,6 +1195,30 @@ fn class_at(x: vec2<f32>, near: f32, w: f32, reverse: f32, inst: u32, line: vec3
         }
     }
     return select(0u, 1u, cap != CAP_NONE && front.y > 0.0);
+}
+
+// The window of pixel ids `class_at` looks at round a point of a line on triangles t and n
+// of `inst` (`crossing`: an intersection line on both): its radius (one of
+// loop_budget::WINDOW_RADII), and whether it is wide, where class_at also walks from the
+// line's triangles' other neighbours.
+struct Window {
+    r: i32,
+    wide: bool,
+}
+
+fn line_window(inst: u32, t: u32, n: u32, crossing: bool) -> Window {
+    // Through a section's cut the eye sees the inside of folded surfaces, where the sheet in
+    // front of an interior silhouette thins out near a fold of its own: look two pixels
+    // round for it there.
+    // Where surfaces cross, the surface a line passes into may show only a few pixels away
+    // (where those in front of it end): look four pixels round (frame::CROSSING_BAND).
+    let base = instances[slot(inst)].triangle_base;
+    let bits = info[base + t] | select(0u, info[base + n], n != BACKGROUND_ID);
+    let crossed = (bits & INFO_CROSSED) != 0u || (instances[slot(inst)].flags & INSTANCE_CROSSED) != 0u;
+    let wide = frame.sections_on != 0u || crossed;
+    // An intersection line lies on both surfaces that cross there, so no surface passes
+    // into view beyond it: it takes a section's window.
+    return Window(select(select(select(1, 2, wide), 4, crossed), 2, crossing), wide);
 }
 
 // Whether sample s of a triangle other than t and n of `inst` covers the line's point (near

@@ -377,11 +377,8 @@ fn nearer_than_cap(a_near: f32, b_near: f32, b_w: f32) -> bool {
     return a_near < b_near - CAP_MARGIN * (abs(b_near) + b_w);
 }
 
-// Steps of a walk across edges (`locate`): enough to go round a vertex's fan of small
-// triangles from a rasterized neighbour to the one that owns the point, and, in the
-// outline pass, to cross the few pixels' worth of sub-pixel triangles between a rasterized
-// triangle and one that hides a point of an outline.
-const WALK_STEPS: u32 = 24u;
+// WALK_STEPS, the steps of a walk across edges (`locate`), is declared from
+// src/gpu/loop_budget.rs.
 
 // Point location by walking: from triangle `tri` of instance `inst`, cross the edge `point`
 // lies beyond, for at most `steps` steps, until a triangle covers it; returns the last

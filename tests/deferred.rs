@@ -755,8 +755,8 @@ fn gpu_tuning_draws_what_the_software_tuning_draws() {
         assert_eq!(apart, 0, "{name}: pixels more than a step apart");
     }
 
-    // The pieces: up to a pixel of outline each on the GPU, up to 16 px in software (most of
-    // fandisk's outline edges are shorter than that here).
+    // The pieces: up to a pixel of outline each on the GPU, up to 2 px in software (so the
+    // GPU's list is the longer wherever fandisk's outline edges are longer than a pixel).
     let cam = framing(&fandisk, size);
     let aspect = f64::from(size.0) / f64::from(size.1);
     let (store, scene) = single(&fandisk, EdgeSelection::Feature(30.0), cam.to_view(aspect));

@@ -59,7 +59,7 @@ pub struct EdgeWork {
     /// Clusters of 64 triangles the outline pass's cull listed (those that may hold an
     /// outline edge from the eye, or a drawn edge of a large patch), 0 where it did not run.
     pub outline_clusters: u32,
-    /// Pieces (up to 16 px, or 1 px for [`Tuning::Gpu`](super::Tuning::Gpu)) of outline
+    /// Pieces (up to 2 px, or 1 px for [`Tuning::Gpu`](super::Tuning::Gpu)) of outline
     /// edges the outline pass listed or found beyond its list's room, 0 where it did not run.
     pub outline_pieces: u32,
     /// How many of them its piece list has room for; it draws the others where it finds

@@ -3,8 +3,10 @@
 //! pixel within reach of their visible runs. Three dispatches: a cull of the clusters that
 //! may hold such an edge, one invocation per listed triangle listing the edges' pieces, one
 //! per piece drawing it; before them, for dashed or dotted lines, one invocation per chain
-//! of drawn edges finding where the patterns stand along it; after them, with intersection
-//! lines, one invocation per intersection segment drawing it.
+//! of drawn edges finding where the patterns stand along it; with intersection lines, one
+//! invocation per intersection segment listing its pieces too, before the piece dispatch.
+//! Pieces are short enough that a piece's loops keep under llvmpipe's cap on them
+//! ([`loop_budget`](super::loop_budget)).
 
 use super::bindings::{self, dispatch, store_resources, Compute, Res, Size, Sources};
 use super::frame::FrameData;
@@ -26,11 +28,19 @@ struct OutlinePipelines {
     pieces: Compute,
     /// Finds the patterns' positions along every chain (PATTERNS).
     phases: Option<Compute>,
-    /// Draws the intersection segments, one a lane: built on first use, as few frames
-    /// draw them.
-    intersections: OnceLock<Compute>,
+    /// Lists the intersection segments' pieces, and draws the pieces of a list that holds
+    /// them: built on first use, as few frames draw them.
+    intersections: OnceLock<Intersections>,
     module: wgpu::ShaderModule,
     resources: Vec<Res>,
+}
+
+/// The pipelines of a frame with intersection lines.
+struct Intersections {
+    /// One invocation per intersection segment, listing its pieces.
+    list: Compute,
+    /// `outline_pieces_main` for a list that holds intersection pieces too.
+    pieces: Compute,
 }
 
 /// The shader flags of variant `v`'s outline module, with pieces of 1 px for a GPU
@@ -53,7 +63,8 @@ pub(crate) fn piece_size_at(data: &FrameData) -> u64 {
 pub(crate) struct OutlinePass {
     /// The format the pipelines' layouts name for the (unused) colour output.
     format: wgpu::TextureFormat,
-    /// Whether outline edges are drawn in pieces of 1 px, not 16 ([`Tuning`](super::Tuning)).
+    /// Whether outline edges are drawn in pieces of 1 px, not as long as a software
+    /// rasterizer's loop cap allows ([`Tuning`](super::Tuning)).
     short_pieces: bool,
     cache: Mutex<HashMap<Variant, Arc<OutlinePipelines>>>,
 }
@@ -74,18 +85,22 @@ impl OutlinePass {
         Ok(())
     }
 
-    /// The intersection lines' pipeline of the set `p`, built on first use.
+    /// The intersection lines' pipelines of the set `p`, built on first use.
     fn intersections<'p>(
         &self,
         device: &wgpu::Device,
         p: &'p OutlinePipelines,
-    ) -> Result<&'p Compute> {
+    ) -> Result<&'p Intersections> {
         if let Some(c) = p.intersections.get() {
             return Ok(c);
         }
         let scope = crate::gpu::validation::Validation::begin(device);
-        let entry = "intersection_main";
-        let c = Compute::new(device, &p.module, entry, p.resources.clone(), self.format)?;
+        let build =
+            |entry| Compute::new(device, &p.module, entry, p.resources.clone(), self.format);
+        let c = Intersections {
+            list: build("intersection_main")?,
+            pieces: build("crossing_pieces_main")?,
+        };
         if let Some(e) = scope.end() {
             return Err(Error::Device(format!(
                 "building the intersection lines: {e}"
@@ -191,8 +206,9 @@ impl OutlinePass {
     /// The outline pass: `outline_cull` lists the (instance, cluster) pairs that may hold
     /// an outline edge, on a 2D grid of workgroups (huge scenes need more than one dimension
     /// allows); `outline_main` then visits their triangles, dispatched indirectly with the
-    /// size the cull leaves, and lists the pieces (up to 16 px, or 1 px) of their outline edges;
-    /// `outline_pieces_main` draws those, one a lane.
+    /// size the cull leaves, and lists the pieces of their outline edges (and
+    /// `intersection_main` those of the intersection segments); `outline_pieces_main` draws
+    /// those, one a lane.
     pub(crate) fn encode(
         &self,
         device: &wgpu::Device,
@@ -205,7 +221,6 @@ impl OutlinePass {
         let p = self.pipelines(device, variant)?;
         let cull = p.cull.bind(device, sources)?;
         let draw = p.draw.bind(device, sources)?;
-        let pieces = p.pieces.bind(device, sources)?;
         let data = sources.frame;
         encoder.clear_buffer(&t.acc, 0, Some(t.acc_phases));
         encoder.copy_buffer_to_buffer(reset, 0, &t.acc, t.acc_tiles, LIST_HEADER);
@@ -234,25 +249,31 @@ impl OutlinePass {
         let names = ("wirepass outline pass", "outline.draw");
         let size = Size::Indirect(list, 0);
         dispatch(encoder, timer.as_deref_mut(), names, (&p.draw, &draw), size);
+        // With intersection lines, their segments' pieces join the list, and the piece
+        // dispatch draws both kinds.
+        let segments = data.intersections();
+        let (pieces, group) = if segments > 0 {
+            let crossing = self.intersections(device, &p)?;
+            let group = crossing.list.bind(device, sources)?;
+            let names = ("wirepass intersection lines", "outline.intersections");
+            let pipeline = (&crossing.list, &group);
+            dispatch(
+                encoder,
+                timer.as_deref_mut(),
+                names,
+                pipeline,
+                grid(segments),
+            );
+            (&crossing.pieces, crossing.pieces.bind(device, sources)?)
+        } else {
+            (&p.pieces, p.pieces.bind(device, sources)?)
+        };
         // The piece dispatch's size, where no pass binding `acc` for writing reads it.
         let size_at = piece_size_at(data);
         encoder.copy_buffer_to_buffer(&t.acc, t.acc_pieces, list, size_at, LIST_HEADER);
         let names = ("wirepass outline pieces", "outline.pieces");
         let size = Size::Indirect(list, size_at);
-        dispatch(
-            encoder,
-            timer.as_deref_mut(),
-            names,
-            (&p.pieces, &pieces),
-            size,
-        );
-        let segments = data.intersections();
-        if segments > 0 {
-            let pipeline = self.intersections(device, &p)?;
-            let group = pipeline.bind(device, sources)?;
-            let names = ("wirepass intersection lines", "outline.intersections");
-            dispatch(encoder, timer, names, (pipeline, &group), grid(segments));
-        }
+        dispatch(encoder, timer, names, (pieces, &group), size);
         Ok(())
     }
 }

@@ -103,9 +103,10 @@ pub fn assemble(parts: &[&str], flags: &[&str]) -> String {
 /// The constants the shaders share with the Rust side, declared from their Rust values.
 fn constants() -> String {
     format!(
-        "const BACKGROUND_ID: u32 = {}u;\nconst HOST_ID: u32 = {}u;",
+        "const BACKGROUND_ID: u32 = {}u;\nconst HOST_ID: u32 = {}u;\n{}",
         super::BACKGROUND_ID,
-        super::HOST_ID
+        super::HOST_ID,
+        super::loop_budget::wgsl()
     )
 }
 
