@@ -233,3 +233,34 @@ fn faces_seen_edge_on_fold_into_outlines() {
         );
     }
 }
+
+/// A 2 M-triangle sphere at 1280×720: each pole is a fan of about 2000 slivers, and the
+/// outline passes over it, where the outline's pixels over the background lie beside
+/// front-facing rim edges that no walk from a rasterized neighbour reaches in a few steps.
+/// Every pixel within the bounds.
+#[test]
+fn outline_beside_a_pole_fan_of_slivers() {
+    let sphere = wirepass::mesh::sphere(2_000_000).unwrap();
+    let size = (1280, 720);
+    let camera = framing(&sphere, size);
+    let scene = TestScene::new(
+        &sphere,
+        camera,
+        Style::default(),
+        size,
+        EdgeSelection::Polygon,
+    );
+    let truth = draw(&scene, Method::Raycast);
+    let deferred = draw(&scene, Method::Deferred);
+    let m = metrics(&truth, &deferred).unwrap();
+    println!("pole fan: {m:?}");
+    println!("{}", common::worst_pixels(&truth, &deferred, 0.01, 8));
+    assert!(m.id_agreement >= 0.999, "{m:?}");
+    let d = &m.distance_error_px;
+    let within = d.p99.unwrap_or(0.0) <= 0.01 && d.max.unwrap_or(0.0) <= 0.1;
+    assert!(
+        within,
+        "{m:?}{}",
+        common::worst_pixels(&truth, &deferred, 0.01, 8)
+    );
+}
