@@ -211,18 +211,7 @@ fn faces_seen_edge_on_fold_into_outlines() {
             EdgeSelection::Polygon,
         );
         scene.view = view;
-        let truth = draw(&scene, Method::Raycast);
-        let deferred = draw(&scene, Method::Deferred);
-        let m = metrics(&truth, &deferred).unwrap();
-        println!("{name}: {m:?}");
-        assert!(m.id_agreement >= 0.999, "{name}: {m:?}");
-        let d = &m.distance_error_px;
-        let within = d.p99.unwrap_or(0.0) <= 0.01 && d.max.unwrap_or(0.0) <= 0.1;
-        assert!(
-            within,
-            "{name}: {m:?}{}",
-            common::worst_pixels(&truth, &deferred, 0.01, 5)
-        );
+        let truth = within_bounds(name, &scene);
         // The outline's core over the background, along the box's whole silhouette.
         let outer = (0..truth.ids.len())
             .filter(|&i| truth.ids[i] == u32::MAX && truth.edge_distance[i] < 0.5)
@@ -250,17 +239,20 @@ fn outline_beside_a_pole_fan_of_slivers() {
         size,
         EdgeSelection::Polygon,
     );
-    let truth = draw(&scene, Method::Raycast);
-    let deferred = draw(&scene, Method::Deferred);
+    within_bounds("pole fan", &scene);
+}
+
+/// The deferred frame of `scene` against the ground truth over every pixel, within the
+/// accuracy bounds (id agreement 0.999, distance p99 0.01 px, max 0.1 px); returns the truth.
+fn within_bounds(name: &str, scene: &TestScene) -> Rendering {
+    let truth = draw(scene, Method::Raycast);
+    let deferred = draw(scene, Method::Deferred);
     let m = metrics(&truth, &deferred).unwrap();
-    println!("pole fan: {m:?}");
-    println!("{}", common::worst_pixels(&truth, &deferred, 0.01, 8));
-    assert!(m.id_agreement >= 0.999, "{m:?}");
+    let worst = common::worst_pixels(&truth, &deferred, 0.01, 8);
+    println!("{name}: {m:?}\n{worst}");
+    assert!(m.id_agreement >= 0.999, "{name}: {m:?}");
     let d = &m.distance_error_px;
     let within = d.p99.unwrap_or(0.0) <= 0.01 && d.max.unwrap_or(0.0) <= 0.1;
-    assert!(
-        within,
-        "{m:?}{}",
-        common::worst_pixels(&truth, &deferred, 0.01, 8)
-    );
+    assert!(within, "{name}: {m:?}\n{worst}");
+    truth
 }
