@@ -393,8 +393,9 @@ fn intersection_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num
     for (var piece = 0u; piece < c.pieces; piece++) {
         let k0 = f32(piece) / f32(c.pieces);
         let k1 = f32(piece + 1u) / f32(c.pieces);
-        if piece_reaches_targets(c.seg, k0, k1, reach) && !(listable && list_piece(Listed(c.seg.inst, k, 0u, mode, piece, c.pieces))) {
-            draw_piece(c.seg, k0, k1, c.length_px, mode);
+        let item = Listed(c.seg.inst, k, 0u, mode, piece, c.pieces);
+        if piece_reaches_targets(c.seg, k0, k1, reach) && !(listable && list_piece(item)) {
+            draw_listed(item, c);
         }
     }
 }
@@ -865,10 +866,9 @@ fn list_outline(inst: u32, t: u32, i: u32, n: u32, a: vec3<f32>, b: vec3<f32>, m
         if !piece_reaches_targets(c.seg, k0, k1, reach) {
             continue;
         }
-        if !(listable && list_piece(Listed(inst, t, i, mode, piece, c.pieces))) {
-            var anchored = clip_outline(inst, t, n, a, b, pattern_anchor(inst, t, i, a, b, mode), cut_plane(mode), false);
-            anchored.seg.cap = capped(inst, t, i, mode);
-            draw_piece(anchored.seg, k0, k1, c.length_px, mode);
+        let item = Listed(inst, t, i, mode, piece, c.pieces);
+        if !(listable && list_piece(item)) {
+            draw_listed(item, listed_edge(item));
         }
     }
 }

@@ -224,9 +224,8 @@ fn faces_seen_edge_on_fold_into_outlines() {
 }
 
 /// A 2 M-triangle sphere at 1280×720: each pole is a fan of about 2000 slivers, and the
-/// outline passes over it, where the outline's pixels over the background lie beside
-/// front-facing rim edges that no walk from a rasterized neighbour reaches in a few steps.
-/// Every pixel within the bounds.
+/// outline passes beside it, where background pixels next to the rim were once off by up to
+/// 0.19 px. Every pixel within the bounds.
 #[test]
 fn outline_beside_a_pole_fan_of_slivers() {
     let sphere = wirepass::mesh::sphere(2_000_000).unwrap();
