@@ -263,33 +263,43 @@ pub fn check_transform(t: &DMat4, index: usize) -> Result<()> {
 /// crosses (a nearer surface's outline lies between a pixel and any of its lines the surface
 /// hides), so boxes that only touch count, and the test errs towards the exact path.
 pub fn overlapping(placed: &[((DVec3, DVec3), DMat4)]) -> Vec<bool> {
-    let boxes: Vec<(DVec3, DVec3)> = placed
-        .iter()
-        .map(|&((lo, hi), t)| {
-            (0..8).fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(a, b), k| {
-                let corner =
-                    DVec3::select(glam::BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0), hi, lo);
-                let p = t.transform_point3(corner);
-                (a.min(p), b.max(p))
-            })
-        })
-        .collect();
+    let boxes: Vec<(DVec3, DVec3)> = placed.iter().map(|&(b, t)| world_box(b, t)).collect();
+    let mut meets = vec![false; boxes.len()];
+    for (a, b) in meeting_pairs(&boxes) {
+        meets[a] = true;
+        meets[b] = true;
+    }
+    meets
+}
+
+/// The world-space bounds of model-space bounds `(lo, hi)` placed by `transform`: the box
+/// round its eight transformed corners.
+pub fn world_box((lo, hi): (DVec3, DVec3), transform: DMat4) -> (DVec3, DVec3) {
+    (0..8).fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(a, b), k| {
+        let corner = DVec3::select(glam::BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0), hi, lo);
+        let p = transform.transform_point3(corner);
+        (a.min(p), b.max(p))
+    })
+}
+
+/// The pairs `(a, b)`, `a < b`, of boxes that meet (touching counts), sorted.
+pub fn meeting_pairs(boxes: &[(DVec3, DVec3)]) -> Vec<(usize, usize)> {
     // Sweep along x.
     let mut order: Vec<usize> = (0..boxes.len()).collect();
     order.sort_by(|&a, &b| boxes[a].0.x.total_cmp(&boxes[b].0.x));
-    let mut meets = vec![false; boxes.len()];
+    let mut pairs = Vec::new();
     for (k, &a) in order.iter().enumerate() {
         for &b in &order[k + 1..] {
             if boxes[b].0.x > boxes[a].1.x {
                 break;
             }
             if boxes[a].0.cmple(boxes[b].1).all() && boxes[b].0.cmple(boxes[a].1).all() {
-                meets[a] = true;
-                meets[b] = true;
+                pairs.push((a.min(b), a.max(b)));
             }
         }
     }
-    meets
+    pairs.sort_unstable();
+    pairs
 }
 
 /// A frame's scene: the instances to draw and the view to draw them through.

@@ -45,14 +45,63 @@ pub fn flag_crossing(count: usize, crossings: &[Crossing]) -> Vec<bool> {
     crossing
 }
 
+/// Contacts closer than this fraction of the surfaces' size are not crossings.
+pub const TOLERANCE: f64 = 1e-9;
+
+/// The tolerance of the crossings between two placed surfaces of world bounds `a` and `b`:
+/// [`TOLERANCE`] of the larger's size.
+pub fn pair_tolerance(a: (DVec3, DVec3), b: (DVec3, DVec3)) -> f64 {
+    TOLERANCE * (a.1 - a.0).max_element().max((b.1 - b.0).max_element())
+}
+
 /// The pairs of triangles of a mesh that cross, each once (`t < u`), sorted, with the
 /// segments along which they meet.
 pub fn crossings(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Crossing> {
-    let n = triangles.len();
+    let corners = |t: usize| triangles[t].map(|v| positions[v as usize].as_dvec3());
+    // The size of what the triangles span (not of vertices no triangle uses).
+    let (lo, hi) =
+        triangles
+            .iter()
+            .flatten()
+            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &v| {
+                let p = positions[v as usize].as_dvec3();
+                (lo.min(p), hi.max(p))
+            });
+    let size = (hi - lo).max_element();
+    let apart = |t: usize, u: usize| !shares_an_edge(triangles[t], triangles[u], positions);
+    find(triangles.len(), &corners, &apart, TOLERANCE * size)
+}
+
+/// Where the triangles of one surface cross those of another (world corners `a` and `b`,
+/// each a part of a surface, such as the triangles of two instances near where their bounds
+/// meet): crossing `t` is an index into `a`, `u` into `b`, sorted. Triangles sharing two
+/// corners (an edge where two surfaces join) do not cross, as in [`crossings`]; contacts
+/// within `tolerance` are not crossings.
+pub fn crossings_between(a: &[[DVec3; 3]], b: &[[DVec3; 3]], tolerance: f64) -> Vec<Crossing> {
+    let split = a.len();
+    let corners = |t: usize| if t < split { a[t] } else { b[t - split] };
+    let apart = |t: usize, u: usize| {
+        let (p, q) = (corners(t), corners(u));
+        (t < split) != (u < split) && p.iter().filter(|c| q.contains(c)).count() < 2
+    };
+    let mut found = find(a.len() + b.len(), &corners, &apart, tolerance);
+    for c in &mut found {
+        c.u -= split as u32;
+    }
+    found
+}
+
+/// The pairs of a soup of `n` triangles (`corners`) that cross by more than `tolerance`,
+/// among those `admits` (`t < u`) lets meet, each once (`t < u`), sorted.
+fn find(
+    n: usize,
+    corners: &(impl Fn(usize) -> [DVec3; 3] + Sync),
+    admits: &(impl Fn(usize, usize) -> bool + Sync),
+    tolerance: f64,
+) -> Vec<Crossing> {
     if n < 2 {
         return Vec::new();
     }
-    let corners = |t: usize| triangles[t].map(|v| positions[v as usize].as_dvec3());
     let boxes: Vec<[DVec3; 2]> = (0..n)
         .map(|t| {
             let [a, b, c] = corners(t);
@@ -65,10 +114,9 @@ pub fn crossings(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Crossing> {
             (lo.min(b[0]), hi.max(b[1]))
         });
     let size = (hi - lo).max_element();
-    if size <= 0.0 {
+    if !(size > 0.0 && size.is_finite()) {
         return Vec::new();
     }
-    let tolerance = 1e-9 * size;
     // A grid of cells about the size of a typical triangle (the median of their largest
     // extents), at most 2^20 cells a side, coarser where the triangles would fill more than
     // 16 cells each on average.
@@ -122,11 +170,12 @@ pub fn crossings(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Crossing> {
         a[0].cmple(b[1] + tolerance).all() && b[0].cmple(a[1] + tolerance).all()
     };
     let test = |t: usize, u: usize| -> Option<Crossing> {
-        if !overlap(t, u) || shares_an_edge(triangles[t], triangles[u], positions) {
+        let (t, u) = (t.min(u), t.max(u));
+        if !overlap(t, u) || !admits(t, u) {
             return None;
         }
         let ends = crossing_segment(corners(t), corners(u), tolerance)?;
-        let (t, u) = (t.min(u) as u32, t.max(u) as u32);
+        let (t, u) = (t as u32, u as u32);
         Some(Crossing { t, u, ends })
     };
     // Runs of one cell; a pair is tested in the cell that holds the low corner of its boxes'
@@ -315,6 +364,28 @@ mod tests {
                 assert!(on_box(q, DVec3::ZERO, 1.0) && on_box(q, c, h), "{q}");
             }
         }
+    }
+
+    /// Two surfaces' crossings are the crossings between the triangles of one and the other
+    /// in the mesh of both.
+    #[test]
+    fn crossings_between_two_surfaces_are_those_of_the_mesh_of_both() {
+        let (mut p, mut t) = (Vec::new(), Vec::new());
+        box_mesh(Vec3::ZERO, 1.0, &mut p, &mut t);
+        box_mesh(Vec3::new(1.5, 0.3, 0.2), 0.8, &mut p, &mut t);
+        let soup = |range: std::ops::Range<usize>| -> Vec<[DVec3; 3]> {
+            t[range]
+                .iter()
+                .map(|c| c.map(|v| p[v as usize].as_dvec3()))
+                .collect()
+        };
+        let between = crossings_between(&soup(0..12), &soup(12..24), 1e-9);
+        let mut both = crossings(&p, &t);
+        for c in &mut both {
+            c.u -= 12;
+        }
+        assert!(!between.is_empty());
+        assert_eq!(between, both);
     }
 
     /// The grid finds what testing every pair finds, on a soup of small triangles and large
