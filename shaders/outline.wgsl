@@ -340,7 +340,7 @@ fn listed_edge(item: Listed) -> Clipped {
         n = BACKGROUND_ID;
     }
     let anchor = pattern_anchor(inst, t, i, a, b, mode);
-    var c = clip_outline(inst, t, n, a, b, anchor, cut_plane(mode), false);
+    var c = clip_outline(On(inst, t, inst, n, false), a, b, anchor, cut_plane(mode));
     c.seg.cap = capped(inst, t, i, mode);
     return c;
 }
@@ -361,20 +361,23 @@ fn outline_pieces_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_i
 }
 
 // The frame's intersection segments (src/gpu/frame.rs, IntersectionRecord): where
-// triangles t and u of the instance in `slot` cross, from a to b in its local coordinates.
+// triangle t of the instance in `slot` crosses triangle u of the instance in `other` (the
+// same one where a mesh passes through itself), from a to b in the first's local
+// coordinates.
 struct Intersection {
     a: vec3<f32>,
     slot: u32,
     b: vec3<f32>,
     t: u32,
     u: u32,
+    other: u32,
 }
 @group(0) @binding(28) var<storage, read> intersections: array<Intersection>;
 
 // Intersection segment k on screen.
 fn clip_intersection(k: u32) -> Clipped {
     let s = intersections[k];
-    return clip_outline(s.slot, s.t, s.u, s.a, s.b, vec4<f32>(0.0, 1.0, 0.0, 1.0), NO_PLANE, true);
+    return clip_outline(On(s.slot, s.t, s.other, s.u, true), s.a, s.b, vec4<f32>(0.0, 1.0, 0.0, 1.0), NO_PLANE);
 }
 
 // One invocation per intersection segment: lists its pieces that reach the targets, after
@@ -718,6 +721,17 @@ const REACH_SLACK: f32 = 1e-3;
 // first dash starts where a chain's first edge ends); twin of edge_math::DASH_SLACK.
 const DASH_SLACK: f32 = 1e-3;
 
+// The triangles a line lies on: t of `inst`, and n of `other`: an edge's neighbour across
+// it (of the same instance; BACKGROUND_ID for none), or for an intersection line
+// (`crossing`) the triangle it crosses, of the same instance or of another.
+struct On {
+    inst: u32,
+    t: u32,
+    other: u32,
+    n: u32,
+    crossing: bool,
+}
+
 // The screen segment of an outline edge, clipped to the view and the targets.
 struct Segment {
     start: Projected,
@@ -725,6 +739,8 @@ struct Segment {
     inst: u32,
     t: u32,
     n: u32,
+    // The instance of n.
+    other: u32,
     // Position of `start` along the visible line's pattern (pixels from the pattern's
     // anchor), and +1 or -1 as the pattern runs towards `end` or away from it; then the
     // hidden line's.
@@ -752,7 +768,7 @@ fn seg_class(s: Segment, k: f32) -> u32 {
     let inset = min(END_INSET / max(distance(s.start.xy, s.end.xy), 1e-30), 0.5);
     let q = seg_at(s, clamp(k, inset, 1.0 - inset));
     let w = 1.0 / q.inv_w;
-    let c = class_at(q.xy, q.near_w * w, w, q.reverse, s.inst, vec3<u32>(s.t, s.n, u32(s.crossing)), s.cap);
+    let c = class_at(q.xy, q.near_w * w, w, q.reverse, On(s.inst, s.t, s.other, s.n, s.crossing), s.cap);
 #if HIDDEN
     let behind_host = (instances[slot(s.inst)].flags & INSTANCE_BEHIND_HOST) != 0u;
     return select(c, 1u, c == 2u && behind_host);
@@ -799,7 +815,7 @@ fn edge_span(inst: u32, a: vec3<f32>, b: vec3<f32>, skip: u32) -> Span {
     return span;
 }
 
-// Edge a -> b of triangle t of `inst` (with neighbour n) on screen: its segment in front of
+// Line a -> b (in the local coordinates of `on.inst`) on screen: its segment in front of
 // the near plane, not beyond the far one, and inside the image and its guard band (not the
 // targets: a tile then samples and bisects the same points as the whole image, and computes
 // exactly what the whole image does), its length, and the pieces it is drawn in (0 when
@@ -812,7 +828,8 @@ struct Clipped {
     pieces: u32,
 }
 
-fn clip_outline(inst: u32, t: u32, n: u32, a: vec3<f32>, b: vec3<f32>, anchor: vec4<f32>, skip: u32, crossing: bool) -> Clipped {
+fn clip_outline(on: On, a: vec3<f32>, b: vec3<f32>, anchor: vec4<f32>, skip: u32) -> Clipped {
+    let inst = on.inst;
     var c: Clipped;
     c.pieces = 0u;
     let span = edge_span(inst, a, b, skip);
@@ -832,16 +849,17 @@ fn clip_outline(inst: u32, t: u32, n: u32, a: vec3<f32>, b: vec3<f32>, anchor: v
     c.seg.start = lerp_projected(p0, p1, u.x);
     c.seg.end = lerp_projected(p0, p1, u.y);
     c.seg.inst = inst;
-    c.seg.t = t;
-    c.seg.n = n;
-    c.seg.crossing = crossing;
+    c.seg.t = on.t;
+    c.seg.n = on.n;
+    c.seg.other = on.other;
+    c.seg.crossing = on.crossing;
     let full = length(d);
     c.seg.phase = anchor.x + select((1.0 - u.x) * full, u.x * full, anchor.y > 0.0);
     c.seg.phase_dir = anchor.y;
     c.seg.hidden_phase = anchor.z + select((1.0 - u.x) * full, u.x * full, anchor.w > 0.0);
     c.seg.hidden_dir = anchor.w;
     c.length_px = length(c.seg.end.xy - c.seg.start.xy);
-    c.pieces = max(u32(ceil(c.length_px / piece_px(line_window(inst, t, n, crossing).r))), 1u);
+    c.pieces = max(u32(ceil(c.length_px / piece_px(line_window(on).r))), 1u);
     return c;
 }
 
@@ -851,7 +869,7 @@ fn clip_outline(inst: u32, t: u32, n: u32, a: vec3<f32>, b: vec3<f32>, anchor: v
 fn list_outline(inst: u32, t: u32, i: u32, n: u32, a: vec3<f32>, b: vec3<f32>, mode: u32) {
     // The pattern's anchor only matters where a piece is drawn here (the piece pass finds it
     // for the pieces it draws): looking it up for every listed edge would cost every lane.
-    let c = clip_outline(inst, t, n, a, b, vec4<f32>(0.0, 1.0, 0.0, 1.0), cut_plane(mode), false);
+    let c = clip_outline(On(inst, t, inst, n, false), a, b, vec4<f32>(0.0, 1.0, 0.0, 1.0), cut_plane(mode));
     var visible_width = select(instances[slot(inst)].line_width, instances[slot(inst)].outline_width, (mode & DRAW_OUTLINE) != 0u);
     visible_width = select(visible_width, frame.section_width, (mode & DRAW_CUT) != 0u);
     var reach = select(0.0, line_reach(visible_width), (mode & DRAW_VISIBLE) != 0u);
@@ -1129,10 +1147,9 @@ fn mark_outline_tiles(first_m: i32, last_m: i32, first_o: i32, last_o: i32, majo
     }
 }
 
-// Whether the edge's point at screen point x (near row `near`, w `w`, reverse depth `reverse`)
-// on triangles `line.xy` (t and n) of `inst` (`line.z` 1 for an intersection line)
-// is visible (0), hidden by a triangle other than t and n of `inst` that covers x nearer
-// than the point (1), or by the host (2, host_hides_point). The candidates are the triangles the
+// Whether the point at screen point x (near row `near`, w `w`, reverse depth `reverse`) of a
+// line on the triangles `on` is visible (0), hidden by a triangle other than those
+// (`lies_on`) that covers x nearer than the point (1), or by the host (2, host_hides_point). The candidates are the triangles the
 // rasterizer gave the 3×3 pixel centres around x (5×5, and the line's triangles' other
 // neighbours, in a frame with section planes; a sliver of surface in front of the edge
 // may own no centre next to x, but one a pixel further on), and those a walk across edges
@@ -1147,9 +1164,7 @@ fn mark_outline_tiles(first_m: i32, last_m: i32, first_o: i32, last_o: i32, majo
 // surface in front of it (within HIDDEN_MARGIN) faces away, the ray came out of the solid
 // through it; where that surface faces the eye, it went in there; where none is nearer by
 // CAP_MARGIN, the line's own triangles tell (CAP_INSIDE).
-fn class_at(x: vec2<f32>, near: f32, w: f32, reverse: f32, inst: u32, line: vec3<u32>, cap: u32) -> u32 {
-    let t = line.x;
-    let n = line.y;
+fn class_at(x: vec2<f32>, near: f32, w: f32, reverse: f32, on: On, cap: u32) -> u32 {
     let centre = vec2<i32>(floor(x - frame.target_origin));
     if host_hides_point(x - frame.target_origin, reverse) {
         return 2u;
@@ -1158,21 +1173,20 @@ fn class_at(x: vec2<f32>, near: f32, w: f32, reverse: f32, inst: u32, line: vec3
     // The nearest surface in front of the point within HIDDEN_MARGIN: its near row, and 1
     // where it faces away (where none is, the line's own triangles tell).
     var front = vec2<f32>(near, select(0.0, 1.0, cap == CAP_INSIDE));
-    let base = instances[slot(inst)].triangle_base;
-    let window = line_window(inst, t, n, line.z != 0u);
+    let window = line_window(on);
     let wide = window.wide;
     let r = window.r;
     let across = 2 * r + 1;
     for (var k = 0; k < across * across; k++) {
         let offset = vec2<i32>(k % across - r, k / across - r);
         let id = id_at(centre + offset);
-        if id.x >= HOST_ID || (id.x == inst && (id.y == t || id.y == n)) || all(id == last) {
+        if id.x >= HOST_ID || lies_on(on, id.x, id.y) || all(id == last) {
             continue;
         }
         last = id;
         // The outer ring's walks only cross the sheet's last few triangles to x.
         let steps = select(WALK_STEPS, FOLD_STEPS, max(abs(offset.x), abs(offset.y)) > 1);
-        if hides(locate(id.x, id.y, x, steps, true), inst, t, n, near, w, &front) {
+        if hides(locate(id.x, id.y, x, steps, true), on, near, w, &front) {
             return 1u;
         }
     }
@@ -1181,15 +1195,16 @@ fn class_at(x: vec2<f32>, near: f32, w: f32, reverse: f32, inst: u32, line: vec3
         // that face the same way: a sheet that folds back over the line starts there (the
         // walks from the pixels stop at such folds).
         for (var j = 0u; j < 6u; j++) {
-            let owner = select(n, t, j < 3u);
+            let owner = select(on.n, on.t, j < 3u);
+            let owner_inst = select(on.other, on.inst, j < 3u);
             if owner == BACKGROUND_ID {
                 continue;
             }
-            let m = neighbour(base + owner, j % 3u);
-            if m == BACKGROUND_ID || m == t || m == n {
+            let m = neighbour(instances[slot(owner_inst)].triangle_base + owner, j % 3u);
+            if m == BACKGROUND_ID || lies_on(on, owner_inst, m) {
                 continue;
             }
-            if hides(locate(inst, m, x, FOLD_STEPS, true), inst, t, n, near, w, &front) {
+            if hides(locate(owner_inst, m, x, FOLD_STEPS, true), on, near, w, &front) {
                 return 1u;
             }
         }
@@ -1197,8 +1212,8 @@ fn class_at(x: vec2<f32>, near: f32, w: f32, reverse: f32, inst: u32, line: vec3
     return select(0u, 1u, cap != CAP_NONE && front.y > 0.0);
 }
 
-// The window of pixel ids `class_at` looks at round a point of a line on triangles t and n
-// of `inst` (`crossing`: an intersection line on both): its radius (one of
+// The window of pixel ids `class_at` looks at round a point of a line on the triangles `on`
+// (`on.crossing`: an intersection line on both): its radius (one of
 // loop_budget::WINDOW_RADII), and whether it is wide, where class_at also walks from the
 // line's triangles' other neighbours.
 struct Window {
@@ -1206,26 +1221,30 @@ struct Window {
     wide: bool,
 }
 
-fn line_window(inst: u32, t: u32, n: u32, crossing: bool) -> Window {
+fn line_window(on: On) -> Window {
     // Through a section's cut the eye sees the inside of folded surfaces, where the sheet in
     // front of an interior silhouette thins out near a fold of its own: look two pixels
     // round for it there.
     // Where surfaces cross, the surface a line passes into may show only a few pixels away
     // (where those in front of it end): look four pixels round (frame::CROSSING_BAND).
-    let base = instances[slot(inst)].triangle_base;
-    let bits = info[base + t] | select(0u, info[base + n], n != BACKGROUND_ID);
-    let crossed = (bits & INFO_CROSSED) != 0u || (instances[slot(inst)].flags & INSTANCE_CROSSED) != 0u;
+    let bits = info[instances[slot(on.inst)].triangle_base + on.t] | select(0u, info[instances[slot(on.other)].triangle_base + on.n], on.n != BACKGROUND_ID);
+    let crossed = (bits & INFO_CROSSED) != 0u || ((instances[slot(on.inst)].flags | instances[slot(on.other)].flags) & INSTANCE_CROSSED) != 0u;
     let wide = frame.sections_on != 0u || crossed;
     // An intersection line lies on both surfaces that cross there, so no surface passes
     // into view beyond it: it takes a section's window.
-    return Window(select(select(select(1, 2, wide), 4, crossed), 2, crossing), wide);
+    return Window(select(select(select(1, 2, wide), 4, crossed), 2, on.crossing), wide);
 }
 
-// Whether sample s of a triangle other than t and n of `inst` covers the line's point (near
+// Whether triangle `tri` of instance `inst` is one the line lies on.
+fn lies_on(on: On, inst: u32, tri: u32) -> bool {
+    return (inst == on.inst && tri == on.t) || (inst == on.other && tri == on.n);
+}
+
+// Whether sample s of a triangle the line does not lie on covers the line's point (near
 // row `near`, w `w`) nearer than it (by HIDDEN_MARGIN); else keeps in `front` the nearest
 // one within that margin but nearer by CAP_MARGIN, and whether it faces away.
-fn hides(s: Sample, inst: u32, t: u32, n: u32, near: f32, w: f32, front: ptr<function, vec2<f32>>) -> bool {
-    if !s.covers || (s.inst == inst && (s.tri == t || s.tri == n)) {
+fn hides(s: Sample, on: On, near: f32, w: f32, front: ptr<function, vec2<f32>>) -> bool {
+    if !s.covers || lies_on(on, s.inst, s.tri) {
         return false;
     }
     if nearer(s.near, near, w) {

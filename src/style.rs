@@ -77,10 +77,12 @@ pub struct Style {
     /// Width of the cut lines in pixels; `None` draws them at
     /// [`line_width`](Self::line_width).
     pub section_line_width: Option<f32>,
-    /// Whether to draw intersection lines: where surfaces of a mesh pass through each other
-    /// (a part modelled through another, an interference fit in an assembly held in one
-    /// mesh), the curve along which they meet, where it is visible. Found once per mesh, in
-    /// its own coordinates, when it is uploaded ([`Mesh::intersections`](crate::Mesh::intersections)).
+    /// Whether to draw intersection lines: where surfaces pass through each other (a part
+    /// modelled through another, an interference fit in an assembly), the curve along which
+    /// they meet, where it is visible. A mesh's own are found once, in its own coordinates,
+    /// when it is uploaded ([`Mesh::intersections`](crate::Mesh::intersections)); those
+    /// between two instances as a frame is prepared, for the instances whose placed bounds
+    /// meet, and kept while both keep their placement.
     pub intersection_lines: bool,
     /// Colour of the intersection lines.
     pub intersection_line_color: Color,

@@ -282,6 +282,147 @@ fn instances_through_each_other() {
     );
 }
 
+/// A box mesh, polygon edges.
+fn box_mesh() -> Arc<Mesh> {
+    let (mut p, mut t, mut m) = (Vec::new(), Vec::new(), Vec::new());
+    add_box(Vec3::ZERO, 1.0, (0.0, 0.0), &mut p, &mut t, &mut m);
+    Arc::new(Mesh::new(p, None, t, Some(m)).unwrap())
+}
+
+/// Two instances of one box through each other, the second moved by `shift`, turned and
+/// shrunk; and `more` objects of other meshes.
+fn boxes_as_instances(shift: DVec3, edges: EdgeSelection) -> World {
+    World {
+        meshes: vec![WorldMesh {
+            mesh: box_mesh(),
+            edges,
+            name: "box".into(),
+        }],
+        objects: vec![
+            Object::new(0, DMat4::IDENTITY),
+            Object::new(
+                0,
+                DMat4::from_translation(shift)
+                    * DMat4::from_euler(glam::EulerRot::YXZ, 0.5, 0.35, 0.0)
+                    * DMat4::from_scale(DVec3::splat(0.7)),
+            ),
+        ],
+        sections: Vec::new(),
+    }
+}
+
+/// Intersection lines between instances (where two placed surfaces meet, found as the frame
+/// is prepared): the boxes as two instances of one mesh (every camera, both edge modes),
+/// dense spheres through each other (one stretched, one mirrored) with wide lines, against
+/// the ground truth over every pixel.
+#[test]
+fn intersection_lines_between_instances() {
+    let target = DVec3::new(0.6, 0.3, 0.2);
+    let shift = DVec3::new(0.9, 0.45, 0.35);
+    for (edges, width) in [
+        (EdgeSelection::Polygon, 1.5),
+        (EdgeSelection::Feature(30.0), 3.0),
+    ] {
+        let world = boxes_as_instances(shift, edges);
+        let style = Style {
+            intersection_lines: true,
+            intersection_line_width: Some(width),
+            ..Style::default()
+        };
+        let mut drawn = 0;
+        for (camera, view) in cameras(target) {
+            let (_, crossing) = check(
+                &format!("box instances, intersection lines, {edges:?}, {camera}"),
+                &world,
+                view,
+                &style,
+            );
+            drawn += usize::from(crossing > 0);
+        }
+        assert!(
+            drawn >= 3,
+            "{edges:?}: {drawn} views draw intersection lines"
+        );
+    }
+    let sphere = Arc::new(wirepass::mesh::sphere(20_000).unwrap());
+    let world = World {
+        meshes: vec![WorldMesh {
+            mesh: sphere,
+            edges: EdgeSelection::Polygon,
+            name: "sphere".into(),
+        }],
+        objects: vec![
+            Object::new(
+                0,
+                DMat4::from_rotation_y(0.4) * DMat4::from_scale(DVec3::new(1.0, 1.6, 0.7)),
+            ),
+            Object::new(
+                0,
+                DMat4::from_translation(DVec3::new(0.9, 0.5, 0.1))
+                    * DMat4::from_rotation_x(1.1)
+                    * DMat4::from_scale(DVec3::new(-0.8, 0.8, 0.8)),
+            ),
+        ],
+        sections: Vec::new(),
+    };
+    let style = Style {
+        line_width: 1.0,
+        intersection_lines: true,
+        intersection_line_width: Some(4.0),
+        ..Style::default()
+    };
+    let (_, crossing) = check(
+        "sphere instances, intersection lines",
+        &world,
+        perspective(DVec3::new(2.2, 2.0, 3.4), DVec3::new(0.5, 0.3, 0.1)),
+        &style,
+    );
+    assert!(crossing > 0, "the spheres' intersection line is drawn");
+}
+
+/// Intersection lines follow the instances from frame to frame of one upload: drawn where
+/// the boxes cross, gone when one moves clear, back to the same bits when it returns.
+#[test]
+fn intersection_lines_follow_moving_instances() {
+    use wirepass::gpu::{DeferredPass, PassOptions};
+    use wirepass::tools::offline::draw_deferred_with;
+    use wirepass::world::offscreen::Uploaded;
+    use wirepass::world::Shot;
+    let ctx = common::gpu();
+    let crossed = boxes_as_instances(DVec3::new(0.9, 0.45, 0.35), EdgeSelection::Polygon);
+    let apart = boxes_as_instances(DVec3::new(3.0, 0.45, 0.35), EdgeSelection::Polygon);
+    let up = Uploaded::new(&ctx.device, &ctx.queue, &crossed).unwrap();
+    let style = Style {
+        intersection_lines: true,
+        intersection_line_width: Some(2.0),
+        ..Style::default()
+    };
+    let view = perspective(DVec3::new(3.0, 2.2, 4.6), DVec3::new(0.9, 0.3, 0.2));
+    let draw = |world: &World| {
+        let shot = Shot {
+            world,
+            view,
+            style: &style,
+            size: SIZE,
+        };
+        let pass = DeferredPass::new(&ctx.device, PassOptions::default()).unwrap();
+        draw_deferred_with(ctx, &shot, &up, pass.with_diagnostics()).unwrap()
+    };
+    let class = LineClass::Intersection as u8;
+    let lines =
+        |r: &wirepass::world::Rendering| r.line_class.iter().filter(|&&c| c == class).count();
+    let first = draw(&crossed);
+    assert!(lines(&first) > 0);
+    assert_eq!(lines(&draw(&apart)), 0);
+    let back = draw(&crossed);
+    assert!(first
+        .edge_distance
+        .iter()
+        .zip(&back.edge_distance)
+        .all(|(a, b)| a.to_bits() == b.to_bits()));
+    check("box instances, moved back", &crossed, view, &style);
+}
+
 /// Intersection lines, where the surfaces of a mesh meet: the two boxes (thin and wide lines,
 /// every camera; every polygon edge or the box edges) and Suzanne's eyes, against the ground truth.
 #[test]

@@ -246,7 +246,8 @@ pub(crate) struct FrameRecords {
 }
 
 /// One intersection segment of a frame (`struct Intersection` in outline.wgsl): where
-/// triangles `t` and `u` of the instance in `slot` cross, its ends `a`, `b` in the
+/// triangle `t` of the instance in `slot` crosses triangle `u` of the instance in `other`
+/// (the same one where a mesh passes through itself), its ends `a`, `b` in the first
 /// instance's local (stored) coordinates.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
@@ -256,7 +257,8 @@ pub(crate) struct IntersectionRecord {
     b: [f32; 3],
     t: u32,
     u: u32,
-    _pad: [u32; 3],
+    other: u32,
+    _pad: [u32; 2],
 }
 
 /// An instance whose drawn edges' chains carry a dashed or dotted hidden-line pattern: its
@@ -458,7 +460,8 @@ impl FrameRecords {
             .ok()
             .filter(|_| u32::try_from(chains).is_ok())
             .ok_or_else(too_many_chains)?;
-        // Intersection lines: every crossing pair of every instance's mesh.
+        // Intersection lines: every crossing pair of every instance's mesh, and of every
+        // two instances that pass through each other (`instance_crossings.rs`).
         let mut intersections = Vec::new();
         if style.intersection_lines {
             for (slot, &i) in order.iter().enumerate() {
@@ -469,7 +472,39 @@ impl FrameRecords {
                     b: c.ends[1],
                     t: c.t,
                     u: c.u,
-                    _pad: [0; 3],
+                    other: slot as u32,
+                    _pad: [0; 2],
+                }));
+            }
+            let mut slot_of = vec![0u32; order.len()];
+            for (slot, &i) in order.iter().enumerate() {
+                slot_of[i as usize] = slot as u32;
+            }
+            // Each box grown by its share of the pair's tolerance.
+            let boxes: Vec<(DVec3, DVec3)> = placed
+                .iter()
+                .map(|&(bounds, t)| {
+                    let (lo, hi) = crate::scene::world_box(bounds, t);
+                    let grow = crate::mesh::crossings::pair_tolerance((lo, hi), (lo, hi));
+                    (lo - grow, hi + grow)
+                })
+                .collect();
+            let mut cache = store.pair_cache();
+            cache.begin_frame();
+            for (i, j) in crate::scene::meeting_pairs(&boxes) {
+                let (a, b) = (&scene.instances[i], &scene.instances[j]);
+                let records = (store.record(a.mesh)?, store.record(b.mesh)?);
+                let pair = ((a.mesh, a.transform), (b.mesh, b.transform));
+                let (slot, other) = (slot_of[i], slot_of[j]);
+                let found = cache.between(pair, records);
+                intersections.extend(found.iter().map(|c| IntersectionRecord {
+                    a: c.ends[0],
+                    slot,
+                    b: c.ends[1],
+                    t: c.t,
+                    u: c.u,
+                    other,
+                    _pad: [0; 2],
                 }));
             }
         }
@@ -905,6 +940,8 @@ mod tests {
             lines: Default::default(),
             bounds_of_clusters: vec![].into(),
             intersections: vec![].into(),
+            positions: vec![].into(),
+            indices: vec![].into(),
         };
         let transform = DMat4::from_scale_rotation_translation(
             DVec3::new(-1.0, 2.0, 0.5),

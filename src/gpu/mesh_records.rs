@@ -31,7 +31,9 @@ pub(crate) struct MeshLines {
 /// One mesh as the arena stores it.
 pub(crate) struct MeshData {
     pub vertices: Vec<[f32; 4]>,
-    pub indices: Vec<[u32; 3]>,
+    pub indices: Arc<[[u32; 3]]>,
+    /// The mesh's positions in its own coordinates.
+    pub positions: Arc<[Vec3]>,
     pub neighbours: Vec<[u32; 3]>,
     pub info: Vec<u32>,
     pub clusters: Vec<[f32; 8]>,
@@ -110,6 +112,7 @@ impl MeshData {
             .collect();
         MeshData {
             intersections,
+            positions: mesh.positions().into(),
             vertices,
             indices,
             neighbours,

@@ -18,14 +18,15 @@
 // `!(a > b)` is deliberate throughout: NaN must take the rejecting branch.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+use super::instance_crossings::PairCache;
 use super::mesh_records::{
     cluster_records, EdgeData, MeshData, MeshLines, StoredCrossing, MAX_MESH_TRIANGLES,
 };
 use crate::error::{Error, Result};
 use crate::mesh::{EdgeSelection, Mesh};
-use glam::{DMat4, DVec3};
+use glam::{DMat4, DVec3, Vec3};
 use std::sync::atomic::{AtomicU32, Ordering};
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 /// Bytes per stored vertex: position (3 × f32) and packed normal.
 pub(crate) const VERTEX_BYTES: u64 = 16;
@@ -47,6 +48,18 @@ pub struct MeshId {
     store: u32,
     slot: u32,
     generation: u32,
+}
+
+#[cfg(test)]
+impl MeshId {
+    /// An id of slot `slot` in no store.
+    pub(crate) fn unstored(slot: u32) -> MeshId {
+        MeshId {
+            store: 0,
+            slot,
+            generation: 0,
+        }
+    }
 }
 
 /// Where one mesh lives in the arena, and how its stored coordinates map to its own.
@@ -77,9 +90,56 @@ pub(crate) struct MeshRecord {
     pub bounds_of_clusters: Arc<[[f32; 8]]>,
     /// Its crossing triangles and their intersection lines.
     pub intersections: Arc<[StoredCrossing]>,
+    /// Its positions (in its own coordinates) and its triangles in stored order: where
+    /// instances pass through each other, their intersection lines are found from these
+    /// (`instance_crossings.rs`).
+    pub positions: Arc<[Vec3]>,
+    pub indices: Arc<[[u32; 3]]>,
 }
 
 impl MeshRecord {
+    /// The record of `data` placed at `bases` (vertices, triangles, clusters, chain records),
+    /// of `counts` each.
+    fn new(data: MeshData, bases: [u32; 4], counts: [u32; 4]) -> MeshRecord {
+        let [vertex_base, triangle_base, cluster_base, chain_base] = bases;
+        let [vertices, triangles, clusters, chain_records] = counts;
+        MeshRecord {
+            vertex_base,
+            vertices,
+            triangle_base,
+            triangles,
+            cluster_base,
+            clusters,
+            chain_base,
+            chain_records,
+            chains: data.chains.chains,
+            table_log2: data.chains.table_log2,
+            origin: data.origin,
+            scale: data.scale,
+            order: data.order,
+            bounds: data.bounds,
+            lines: data.lines,
+            bounds_of_clusters: data.bounds_of_clusters,
+            intersections: data.intersections,
+            positions: data.positions,
+            indices: data.indices,
+        }
+    }
+
+    /// The record of `mesh` as the store would make it, at the start of empty buffers.
+    #[cfg(test)]
+    pub fn unstored(mesh: &Mesh) -> MeshRecord {
+        let data = MeshData::new(mesh, EdgeSelection::All);
+        let counts = [
+            data.vertices.len(),
+            data.indices.len(),
+            data.clusters.len(),
+            data.chains.records.len(),
+        ]
+        .map(|n| n as u32);
+        MeshRecord::new(data, [0; 4], counts)
+    }
+
     /// Stored (rebased, scaled) coordinates → the mesh's own coordinates.
     pub fn local_to_mesh(&self) -> DMat4 {
         DMat4::from_translation(self.origin) * DMat4::from_scale(DVec3::splat(self.scale))
@@ -163,6 +223,10 @@ enum Kind {
 /// All meshes' GPU buffers. Insert meshes once; instances of them are then drawn by any
 /// pass of the same device.
 ///
+/// The store also keeps each mesh's positions and triangles in CPU memory (12 bytes a vertex
+/// and 12 a triangle), from which a frame with intersection lines finds where two instances
+/// pass through each other ([`Style::intersection_lines`](crate::Style::intersection_lines)).
+///
 /// ```
 /// # fn main() -> Result<(), Box<dyn std::error::Error>> {
 /// # use wirepass::wgpu;
@@ -194,6 +258,8 @@ pub struct MeshStore {
     free_slots: Vec<u32>,
     /// Bumped whenever stored data may be overwritten under frames prepared earlier.
     version: u64,
+    /// The intersection lines of instance pairs found for recent frames.
+    pairs: Mutex<PairCache>,
 }
 
 impl MeshStore {
@@ -262,6 +328,7 @@ impl MeshStore {
             slots: Vec::new(),
             free_slots: Vec::new(),
             version: 0,
+            pairs: Mutex::default(),
         }
     }
 
@@ -309,25 +376,11 @@ impl MeshStore {
         write(c, cluster_base, bytemuck::cast_slice(&data.clusters));
         write(h, chain_base, bytemuck::cast_slice(&chains.records));
 
-        let record = MeshRecord {
-            vertex_base,
-            vertices,
-            triangle_base,
-            triangles,
-            cluster_base,
-            clusters,
-            chain_base,
-            chain_records,
-            chains: chains.chains,
-            table_log2: chains.table_log2,
-            origin: data.origin,
-            scale: data.scale,
-            order: data.order,
-            bounds: data.bounds,
-            lines: data.lines,
-            bounds_of_clusters: data.bounds_of_clusters,
-            intersections: data.intersections,
-        };
+        let record = MeshRecord::new(
+            data,
+            [vertex_base, triangle_base, cluster_base, chain_base],
+            [vertices, triangles, clusters, chain_records],
+        );
         let slot = match self.free_slots.pop() {
             Some(s) => s,
             None => {
@@ -456,6 +509,12 @@ impl MeshStore {
             Some((generation, Some(record))) if *generation == id.generation => Ok(record),
             _ => Err(Error::Misuse("the mesh was removed from the store".into())),
         }
+    }
+
+    /// The intersection lines of instance pairs found for recent frames.
+    pub(crate) fn pair_cache(&self) -> std::sync::MutexGuard<'_, PairCache> {
+        // The cache only ever holds whole entries, so one left by a panicking thread is sound.
+        self.pairs.lock().unwrap_or_else(|e| e.into_inner())
     }
 
     pub(crate) fn version(&self) -> u64 {

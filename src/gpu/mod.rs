@@ -17,6 +17,7 @@ mod diagnostics;
 mod edge_pass;
 mod frame;
 mod host_depth;
+mod instance_crossings;
 mod loop_budget;
 mod mesh_records;
 mod mesh_store;

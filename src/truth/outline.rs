@@ -22,8 +22,10 @@
 //!
 //! With intersection lines on ([`Style::intersection_lines`](crate::Style::intersection_lines)),
 //! the segments along which an object's crossing triangles meet
-//! ([`Mesh::intersections`](crate::Mesh::intersections)) are drawn where visible, hidden by
-//! any surface but the two they lie on.
+//! ([`Mesh::intersections`](crate::Mesh::intersections)), and those along which the
+//! triangles of two objects cross (found in world coordinates over all their triangles, for
+//! every two objects whose placed bounds meet), are drawn where visible, hidden by any surface
+//! but the two they lie on; a line between two objects is the lower object's.
 //!
 //! Visibility along an edge is found by casting a ray through points every 1/8 pixel of its
 //! projection and bisecting each change to 2⁻³⁰ of the edge. The GPU pass does the same at
@@ -298,7 +300,7 @@ pub(crate) fn outline_map(
                         let ends = c.ends.map(|p| object.transform.transform_point3(p));
                         let lines = (([0.0; 2], (0.0, true)), (0.0, true));
                         return view.stretches(
-                            first,
+                            (first, first),
                             (c.t, c.u, (ends[0], ends[1])),
                             (o as u32, widths),
                             draw,
@@ -311,7 +313,7 @@ pub(crate) fn outline_map(
                         let lines = (([0.0; 2], (0.0, true)), (0.0, true));
                         let edge = (t, NO_NEIGHBOUR, ends);
                         return view.stretches(
-                            first,
+                            (first, first),
                             edge,
                             (o as u32, widths),
                             draw,
@@ -359,7 +361,7 @@ pub(crate) fn outline_map(
                     };
                     let lines = (visible, along(0));
                     view.stretches(
-                        first,
+                        (first, first),
                         (t, n, ends),
                         (o as u32, widths),
                         draw,
@@ -369,8 +371,13 @@ pub(crate) fn outline_map(
                 .collect::<Vec<_>>()
         })
         .unzip();
+    let between = if shot.style.intersection_lines {
+        view.lines_between_objects(f64::from(shot.style.intersection_width()))
+    } else {
+        Vec::new()
+    };
     let fade = shot.style.fade_range().map(f64::from);
-    let visible: Vec<Stretch> = visible.into_iter().flatten().collect();
+    let visible: Vec<Stretch> = visible.into_iter().flatten().chain(between).collect();
     let line = splat(&visible, shot.size, fade, host);
     let stretches: Vec<Stretch> = hidden_stretches.into_iter().flatten().collect();
     let hidden = splat(&stretches, shot.size, fade, host);
@@ -489,6 +496,62 @@ enum Class {
 }
 
 impl Visibility<'_> {
+    /// The visible stretches of the intersection lines between objects, `width` wide.
+    fn lines_between_objects(&self, width: f64) -> Vec<Stretch> {
+        use crate::mesh::crossings::{crossings_between, pair_tolerance};
+        let world = self.caster.world();
+        let boxes: Vec<(DVec3, DVec3)> = world
+            .objects
+            .iter()
+            .map(|o| crate::scene::world_box(world.meshes[o.mesh].mesh.bounds_f64(), o.transform))
+            .collect();
+        let grown: Vec<(DVec3, DVec3)> = boxes
+            .iter()
+            .map(|&b| {
+                let grow = pair_tolerance(b, b);
+                (b.0 - grow, b.1 + grow)
+            })
+            .collect();
+        let firsts = self.caster.first_ids();
+        let corners = |o: usize| {
+            let count = world.meshes[world.objects[o].mesh].mesh.triangle_count() as u32;
+            (0..count)
+                .map(|t| self.caster.corners(firsts[o] + t))
+                .collect::<Vec<_>>()
+        };
+        let draw = Draw {
+            visible: true,
+            hidden: false,
+            outline: false,
+            cut: None,
+            // (Any index: only a mesh's own lines look theirs up.)
+            crossing: Some(0),
+            cap: Cap::None,
+        };
+        let lines = (([0.0; 2], (0.0, true)), (0.0, true));
+        let widths = (0.0, 0.0, 0.0, width);
+        crate::scene::meeting_pairs(&grown)
+            .into_iter()
+            .flat_map(|(a, b)| {
+                let tolerance = pair_tolerance(boxes[a], boxes[b]);
+                crossings_between(&corners(a), &corners(b), tolerance)
+                    .into_par_iter()
+                    .flat_map_iter(move |c| {
+                        let ends = (c.ends[0], c.ends[1]);
+                        self.stretches(
+                            (firsts[a], firsts[b]),
+                            (c.t, c.u, ends),
+                            (a as u32, widths),
+                            draw,
+                            (lines, None),
+                        )
+                        .0
+                    })
+                    .collect::<Vec<_>>()
+            })
+            .collect()
+    }
+
     /// The part of the edge `a` → `b` (world coordinates) in front of the near plane, not
     /// beyond the far one and not behind a section plane, as parameters along it, and the
     /// projections of its ends.
@@ -573,13 +636,14 @@ impl Visibility<'_> {
     /// The dashes of the visible stretches (where `draw.visible`, in the visible pattern
     /// (dash, period)) and of the hidden stretches (where `draw.hidden`, in `hidden`'s pattern
     /// and width) of edge `i` of triangle `t` (neighbour `n`) of the object whose first
-    /// global id is `first`. Each pattern stands at its anchor's position at corner `i` when
+    /// global id is `first` (`first_n`: of `n`'s object, another where an intersection line
+    /// lies on two objects). Each pattern stands at its anchor's position at corner `i` when
     /// the anchor's flag is set, else at `i + 1` (or where a clip plane cuts the edge short
     /// of that end), and runs towards the other end.
     #[allow(clippy::type_complexity)]
     fn stretches(
         &self,
-        first: u32,
+        (first, first_n): (u32, u32),
         (t, n, (a, b)): (u32, u32, (DVec3, DVec3)),
         (object, (edge_width, outline_width, section_width, intersection_width)): (
             u32,
@@ -627,7 +691,7 @@ impl Visibility<'_> {
             self.class(
                 q.xy,
                 (q.near_w * w, w),
-                first,
+                (first, first_n),
                 (t, n),
                 behind_host,
                 draw.cap,
@@ -718,8 +782,8 @@ impl Visibility<'_> {
 
     /// What the edge's point at screen point `x` (near row and w) is: where
     /// [`HostMap::hides_point`] says so hidden by the host (`behind_host`: counted as hidden,
-    /// else neither drawn), hidden by a triangle other than `t` and `n` of the object (first
-    /// id `first`) that covers `x` nearer than that point, else visible (twin of `class_at`
+    /// else neither drawn), hidden by a triangle other than `t` and `n` (global ids `first + t`
+    /// and `first_n + n`) that covers `x` nearer than that point, else visible (twin of `class_at`
     /// in outline.wgsl).
     ///
     /// In a frame with section planes (`cap` not [`Cap::None`]) a point that the eye's ray
@@ -731,7 +795,7 @@ impl Visibility<'_> {
         &self,
         x: DVec2,
         (near, w): (f64, f64),
-        first: u32,
+        (first, first_n): (u32, u32),
         (t, n): (u32, u32),
         behind_host: bool,
         cap: Cap,
@@ -749,7 +813,7 @@ impl Visibility<'_> {
             if n == NO_NEIGHBOUR {
                 u32::MAX
             } else {
-                first + n
+                first_n + n
             },
         ];
         let front = self.caster.cast_past(from, to, own).and_then(|hit| {
@@ -1202,7 +1266,7 @@ mod tests {
         let edge = (0, NO_NEIGHBOUR, (corners[1], corners[2]));
         let lines = (([0.0; 2], (0.0, true)), (0.0, true));
         let widths = (0, (1.5, 1.5, 1.5, 1.5));
-        let (s, h) = vis.stretches(0, edge, widths, draw, (lines, Some(hidden)));
+        let (s, h) = vis.stretches((0, 0), edge, widths, draw, (lines, Some(hidden)));
         assert_eq!(s.len(), 1, "{s:?}");
         let top_of_near = {
             let c = cam.view_projection(64, 64) * DVec4::new(1.0, 0.0, 1.0, 1.0);

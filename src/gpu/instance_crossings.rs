@@ -1,0 +1,259 @@
+//! Intersection lines between instances ([`Style::intersection_lines`](crate::Style)): where
+//! the surfaces of two instances pass through each other (parts of an assembly with an
+//! interference fit, a body through a wall).
+//!
+//! A mesh's own crossings depend on its shape alone and are found once, at upload
+//! ([`Mesh::intersections`](crate::Mesh::intersections)). Those between two instances depend
+//! on where both are placed, so they are found as a frame is prepared, for each pair of
+//! instances whose placed bounds meet ([`crate::scene::meeting_pairs`]), from the positions
+//! and triangles the store keeps: the triangles of the clusters that reach the overlap of the
+//! two bounds are tested in world coordinates, in f64, by the test a mesh's own crossings
+//! take ([`crossings_between`]). A pair's segments are kept (in the store) while both
+//! instances keep their mesh and transform, so a still scene seen from a moving camera finds
+//! them once.
+
+use super::mesh_store::{MeshId, MeshRecord};
+use crate::mesh::clusters::CLUSTER_TRIANGLES;
+use crate::mesh::crossings::{crossings_between, pair_tolerance};
+use crate::scene::world_box;
+use glam::{DMat4, DVec3};
+use std::collections::HashMap;
+use std::sync::Arc;
+
+/// Where triangle `t` of one instance crosses triangle `u` of another (stored ids), the
+/// segment's ends in the first instance's stored coordinates.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct PairCrossing {
+    pub t: u32,
+    pub u: u32,
+    pub ends: [[f32; 3]; 2],
+}
+
+/// One placed instance: its mesh and model → world transform.
+pub(crate) type Placed = (MeshId, DMat4);
+
+/// The crossings of instance pairs found for recent frames.
+#[derive(Debug, Default)]
+pub(crate) struct PairCache {
+    /// Frames prepared so far.
+    frames: u64,
+    /// By the pair's placements, the frame that last asked for it and its crossings.
+    entries: HashMap<PairKey, (u64, Arc<[PairCrossing]>)>,
+}
+
+/// A pair's meshes and the bits of their transforms.
+type PairKey = (MeshId, MeshId, [u64; 16], [u64; 16]);
+
+/// Pairs no frame has asked for in this many frames are forgotten.
+const KEEP_FRAMES: u64 = 8;
+
+impl PairCache {
+    /// Starts a frame: forgets the pairs that recent frames did not ask for.
+    pub fn begin_frame(&mut self) {
+        self.frames += 1;
+        let now = self.frames;
+        self.entries
+            .retain(|_, (used, _)| now - *used < KEEP_FRAMES);
+    }
+
+    /// The crossings between instances `a` and `b` (of meshes `records`), found or kept.
+    pub fn between(
+        &mut self,
+        (a, b): (Placed, Placed),
+        records: (&MeshRecord, &MeshRecord),
+    ) -> Arc<[PairCrossing]> {
+        let bits = |m: DMat4| m.to_cols_array().map(f64::to_bits);
+        let key = (a.0, b.0, bits(a.1), bits(b.1));
+        let now = self.frames;
+        let entry = self
+            .entries
+            .entry(key)
+            .or_insert_with(|| (now, crossings(records.0, a.1, records.1, b.1).into()));
+        entry.0 = now;
+        entry.1.clone()
+    }
+}
+
+/// Where mesh `a` placed by `ta` and mesh `b` placed by `tb` cross, sorted by triangle.
+pub(crate) fn crossings(a: &MeshRecord, ta: DMat4, b: &MeshRecord, tb: DMat4) -> Vec<PairCrossing> {
+    let (box_a, box_b) = (world_box(a.bounds, ta), world_box(b.bounds, tb));
+    let tolerance = pair_tolerance(box_a, box_b);
+    let overlap = (
+        box_a.0.max(box_b.0) - tolerance,
+        box_a.1.min(box_b.1) + tolerance,
+    );
+    if !overlap.0.cmple(overlap.1).all() {
+        return Vec::new();
+    }
+    let (ids_a, corners_a) = near(a, ta, overlap, tolerance);
+    let (ids_b, corners_b) = near(b, tb, overlap, tolerance);
+    if ids_a.is_empty() || ids_b.is_empty() {
+        return Vec::new();
+    }
+    // World → the first instance's stored coordinates.
+    let to_stored = (ta * a.local_to_mesh()).inverse();
+    crossings_between(&corners_a, &corners_b, tolerance)
+        .into_iter()
+        .map(|c| PairCrossing {
+            t: ids_a[c.t as usize],
+            u: ids_b[c.u as usize],
+            ends: c
+                .ends
+                .map(|p| to_stored.transform_point3(p).as_vec3().to_array()),
+        })
+        .collect()
+}
+
+/// The triangles of `mesh` placed by `transform` whose world bounds reach `region` (within
+/// `tolerance`): their stored ids and world corners. Whole clusters whose bounding spheres
+/// miss the region are passed over.
+fn near(
+    mesh: &MeshRecord,
+    transform: DMat4,
+    region: (DVec3, DVec3),
+    tolerance: f64,
+) -> (Vec<u32>, Vec<[DVec3; 3]>) {
+    let stored_to_world = transform * mesh.local_to_mesh();
+    // A sphere of radius r maps into one of radius r times the largest column length.
+    let stretch = [
+        stored_to_world.x_axis,
+        stored_to_world.y_axis,
+        stored_to_world.z_axis,
+    ]
+    .map(|c| c.truncate().length())
+    .into_iter()
+    .fold(0.0, f64::max);
+    let reaches = |lo: DVec3, hi: DVec3| {
+        lo.cmple(region.1 + tolerance).all() && hi.cmpge(region.0 - tolerance).all()
+    };
+    let (mut ids, mut corners) = (Vec::new(), Vec::new());
+    let per_cluster = CLUSTER_TRIANGLES;
+    for (c, bound) in mesh.bounds_of_clusters.iter().enumerate() {
+        let centre = stored_to_world.transform_point3(DVec3::new(
+            f64::from(bound[0]),
+            f64::from(bound[1]),
+            f64::from(bound[2]),
+        ));
+        let r = f64::from(bound[3]) * stretch * (1.0 + 1e-9) + tolerance;
+        if !reaches(centre - r, centre + r) {
+            continue;
+        }
+        let first = c * per_cluster;
+        let last = (first + per_cluster).min(mesh.indices.len());
+        for t in first..last {
+            let p = mesh.indices[t]
+                .map(|v| transform.transform_point3(mesh.positions[v as usize].as_dvec3()));
+            if reaches(p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2])) {
+                ids.push(t as u32);
+                corners.push(p);
+            }
+        }
+    }
+    (ids, corners)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::crossings::crossings_between;
+
+    fn world_ends(record: &MeshRecord, transform: DMat4, c: &PairCrossing) -> [DVec3; 2] {
+        let m = transform * record.local_to_mesh();
+        c.ends
+            .map(|p| m.transform_point3(glam::Vec3::from(p).as_dvec3()))
+    }
+
+    /// Two unit boxes through each other (the second moved by (1.5, 0.3, 0.2), and mirrored:
+    /// the same box) meet along six straight pieces, 8.0 long in all (worked out by hand from
+    /// the boxes' faces), every end on both boxes.
+    #[test]
+    fn placed_boxes_meet_along_their_intersection_curve() {
+        let cube = MeshRecord::unstored(&crate::mesh::cube(12).unwrap());
+        let shift = DVec3::new(1.5, 0.3, 0.2);
+        let on_box =
+            |q: DVec3, centre: DVec3| ((q - centre).abs().max_element() - 1.0).abs() < 1e-6;
+        for tb in [
+            DMat4::from_translation(shift),
+            DMat4::from_translation(shift) * DMat4::from_scale(DVec3::new(-1.0, 1.0, 1.0)),
+        ] {
+            let found = crossings(&cube, DMat4::IDENTITY, &cube, tb);
+            let mut length = 0.0;
+            for c in &found {
+                let [p, q] = world_ends(&cube, DMat4::IDENTITY, c);
+                length += p.distance(q);
+                for e in [p, q] {
+                    assert!(on_box(e, DVec3::ZERO) && on_box(e, shift), "{e}");
+                }
+            }
+            assert!((length - 8.0).abs() < 1e-5, "{length}");
+        }
+        // Apart: nothing.
+        let apart = DMat4::from_translation(DVec3::new(2.5, 0.3, 0.2));
+        assert!(crossings(&cube, DMat4::IDENTITY, &cube, apart).is_empty());
+    }
+
+    /// Passing over the clusters that miss the overlap loses no crossing: dense spheres,
+    /// one stretched and turned, one mirrored, cross where testing all their triangles finds.
+    #[test]
+    fn near_the_overlap_holds_every_crossing() {
+        let sphere = crate::mesh::sphere(20_000).unwrap();
+        let record = MeshRecord::unstored(&sphere);
+        let ta = DMat4::from_rotation_y(0.4) * DMat4::from_scale(DVec3::new(1.0, 2.5, 0.6));
+        let tb = DMat4::from_translation(DVec3::new(0.9, 0.7, 0.1))
+            * DMat4::from_rotation_x(1.1)
+            * DMat4::from_scale(DVec3::new(-0.8, 0.8, 0.8));
+        let found = crossings(&record, ta, &record, tb);
+        let all = |t: DMat4| -> Vec<[DVec3; 3]> {
+            record
+                .indices
+                .iter()
+                .map(|c| c.map(|v| t.transform_point3(record.positions[v as usize].as_dvec3())))
+                .collect()
+        };
+        let boxes = (world_box(record.bounds, ta), world_box(record.bounds, tb));
+        let every = crossings_between(&all(ta), &all(tb), pair_tolerance(boxes.0, boxes.1));
+        assert!(every.len() > 100, "{}", every.len());
+        let pairs = |v: &mut dyn Iterator<Item = (u32, u32)>| v.collect::<Vec<_>>();
+        assert_eq!(
+            pairs(&mut found.iter().map(|c| (c.t, c.u))),
+            pairs(&mut every.iter().map(|c| (c.t, c.u)))
+        );
+        for (c, e) in found.iter().zip(&every) {
+            let ends = world_ends(&record, ta, c);
+            for (p, q) in ends.iter().zip(&e.ends) {
+                assert!(p.distance(*q) < 1e-5, "{p} {q}");
+            }
+        }
+    }
+
+    /// A pair's crossings are found once while both keep their placement, again when one
+    /// moves, and forgotten once unused for KEEP_FRAMES frames.
+    #[test]
+    fn the_cache_keeps_a_pair_while_it_stays_put() {
+        let mesh = crate::mesh::cube(12).unwrap();
+        let record = MeshRecord::unstored(&mesh);
+        let (a, b) = (MeshId::unstored(0), MeshId::unstored(1));
+        let placed = |x: f64| {
+            (
+                (a, DMat4::IDENTITY),
+                (b, DMat4::from_translation(DVec3::new(x, 0.3, 0.2))),
+            )
+        };
+        let mut cache = PairCache::default();
+        cache.begin_frame();
+        let first = cache.between(placed(1.5), (&record, &record));
+        assert!(!first.is_empty());
+        cache.begin_frame();
+        assert!(Arc::ptr_eq(
+            &first,
+            &cache.between(placed(1.5), (&record, &record))
+        ));
+        let moved = cache.between(placed(1.4), (&record, &record));
+        assert!(!Arc::ptr_eq(&first, &moved) && *first != *moved);
+        assert!(cache.between(placed(2.5), (&record, &record)).is_empty());
+        for _ in 0..KEEP_FRAMES {
+            cache.begin_frame();
+        }
+        assert!(cache.entries.is_empty());
+    }
+}
