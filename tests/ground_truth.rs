@@ -12,18 +12,15 @@
 
 mod common;
 
-use common::{framing, gpu, load, shoot};
+use common::{framing, gpu, load, shoot, MAX_ERROR_PX, MAX_P99_PX, MIN_ID_AGREEMENT};
 use glam::{DVec3, Vec3};
-use wirepass::tools::compare::{distance_errors, metrics, Metrics};
+use wirepass::tools::compare::{metrics, Metrics};
 use wirepass::tools::offline::Method;
 use wirepass::truth::RayCaster;
-use wirepass::world::{Rendering, Shot, World};
+use wirepass::world::{Shot, World};
 use wirepass::{Camera, EdgeSelection, Mesh, Style};
 
 const SIZE: (u32, u32) = (320, 240);
-const MIN_ID_AGREEMENT: f64 = 0.999;
-const MAX_P99_PX: f64 = 0.01;
-const MAX_ERROR_PX: f64 = 0.1;
 
 /// The hard cameras, each built from the mesh itself so it means the same on every mesh.
 #[derive(Clone, Copy, Debug)]
@@ -168,33 +165,7 @@ fn measure(
     let truth = shoot(mesh, cam, &style, SIZE, edges, Method::Raycast);
     let frame = shoot(mesh, cam, &style, SIZE, edges, Method::Deferred);
     let m = metrics(&truth, &frame).unwrap_or_else(|e| panic!("{e}"));
-    (m, worst_pixels(&truth, &frame))
-}
-
-/// The pixels with the largest distance errors, for the failure message.
-pub fn worst_pixels(truth: &Rendering, frame: &Rendering) -> String {
-    let errors = distance_errors(truth, frame).unwrap_or_else(|e| panic!("{e}"));
-    let mut worst: Vec<(usize, f64)> = errors
-        .iter()
-        .enumerate()
-        .filter_map(|(i, e)| e.filter(|&e| e > MAX_ERROR_PX).map(|e| (i, e)))
-        .collect();
-    worst.sort_by(|a, b| b.1.total_cmp(&a.1));
-    let width = truth.size.0 as usize;
-    worst
-        .iter()
-        .take(5)
-        .map(|&(i, _)| {
-            format!(
-                "\n    pixel ({}, {}) id {}: truth {} measured {}",
-                i % width,
-                i / width,
-                truth.ids[i] as i64,
-                truth.edge_distance[i],
-                frame.edge_distance[i]
-            )
-        })
-        .collect()
+    (m, common::worst_pixels(&truth, &frame, MAX_ERROR_PX, 5))
 }
 
 /// Measures every shot of `name`, prints the numbers, then checks the bounds (all shots are

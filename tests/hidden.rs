@@ -4,15 +4,15 @@
 
 mod common;
 
-use common::{channel_difference, cylinder, framing, load, shoot_world, worst_of};
+use common::{
+    channel_difference, cylinder, framing, load, shoot_world, truth_and_frame, within_bounds,
+    worst_hidden,
+};
 use glam::{DMat4, DVec3};
 use std::sync::Arc;
 use wirepass::mesh::Procedural;
 use wirepass::tools::offline::Method;
-use wirepass::truth::accuracy::{
-    distance_error, hidden_distance_error, hidden_distance_errors, id_agreement,
-};
-use wirepass::world::{Object, Rendering, World, WorldMesh};
+use wirepass::world::{Object, World, WorldMesh};
 use wirepass::{Color, EdgeSelection, HiddenLines, LinePattern, Style, View};
 
 const SIZE: (u32, u32) = (320, 240);
@@ -62,28 +62,10 @@ fn cube_and_torus() -> World {
 /// The deferred frame against the ground truth, visible and hidden lines alike; returns the
 /// pixels the hidden-line distance was measured on.
 fn check(name: &str, world: &World, view: View, style: &Style) -> usize {
-    let truth = shoot_world(world, view, style, SIZE, Method::Raycast);
-    let frame = shoot_world(world, view, style, SIZE, Method::Deferred);
-    let (ids, _) = id_agreement(&truth, &frame).unwrap();
-    let visible = distance_error(&truth, &frame).unwrap();
-    let hidden = hidden_distance_error(&truth, &frame).unwrap();
-    println!("{name}: id {ids:.5}, visible {visible:?}, hidden {hidden:?}");
-    assert!(ids >= 0.999, "{name}: id agreement {ids}");
-    assert!(
-        visible.max.unwrap_or(0.0) <= 0.1,
-        "{name}: visible {visible:?}"
-    );
+    let (truth, frame) = truth_and_frame(world, view, style, SIZE);
+    let hidden = within_bounds(name, &truth, &frame).hidden;
+    assert!(hidden.pixels > 0, "{name}: no hidden-line pixels");
     let worst = || worst_hidden(&truth, &frame);
-    assert!(
-        hidden.p99.unwrap() <= 0.01,
-        "{name}: hidden {hidden:?}\n{}",
-        worst()
-    );
-    assert!(
-        hidden.max.unwrap() <= 0.1,
-        "{name}: hidden {hidden:?}\n{}",
-        worst()
-    );
     // Where the truth draws no hidden line, the pass draws none either (but at the very
     // edge of a line's reach).
     let extra = (0..truth.ids.len())
@@ -100,11 +82,6 @@ fn check(name: &str, world: &World, view: View, style: &Style) -> usize {
 }
 
 /// The worst hidden-line pixels, for failure messages.
-fn worst_hidden(truth: &Rendering, frame: &Rendering) -> String {
-    let errors = hidden_distance_errors(truth, frame).unwrap();
-    worst_of(truth, frame, (&errors, |r| &r.hidden_distance), 0.01, 8)
-}
-
 fn perspective(world: &World, eye: DVec3) -> View {
     let (lo, hi) = world.bounds();
     let centre = 0.5 * (lo + hi);

@@ -242,16 +242,10 @@ fn outline_beside_a_pole_fan_of_slivers() {
 }
 
 /// The deferred frame of `scene` against the ground truth over every pixel, within the
-/// accuracy bounds (id agreement 0.999, distance p99 0.01 px, max 0.1 px); returns the truth.
+/// accuracy bounds (`common::within_bounds`); returns the truth.
 fn within_bounds(name: &str, scene: &TestScene) -> Rendering {
     let truth = draw(scene, Method::Raycast);
     let deferred = draw(scene, Method::Deferred);
-    let m = metrics(&truth, &deferred).unwrap();
-    let worst = common::worst_pixels(&truth, &deferred, 0.01, 8);
-    println!("{name}: {m:?}\n{worst}");
-    assert!(m.id_agreement >= 0.999, "{name}: {m:?}");
-    let d = &m.distance_error_px;
-    let within = d.p99.unwrap_or(0.0) <= 0.01 && d.max.unwrap_or(0.0) <= 0.1;
-    assert!(within, "{name}: {m:?}\n{worst}");
+    common::within_bounds(name, &truth, &deferred);
     truth
 }

@@ -9,10 +9,10 @@
 
 mod common;
 
-use common::{load, shoot_world};
+use common::{load, shoot_world, truth_and_frame, within_bounds};
 use glam::{DMat4, DQuat, DVec3};
 use std::sync::Arc;
-use wirepass::tools::compare::{metrics, Metrics};
+use wirepass::tools::compare::metrics;
 use wirepass::tools::offline::Method;
 use wirepass::world::{Object, Rendering, World, WorldMesh, BACKGROUND};
 use wirepass::{Camera, DepthRange, EdgeSelection, InstanceStyle, Mesh, Style, View};
@@ -42,28 +42,13 @@ fn world(meshes: Vec<(Mesh, EdgeSelection)>, objects: Vec<(usize, DMat4)>) -> Wo
     }
 }
 
-/// The deferred frame and its metrics against the ground truth; panics past the bounds.
-fn check(name: &str, world: &World, view: View, style: &Style) -> (Rendering, Metrics) {
-    let truth = shoot_world(world, view, style, SIZE, Method::Raycast);
-    let frame = shoot_world(world, view, style, SIZE, Method::Deferred);
-    let m = metrics(&truth, &frame).unwrap_or_else(|e| panic!("{e}"));
-    let d = m.distance_error_px;
-    println!(
-        "{name:<32} id {:.5} distance p99 {:.2e} max {:.2e} ({} px)",
-        m.id_agreement,
-        d.p99.unwrap_or(f64::NAN),
-        d.max.unwrap_or(f64::NAN),
-        d.pixels
-    );
-    assert!(m.id_agreement >= 0.999, "{name}: {m:?}");
+/// The deferred frame against the ground truth, within the accuracy bounds; panics past
+/// them.
+fn check(name: &str, world: &World, view: View, style: &Style) -> Rendering {
+    let (truth, frame) = truth_and_frame(world, view, style, SIZE);
+    let d = within_bounds(name, &truth, &frame).lines;
     assert!(d.pixels > 500, "{name}: only {} pixels measured", d.pixels);
-    assert!(d.p99.is_some_and(|v| v <= 0.01), "{name}: {m:?}");
-    assert!(
-        d.max.is_some_and(|v| v <= 0.1),
-        "{name}: {m:?}{}",
-        common::worst_pixels(&truth, &frame, 0.1, 8)
-    );
-    (frame, m)
+    frame
 }
 
 /// A camera looking at `world` from the framing direction.
@@ -89,7 +74,7 @@ fn overlapping_instances_one_mirrored_and_stretched() {
             line_width: 2.0,
             ..Style::default()
         };
-        let (frame, _) = check(&format!("two suzannes {edges:?}"), &w, view, &style);
+        let frame = check(&format!("two suzannes {edges:?}"), &w, view, &style);
         // Both instances show, and the second's ids follow the first's.
         let n = suzanne.triangle_count() as u32;
         let first = frame.ids.iter().filter(|&&id| id < n).count();
@@ -154,7 +139,7 @@ fn orthographic_views_front_grazing_and_filling() {
         ),
     ];
     for (name, view) in views {
-        let (frame, _) = check(name, &w, view, &style);
+        let frame = check(name, &w, view, &style);
         if name.contains("filling") {
             let covered = frame.ids.iter().filter(|&&id| id != BACKGROUND).count();
             assert!(covered * 10 > frame.ids.len() * 9, "{name}: {covered}");
@@ -196,9 +181,9 @@ fn infinite_far_and_reversed_depth() {
         proj::perspective_infinite_reverse(fov, ASPECT, near),
         DepthRange::Reversed,
     );
-    let (a, _) = check("standard depth", &w, standard, &style);
-    let (b, _) = check("reversed depth", &w, reversed, &style);
-    let (c, _) = check("infinite reversed depth", &w, infinite_reversed, &style);
+    let a = check("standard depth", &w, standard, &style);
+    let b = check("reversed depth", &w, reversed, &style);
+    let c = check("infinite reversed depth", &w, infinite_reversed, &style);
     for (name, other) in [("reversed", &b), ("infinite reversed", &c)] {
         let same = a.ids.iter().zip(&other.ids).filter(|(x, y)| x == y).count();
         assert!(
@@ -290,7 +275,7 @@ fn a_thousand_instances_match_the_ground_truth() {
         .collect();
     let w = world(vec![(sphere, EdgeSelection::Polygon)], objects);
     let style = Style::default();
-    let (frame, _) = check("1000 spheres", &w, framing(&w).to_view(ASPECT), &style);
+    let frame = check("1000 spheres", &w, framing(&w).to_view(ASPECT), &style);
     let first = w.first_ids();
     let seen: std::collections::BTreeSet<usize> = frame
         .ids

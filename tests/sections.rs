@@ -4,14 +4,12 @@
 
 mod common;
 
-use common::{channel_difference, load, shoot_world, worst_pixels};
+use common::{channel_difference, load, shoot_world, truth_and_frame, within_bounds};
 use glam::{DMat4, DVec3, Vec3};
 use std::sync::Arc;
 use wirepass::mesh::Procedural;
 use wirepass::tools::offline::Method;
-use wirepass::truth::accuracy::{
-    distance_error, hidden_distance_error, id_agreement, line_class_agreement,
-};
+use wirepass::truth::accuracy::{hidden_distance_error, line_class_agreement};
 use wirepass::world::LineClass;
 use wirepass::world::{Object, World, WorldMesh};
 use wirepass::{EdgeSelection, Error, Mesh, SectionPlane, Style, View};
@@ -38,17 +36,8 @@ fn plane(point: [f64; 3], normal: [f64; 3]) -> SectionPlane {
 /// The deferred frame against the ground truth; returns the pixels showing a section face
 /// (a back face in the section colour) and those a cut line colours, in the truth.
 fn check(name: &str, world: &World, view: View, style: &Style) -> (usize, usize) {
-    let truth = shoot_world(world, view, style, SIZE, Method::Raycast);
-    let frame = shoot_world(world, view, style, SIZE, Method::Deferred);
-    let (ids, _) = id_agreement(&truth, &frame).unwrap();
-    let lines = distance_error(&truth, &frame).unwrap();
-    println!("{name}: id {ids:.5}, lines {lines:?}");
-    let worst = || worst_pixels(&truth, &frame, 0.01, 8);
-    assert!(ids >= 0.999, "{name}: id agreement {ids}");
-    if lines.pixels > 0 {
-        assert!(lines.p99.unwrap() <= 0.01, "{name}: {lines:?}\n{}", worst());
-        assert!(lines.max.unwrap() <= 0.1, "{name}: {lines:?}\n{}", worst());
-    }
+    let (truth, frame) = truth_and_frame(world, view, style, SIZE);
+    within_bounds(name, &truth, &frame);
     // Colours where both show the same triangle away from lines: the section face and the
     // shaded surface alike.
     let section = style.section_color.to_srgb8();

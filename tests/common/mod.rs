@@ -8,6 +8,9 @@ use std::path::PathBuf;
 use std::sync::OnceLock;
 use wirepass::gpu::{DeferredPass, GpuContext, PassOptions, TriangleIds};
 use wirepass::tools::offline::{draw, Method};
+use wirepass::truth::accuracy::{
+    distance_error, hidden_distance_error, hidden_distance_errors, id_agreement, DistanceError,
+};
 use wirepass::world::{Rendering, Shot, World};
 use wirepass::{edge_math, Camera, EdgeSelection, Mesh, Style};
 
@@ -100,6 +103,74 @@ pub fn shoot_world(
         size,
     };
     draw(gpu(), &shot, method).unwrap_or_else(|e| panic!("{}: {e}", method.name()))
+}
+
+/// The ground truth's and the deferred pass's frames of a world.
+pub fn truth_and_frame(
+    world: &World,
+    view: wirepass::View,
+    style: &Style,
+    size: (u32, u32),
+) -> (Rendering, Rendering) {
+    (
+        shoot_world(world, view, style, size, Method::Raycast),
+        shoot_world(world, view, style, size, Method::Deferred),
+    )
+}
+
+/// The accuracy bounds a frame is held to against the ground truth, over every pixel.
+pub const MIN_ID_AGREEMENT: f64 = 0.999;
+pub const MAX_P99_PX: f64 = 0.01;
+pub const MAX_ERROR_PX: f64 = 0.1;
+
+/// How a frame measures against the ground truth.
+#[derive(Debug)]
+pub struct Accuracy {
+    /// The share of pixels showing the same triangle.
+    pub ids: f64,
+    /// The distance error of the lines, and of the hidden lines.
+    pub lines: DistanceError,
+    pub hidden: DistanceError,
+}
+
+/// Holds `frame` to the accuracy bounds against `truth` over every pixel: the id agreement,
+/// and the distance error's p99 and max of the lines and of the hidden lines (where any pixel
+/// of them is measured). Panics naming `name` and the worst pixels.
+pub fn within_bounds(name: &str, truth: &Rendering, frame: &Rendering) -> Accuracy {
+    let ids = id_agreement(truth, frame)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .0;
+    let lines = distance_error(truth, frame).unwrap_or_else(|e| panic!("{e}"));
+    let hidden = hidden_distance_error(truth, frame).unwrap_or_else(|e| panic!("{e}"));
+    println!("{name}: id {ids:.5}, lines {lines:?}, hidden {hidden:?}");
+    assert!(ids >= MIN_ID_AGREEMENT, "{name}: id agreement {ids}");
+    let within = |d: &DistanceError| {
+        d.pixels == 0
+            || (d.p99.is_some_and(|v| v <= MAX_P99_PX) && d.max.is_some_and(|v| v <= MAX_ERROR_PX))
+    };
+    assert!(
+        within(&lines),
+        "{name}: lines {lines:?}{}",
+        worst_pixels(truth, frame, MAX_P99_PX, 8)
+    );
+    assert!(
+        within(&hidden),
+        "{name}: hidden lines {hidden:?}{}",
+        worst_hidden(truth, frame)
+    );
+    Accuracy { ids, lines, hidden }
+}
+
+/// The 8 pixels with the largest hidden-line distance errors over 0.01 px.
+pub fn worst_hidden(truth: &Rendering, frame: &Rendering) -> String {
+    let errors = hidden_distance_errors(truth, frame).unwrap_or_else(|e| panic!("{e}"));
+    worst_of(
+        truth,
+        frame,
+        (&errors, |r| &r.hidden_distance),
+        MAX_P99_PX,
+        8,
+    )
 }
 
 /// The camera that frames `mesh` for an image of `size`.
