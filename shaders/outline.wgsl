@@ -396,7 +396,7 @@ fn intersection_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num
     for (var piece = 0u; piece < c.pieces; piece++) {
         let k0 = f32(piece) / f32(c.pieces);
         let k1 = f32(piece + 1u) / f32(c.pieces);
-        let item = Listed(c.seg.inst, k, 0u, mode, piece, c.pieces);
+        let item = Listed(c.seg.on.inst, k, 0u, mode, piece, c.pieces);
         if piece_reaches_targets(c.seg, k0, k1, reach) && !(listable && list_piece(item)) {
             draw_listed(item, c);
         }
@@ -732,15 +732,12 @@ struct On {
     crossing: bool,
 }
 
-// The screen segment of an outline edge, clipped to the view and the targets.
+// The screen segment of a line, clipped to the view and the targets, and the triangles
+// it lies on.
 struct Segment {
     start: Projected,
     end: Projected,
-    inst: u32,
-    t: u32,
-    n: u32,
-    // The instance of n.
-    other: u32,
+    on: On,
     // Position of `start` along the visible line's pattern (pixels from the pattern's
     // anchor), and +1 or -1 as the pattern runs towards `end` or away from it; then the
     // hidden line's.
@@ -750,8 +747,6 @@ struct Segment {
     hidden_dir: f32,
     // How the eye's ray reaches the line where no other surface tells (`capped`).
     cap: u32,
-    // An intersection line (on t and on n, which cross there).
-    crossing: bool,
 }
 
 fn seg_at(s: Segment, k: f32) -> Projected {
@@ -768,9 +763,9 @@ fn seg_class(s: Segment, k: f32) -> u32 {
     let inset = min(END_INSET / max(distance(s.start.xy, s.end.xy), 1e-30), 0.5);
     let q = seg_at(s, clamp(k, inset, 1.0 - inset));
     let w = 1.0 / q.inv_w;
-    let c = class_at(q.xy, q.near_w * w, w, q.reverse, On(s.inst, s.t, s.other, s.n, s.crossing), s.cap);
+    let c = class_at(q.xy, q.near_w * w, w, q.reverse, s.on, s.cap);
 #if HIDDEN
-    let behind_host = (instances[slot(s.inst)].flags & INSTANCE_BEHIND_HOST) != 0u;
+    let behind_host = (instances[slot(s.on.inst)].flags & INSTANCE_BEHIND_HOST) != 0u;
     return select(c, 1u, c == 2u && behind_host);
 #else
     return min(c, 1u);
@@ -848,11 +843,7 @@ fn clip_outline(on: On, a: vec3<f32>, b: vec3<f32>, anchor: vec4<f32>, skip: u32
     }
     c.seg.start = lerp_projected(p0, p1, u.x);
     c.seg.end = lerp_projected(p0, p1, u.y);
-    c.seg.inst = inst;
-    c.seg.t = on.t;
-    c.seg.n = on.n;
-    c.seg.other = on.other;
-    c.seg.crossing = on.crossing;
+    c.seg.on = on;
     let full = length(d);
     c.seg.phase = anchor.x + select((1.0 - u.x) * full, u.x * full, anchor.y > 0.0);
     c.seg.phase_dir = anchor.y;
@@ -994,7 +985,7 @@ fn push_run(runs: ptr<function, array<vec2<f32>, MAX_RUNS>>, count: ptr<function
 // outline's visible line, or (LINE_HIDDEN) a dash of the hidden-line pattern, in the hidden
 // lines' word.
 fn splat_runs(seg: Segment, k0: f32, k1: f32, runs: ptr<function, array<vec2<f32>, MAX_RUNS>>, count: u32, kind: u32) {
-    var width = select(instances[slot(seg.inst)].line_width, instances[slot(seg.inst)].outline_width, kind == LINE_OUTLINE);
+    var width = select(instances[slot(seg.on.inst)].line_width, instances[slot(seg.on.inst)].outline_width, kind == LINE_OUTLINE);
     width = select(width, frame.section_width, kind == LINE_CUT);
     width = select(width, frame.intersection_width, kind == LINE_INTERSECTION);
     var pattern = vec2<f32>(0.0);
@@ -1003,12 +994,12 @@ fn splat_runs(seg: Segment, k0: f32, k1: f32, runs: ptr<function, array<vec2<f32
     var behind_host = false;
     let hidden = kind == LINE_HIDDEN;
 #if PATTERNS
-    pattern = select(instances[slot(seg.inst)].edge_pattern, instances[slot(seg.inst)].outline_pattern, kind == LINE_OUTLINE);
+    pattern = select(instances[slot(seg.on.inst)].edge_pattern, instances[slot(seg.on.inst)].outline_pattern, kind == LINE_OUTLINE);
     pattern = select(pattern, vec2<f32>(0.0), kind == LINE_CUT || kind == LINE_INTERSECTION);
 #endif
 #if HIDDEN
     if hidden {
-        let inst = instances[slot(seg.inst)];
+        let inst = instances[slot(seg.on.inst)];
         width = inst.hidden_width;
 #if PATTERNS
         pattern = vec2<f32>(inst.hidden_dash, inst.hidden_period);
@@ -1098,7 +1089,7 @@ fn splat_runs(seg: Segment, k0: f32, k1: f32, runs: ptr<function, array<vec2<f32
             if hidden {
 #if COLORS
                 atomicMax(&acc_rw[hidden_lines() + 2u * index], key);
-                atomicMax(&acc_rw[hidden_lines() + 2u * index + 1u], (key & 0xfff00000u) | seg.inst);
+                atomicMax(&acc_rw[hidden_lines() + 2u * index + 1u], (key & 0xfff00000u) | seg.on.inst);
 #else
                 atomicMax(&acc_rw[hidden_lines() + index], key);
 #endif
@@ -1109,7 +1100,7 @@ fn splat_runs(seg: Segment, k0: f32, k1: f32, runs: ptr<function, array<vec2<f32
             atomicMax(&acc_rw[2u * index], key);
             var owner = select(select(0u, OWNER_OUTLINE, kind == LINE_OUTLINE), OWNER_CUT, kind == LINE_CUT);
             owner = select(owner, OWNER_INTERSECTION, kind == LINE_INTERSECTION);
-            atomicMax(&acc_rw[2u * index + 1u], (key & 0xfff00000u) | owner | seg.inst);
+            atomicMax(&acc_rw[2u * index + 1u], (key & 0xfff00000u) | owner | seg.on.inst);
 #else
             atomicMax(&acc_rw[index], key);
 #endif
@@ -1149,10 +1140,11 @@ fn mark_outline_tiles(first_m: i32, last_m: i32, first_o: i32, last_o: i32, majo
 
 // Whether the point at screen point x (near row `near`, w `w`, reverse depth `reverse`) of a
 // line on the triangles `on` is visible (0), hidden by a triangle other than those
-// (`lies_on`) that covers x nearer than the point (1), or by the host (2, host_hides_point). The candidates are the triangles the
-// rasterizer gave the 3×3 pixel centres around x (5×5, and the line's triangles' other
-// neighbours, in a frame with section planes; a sliver of surface in front of the edge
-// may own no centre next to x, but one a pixel further on), and those a walk across edges
+// (`lies_on`) that covers x nearer than the point (1), or by the host (2,
+// host_hides_point). The candidates are the triangles the rasterizer gave the 3×3 pixel
+// centres around x (5×5, and the line's triangles' other neighbours, in a frame with
+// section planes; a sliver of surface in front of the edge may own no centre next to x,
+// but one a pixel further on), and those a walk across edges
 // from them reaches when they do not cover x themselves (x may lie in a small triangle that
 // owns none of those centres). A walk ends at a fold (`locate`): beyond it the surface lies
 // on this side of the fold's edge, and a walk towards x, a point of a silhouette, would
