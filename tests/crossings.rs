@@ -376,6 +376,25 @@ fn intersection_lines_between_instances() {
         &style,
     );
     assert!(crossing > 0, "the spheres' intersection line is drawn");
+    // The boxes cut by a section plane through their crossing: the lines end at the cut, and
+    // the section faces inside show through it.
+    let mut cut = boxes_as_instances(shift, EdgeSelection::Polygon);
+    cut.sections = vec![wirepass::SectionPlane::new(
+        DVec3::new(0.0, 0.5, 0.0),
+        DVec3::new(0.3, -1.0, 0.2),
+    )];
+    let style = Style {
+        intersection_lines: true,
+        intersection_line_width: Some(2.0),
+        ..Style::default()
+    };
+    let (_, crossing) = check(
+        "box instances cut, intersection lines",
+        &cut,
+        perspective(DVec3::new(2.6, 3.2, 3.4), DVec3::new(0.6, 0.3, 0.2)),
+        &style,
+    );
+    assert!(crossing > 0, "the cut boxes' intersection lines are drawn");
 }
 
 /// Intersection lines follow the instances from frame to frame of one upload: drawn where
