@@ -282,6 +282,22 @@ pub fn world_box((lo, hi): (DVec3, DVec3), transform: DMat4) -> (DVec3, DVec3) {
     })
 }
 
+/// The pairs `(a, b)`, `a < b`, of placed objects (model-space bounds and model → world
+/// transform) whose surfaces may cross: their world bounds, each grown by its share of the
+/// pair's crossing tolerance ([`pair_tolerance`](crate::mesh::crossings::pair_tolerance)),
+/// meet. Sorted.
+pub fn crossing_pairs(placed: &[((DVec3, DVec3), DMat4)]) -> Vec<(usize, usize)> {
+    let grown: Vec<(DVec3, DVec3)> = placed
+        .iter()
+        .map(|&(bounds, t)| {
+            let (lo, hi) = world_box(bounds, t);
+            let grow = crate::mesh::crossings::pair_tolerance((lo, hi), (lo, hi));
+            (lo - grow, hi + grow)
+        })
+        .collect();
+    meeting_pairs(&grown)
+}
+
 /// The pairs `(a, b)`, `a < b`, of boxes that meet (touching counts), sorted.
 pub fn meeting_pairs(boxes: &[(DVec3, DVec3)]) -> Vec<(usize, usize)> {
     // Sweep along x.

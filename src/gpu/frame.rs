@@ -480,18 +480,9 @@ impl FrameRecords {
             for (slot, &i) in order.iter().enumerate() {
                 slot_of[i as usize] = slot as u32;
             }
-            // Each box grown by its share of the pair's tolerance.
-            let boxes: Vec<(DVec3, DVec3)> = placed
-                .iter()
-                .map(|&(bounds, t)| {
-                    let (lo, hi) = crate::scene::world_box(bounds, t);
-                    let grow = crate::mesh::crossings::pair_tolerance((lo, hi), (lo, hi));
-                    (lo - grow, hi + grow)
-                })
-                .collect();
             let mut cache = store.pair_cache();
             cache.begin_frame();
-            for (i, j) in crate::scene::meeting_pairs(&boxes) {
+            for (i, j) in crate::scene::crossing_pairs(&placed) {
                 let (a, b) = (&scene.instances[i], &scene.instances[j]);
                 let records = (store.record(a.mesh)?, store.record(b.mesh)?);
                 let pair = ((a.mesh, a.transform), (b.mesh, b.transform));

@@ -500,17 +500,14 @@ impl Visibility<'_> {
     fn lines_between_objects(&self, width: f64) -> Vec<Stretch> {
         use crate::mesh::crossings::{crossings_between, pair_tolerance};
         let world = self.caster.world();
-        let boxes: Vec<(DVec3, DVec3)> = world
+        let placed: Vec<((DVec3, DVec3), glam::DMat4)> = world
             .objects
             .iter()
-            .map(|o| crate::scene::world_box(world.meshes[o.mesh].mesh.bounds_f64(), o.transform))
+            .map(|o| (world.meshes[o.mesh].mesh.bounds_f64(), o.transform))
             .collect();
-        let grown: Vec<(DVec3, DVec3)> = boxes
+        let boxes: Vec<(DVec3, DVec3)> = placed
             .iter()
-            .map(|&b| {
-                let grow = pair_tolerance(b, b);
-                (b.0 - grow, b.1 + grow)
-            })
+            .map(|&(bounds, t)| crate::scene::world_box(bounds, t))
             .collect();
         let firsts = self.caster.first_ids();
         let corners = |o: usize| {
@@ -530,7 +527,7 @@ impl Visibility<'_> {
         };
         let lines = (([0.0; 2], (0.0, true)), (0.0, true));
         let widths = (0.0, 0.0, 0.0, width);
-        crate::scene::meeting_pairs(&grown)
+        crate::scene::crossing_pairs(&placed)
             .into_iter()
             .flat_map(|(a, b)| {
                 let tolerance = pair_tolerance(boxes[a], boxes[b]);
