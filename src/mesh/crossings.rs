@@ -4,9 +4,11 @@
 //! pixels with no outline between, so the passes draw the drawn edges of such triangles (and
 //! of their patches) only where they are visible ([`super::patches::Patches::crossed`]).
 //!
-//! Two triangles cross when their intersection is more than a point and they share no edge:
-//! triangles sharing one vertex cross when they meet along a segment from it (a fan folded
-//! through itself). Coplanar triangles never cross. The test is in f64 with a tolerance of
+//! Two triangles cross when one passes through the other's plane (corners on both sides of
+//! it), their intersection is more than a point, and they share no edge: triangles sharing
+//! one vertex cross when they meet along a segment from it (a fan folded through itself).
+//! Two that each lie on one side of the other's plane (touching only within the tolerance),
+//! and coplanar ones, never cross. The test is in f64 with a tolerance of
 //! 1e-9 of the mesh's size, so it errs towards "crossing" only for contacts far below a pixel,
 //! which costs the exact (outline-pass) path, never a wrong line.
 //!
@@ -239,8 +241,8 @@ pub fn cross(t: [DVec3; 3], u: [DVec3; 3], tolerance: f64) -> bool {
     crossing_segment(t, u, tolerance).is_some()
 }
 
-/// The segment along which triangles `t` and `u` meet, where they meet in more than a point
-/// (by more than `tolerance`); coplanar ones never. Its ends are where one triangle's edges
+/// The segment along which triangles `t` and `u` meet, where one passes through the other's
+/// plane and they meet in more than a point (by more than `tolerance`); coplanar ones never. Its ends are where one triangle's edges
 /// pass through the other's plane, or the other's edges through the first's.
 pub fn crossing_segment(t: [DVec3; 3], u: [DVec3; 3], tolerance: f64) -> Option<[DVec3; 2]> {
     let (nt, nu) = (plane(t)?, plane(u)?);
@@ -256,9 +258,12 @@ pub fn crossing_segment(t: [DVec3; 3], u: [DVec3; 3], tolerance: f64) -> Option<
     };
     let du = side(nt, t[0], u);
     let dt = side(nu, u[0], t);
-    let apart = |d: [f64; 3]| d.iter().all(|&x| x > 0.0) || d.iter().all(|&x| x < 0.0);
+    // One passes through the other's plane: corners on both sides of it, beyond the
+    // tolerance. Two that each lie on one side of the other's plane and meet only within
+    // the tolerance (a fan round a vertex, its f32 corners a hair from flat) do not cross.
+    let straddles = |d: [f64; 3]| d.iter().any(|&x| x > 0.0) && d.iter().any(|&x| x < 0.0);
     let flat = |d: [f64; 3]| d.iter().all(|&x| x == 0.0);
-    if apart(du) || apart(dt) || flat(du) || flat(dt) {
+    if !straddles(du) && !straddles(dt) || flat(du) || flat(dt) {
         return None;
     }
     let along = nt.cross(nu).try_normalize()?;
@@ -429,6 +434,55 @@ mod tests {
         let count = expected.iter().filter(|&&c| c).count();
         assert!(count > 50, "{count}");
         assert_eq!(found, expected);
+    }
+
+    /// The fan round the pole of a fine UV sphere (2 M triangles: 1,414 slices, the first
+    /// ring 1e-5 below the pole), its corners rounded to f32: each triangle lies below the
+    /// others' planes by less than a 1e-9 tolerance, and none passes through another.
+    #[test]
+    fn a_fine_fan_that_rounds_to_nearly_flat_does_not_cross_itself() {
+        let slices = 1414;
+        let (sin_p, cos_p) = (std::f64::consts::PI / 708.0).sin_cos();
+        let mut positions = vec![Vec3::Y];
+        positions.extend((0..slices).map(|j| {
+            let (sin_a, cos_a) = (std::f64::consts::TAU * j as f64 / slices as f64).sin_cos();
+            Vec3::new((sin_p * sin_a) as f32, cos_p as f32, (sin_p * cos_a) as f32)
+        }));
+        let mut triangles: Vec<[u32; 3]> = (0..slices as u32)
+            .map(|j| [0, 1 + j, 1 + (j + 1) % slices as u32])
+            .collect();
+        // The sphere's size sets the tolerance: a triangle at its other pole.
+        let south = positions.len() as u32;
+        positions.extend([
+            Vec3::NEG_Y,
+            Vec3::new(0.01, -1.0, 0.0),
+            Vec3::new(0.0, -1.0, 0.01),
+        ]);
+        triangles.push([south, south + 1, south + 2]);
+        let corners = |t: usize| triangles[t].map(|v| positions[v as usize].as_dvec3());
+        // Within the tolerance of touching: the old test took that for meeting.
+        let n = (corners(0)[1] - corners(0)[0]).cross(corners(0)[2] - corners(0)[0]);
+        let below = n.normalize().dot(corners(5)[1] - corners(0)[0]);
+        assert!(below < 0.0 && below > -2e-9, "{below}");
+        assert!(crossings(&positions, &triangles).is_empty());
+    }
+
+    /// A triangle standing on another (its edge in the other's interior) meets it along
+    /// that edge, which the other passes through the plane of: a line where surfaces meet.
+    /// Lifted off by more than the tolerance it meets nothing.
+    #[test]
+    fn a_triangle_standing_on_another_meets_it_along_its_edge() {
+        let t = [DVec3::ZERO, DVec3::X, DVec3::Y];
+        let standing = [
+            DVec3::new(0.2, 0.1, 0.0),
+            DVec3::new(0.2, 0.6, 0.0),
+            DVec3::new(0.3, 0.3, 1.0),
+        ];
+        let ends = crossing_segment(t, standing, 1e-9).unwrap();
+        assert!(ends[0].distance(ends[1]) > 0.5 - 1e-12);
+        assert!(cross(standing, t, 1e-9));
+        assert!(!cross(t, standing.map(|p| p + DVec3::Z * 1e-6), 1e-9));
+        assert!(cross(t, standing.map(|p| p - DVec3::Z * 1e-6), 1e-9));
     }
 
     #[test]
