@@ -40,7 +40,8 @@ struct Frame {
     clusters: u32,
     // Host depth: 1 when the id target was seeded from the host's depth.
     host_depth: u32,
-    _pad: u32,
+    // Room of the outline pass's overflow list (`overflow_list` in outline.wgsl).
+    overflow_room: u32,
     // Opacity of the shaded surface over the background (`see_through`).
     fill_opacity: f32,
     // Hidden lines (HIDDEN): linear RGBA colour of every instance's (without COLORS, they

@@ -68,15 +68,28 @@ struct OutlineListRead {
 }
 @group(0) @binding(14) var<storage, read> cull: OutlineListRead;
 
-// After the lines and the tiles in `acc_rw`, the pieces of outline edges that `outline_main`
-// lists for `outline_pieces_main`: a header (indirect dispatch size x, y, z, then the count;
-// the encoder copies it to where the piece dispatch reads its size) and PIECE_WORDS words
-// per piece. A lane of the piece dispatch draws one piece, where a lane of `outline_main`
-// would draw every piece of its triangle's outline edges while the other lanes of its
-// cluster, most of them without any, wait for it.
-fn piece_list() -> u32 {
+// After the lines and the tiles in `acc_rw`, the phase tables, then the overflow list, then
+// the pieces of outline edges that `outline_main` lists for `outline_pieces_main`: a header
+// (indirect dispatch size x, y, z, then the count; the encoder copies it to where the piece
+// dispatch reads its size) and PIECE_WORDS words per piece. A lane of the piece dispatch
+// draws one piece, where a lane of `outline_main` would draw every piece of its triangle's
+// outline edges while the other lanes of its cluster, most of them without any, wait for it.
+//
+// Where the piece list has no room for all of a cluster's pieces (or all of a group of 64
+// intersection segments'), its entry goes to the overflow list (a header, then up to
+// `frame.overflow_room` entries), and the piece dispatch grows by 64 lanes for it, each
+// drawing every piece of one of its triangles (`lane_work`): the listing dispatch itself
+// holds no drawing code, which a software rasterizer would run for every lane.
+fn overflow_list() -> u32 {
     return phase_tables() + frame.chain_work.x;
 }
+
+fn piece_list() -> u32 {
+    return overflow_list() + 4u + frame.overflow_room;
+}
+
+// An overflow entry of intersection segments: their group's index, with this bit.
+const OVERFLOW_SEGMENTS: u32 = 0x80000000u;
 
 // Word offset of the phase tables (`chain_phases`), after the tile list.
 fn phase_tables() -> u32 {
@@ -261,6 +274,9 @@ const EDGE_ON_MARGIN: f32 = 2e-5;
 // Triangles per cluster, and invocations per workgroup of both entry points.
 const CLUSTER_TRIANGLES: u32 = 64u;
 
+// Whether a lane of this workgroup found more pieces than the piece list had room for.
+var<workgroup> overflowed: atomic<u32>;
+
 // One invocation per triangle of each listed cluster: lists the pieces of its outline edges.
 @compute @workgroup_size(64)
 fn outline_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
@@ -268,10 +284,28 @@ fn outline_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocati
     if k < cull.count {
         let item = cull.items[k];
         let t = item.y * CLUSTER_TRIANGLES + lane;
-        if t < instances[slot(item.x)].triangles {
-            outline_triangle(item.x, t);
+        if t < instances[slot(item.x)].triangles && !list_triangle(item.x, t) {
+            atomicStore(&overflowed, 1u);
         }
     }
+    workgroupBarrier();
+    if lane == 0u && atomicLoad(&overflowed) != 0u {
+        push_overflow(k);
+    }
+}
+
+// Appends `entry` (a cluster list index, or a group of intersection segments) to the
+// overflow list, and grows the piece dispatch by 64 lanes for it.
+fn push_overflow(entry: u32) {
+    let o = overflow_list();
+    let j = atomicAdd(&acc_rw[o + 3u], 1u);
+    if j < frame.overflow_room {
+        atomicStore(&acc_rw[o + 4u + j], entry);
+    }
+    let list = piece_list();
+    let size = list_size(piece_room(list) + 64u * j + 63u, 64u);
+    atomicMax(&acc_rw[list], size.x);
+    atomicMax(&acc_rw[list + 1u], size.y);
 }
 
 // A listed piece (`list_piece`): its instance, its triangle (or, DRAW_INTERSECTION in
@@ -286,62 +320,66 @@ struct Listed {
     pieces: u32,
 }
 
-// Lists a piece for outline_pieces_main (or crossing_pieces_main) to draw: false where the
-// list is full, and the caller draws it itself.
-fn list_piece(item: Listed) -> bool {
-    let list = piece_list();
-    let k = atomicAdd(&acc_rw[list + 3u], 1u);
-    if k >= piece_room(list) {
-        return false;
+// Lists pieces range.x..range.y of an edge (`item` names the edge, its mode and its piece
+// count) for outline_pieces_main to draw, with one reservation in
+// the list for all of them; returns how many it listed, fewer where the list is full (the
+// caller draws the rest itself, `draw_unlisted`).
+fn list_pieces(item: Listed, range: vec2<u32>) -> u32 {
+    if range.x >= range.y {
+        return 0u;
     }
+    let n = range.y - range.x;
+    let list = piece_list();
+    let room = piece_room(list);
+    let k = atomicAdd(&acc_rw[list + 3u], n);
+    let listed = min(n, room - min(k, room));
     let at = list + 4u + PIECE_WORDS * k;
-    atomicStore(&acc_rw[at], item.inst);
-    atomicStore(&acc_rw[at + 1u], item.t);
-    atomicStore(&acc_rw[at + 2u], item.i | (item.mode << 2u));
-    atomicStore(&acc_rw[at + 3u], item.piece | (item.pieces << 16u));
-    let size = list_size(k, 64u);
-    atomicMax(&acc_rw[list], size.x);
-    atomicMax(&acc_rw[list + 1u], size.y);
-    return true;
+    let word = item.i | (item.mode << 2u);
+    for (var j = 0u; j < listed; j++) {
+        let w = at + PIECE_WORDS * j;
+        atomicStore(&acc_rw[w], item.inst);
+        atomicStore(&acc_rw[w + 1u], item.t);
+        atomicStore(&acc_rw[w + 2u], word);
+        atomicStore(&acc_rw[w + 3u], (range.x + j) | (item.pieces << 16u));
+    }
+    if listed > 0u {
+        let size = list_size(k + listed - 1u, 64u);
+        atomicMax(&acc_rw[list], size.x);
+        atomicMax(&acc_rw[list + 1u], size.y);
+    }
+    return listed;
 }
 
-// The piece a lane of the piece dispatch draws: the list's k-th, where k is below the list's
-// count (which includes the pieces found beyond the list's room, drawn where they were found).
-fn listed_piece(group: vec3<u32>, lane: u32, item: ptr<function, Listed>) -> bool {
-    let k = list_group(group) * 64u + lane;
-    let list = piece_list();
-    if k >= min(atomicLoad(&acc_rw[list + 3u]), piece_room(list)) {
-        return false;
+// The ends of edge i of triangle t of `inst` (local corners p), or of its cut line
+// (DRAW_CUT in `mode`: where its plane meets the triangle), and the triangle across it.
+struct EdgeEnds {
+    a: vec3<f32>,
+    b: vec3<f32>,
+    n: u32,
+}
+
+fn edge_ends(inst: u32, t: u32, p: array<vec3<f32>, 3>, i: u32, mode: u32) -> EdgeEnds {
+    var e = EdgeEnds(p[i], p[(i + 1u) % 3u], neighbour(instances[slot(inst)].triangle_base + t, i));
+    if (mode & DRAW_CUT) != 0u {
+        let cut = cut_segment(inst, p[0], p[1], p[2], cut_plane(mode));
+        e = EdgeEnds(cut[0], cut[1], BACKGROUND_ID);
     }
-    let at = list + 4u + PIECE_WORDS * k;
-    let word = atomicLoad(&acc_rw[at + 2u]);
-    let piece = atomicLoad(&acc_rw[at + 3u]);
-    *item = Listed(atomicLoad(&acc_rw[at]), atomicLoad(&acc_rw[at + 1u]), word & 3u, word >> 2u, piece & 0xffffu, piece >> 16u);
-    return true;
+    return e;
+}
+
+// The local corners of triangle t of `inst`.
+fn triangle_corners(inst: u32, t: u32) -> array<vec3<f32>, 3> {
+    let v = corners(instances[slot(inst)].triangle_base + t) + instances[slot(inst)].vertex_base;
+    return array<vec3<f32>, 3>(vertex_at(v.x).xyz, vertex_at(v.y).xyz, vertex_at(v.z).xyz);
 }
 
 // The segment of a listed piece's edge (an outline, a drawn edge or a cut line), its
 // pattern anchored.
 fn listed_edge(item: Listed) -> Clipped {
-    let inst = item.inst;
-    let t = item.t;
-    let i = item.i;
-    let mode = item.mode;
-    let base = instances[slot(inst)].triangle_base;
-    let v = corners(base + t) + instances[slot(inst)].vertex_base;
-    var a = vertex_at(v[i]).xyz;
-    var b = vertex_at(v[(i + 1u) % 3u]).xyz;
-    var n = neighbour(base + t, i);
-    // A cut line: where its plane meets the triangle.
-    if (mode & DRAW_CUT) != 0u {
-        let cut = cut_segment(inst, vertex_at(v.x).xyz, vertex_at(v.y).xyz, vertex_at(v.z).xyz, cut_plane(mode));
-        a = cut[0];
-        b = cut[1];
-        n = BACKGROUND_ID;
-    }
-    let anchor = pattern_anchor(inst, t, i, a, b, mode);
-    var c = clip_outline(On(inst, t, inst, n, false), a, b, anchor, cut_plane(mode));
-    c.seg.cap = capped(inst, t, i, mode);
+    let e = edge_ends(item.inst, item.t, triangle_corners(item.inst, item.t), item.i, item.mode);
+    let anchor = pattern_anchor(item.inst, item.t, item.i, e.a, e.b, item.mode);
+    var c = clip_outline(On(item.inst, item.t, item.inst, e.n, false), e.a, e.b, anchor, cut_plane(item.mode));
+    c.seg.cap = capped(item.inst, item.t, item.i, item.mode);
     return c;
 }
 
@@ -351,13 +389,123 @@ fn draw_listed(item: Listed, c: Clipped) {
     draw_piece(c.seg, f32(item.piece) / pieces, f32(item.piece + 1u) / pieces, c.length_px, item.mode);
 }
 
-// One invocation per listed piece: draws it.
+// What a lane of the piece dispatch draws: one listed piece, or (a lane past the list's
+// room, for an overflow entry) every piece of a triangle's lines (`found`, each i | mode << 2)
+// or of an intersection segment (`segment`).
+struct LaneWork {
+    inst: u32,
+    t: u32,
+    found: Found,
+    // The listed piece, the only one drawn (`overflow` false).
+    piece: u32,
+    pieces: u32,
+    overflow: bool,
+    segment: bool,
+}
+
+fn lane_work(group: vec3<u32>, lane: u32) -> LaneWork {
+    var w: LaneWork;
+    let k = list_group(group) * 64u + lane;
+    let list = piece_list();
+    let room = piece_room(list);
+    let count = atomicLoad(&acc_rw[list + 3u]);
+    if k < min(count, room) {
+        let at = list + 4u + PIECE_WORDS * k;
+        let word = atomicLoad(&acc_rw[at + 2u]);
+        let piece = atomicLoad(&acc_rw[at + 3u]);
+        w.inst = atomicLoad(&acc_rw[at]);
+        w.t = atomicLoad(&acc_rw[at + 1u]);
+        w.found.count = 1u;
+        w.found.words[0] = word;
+        w.piece = piece & 0xffffu;
+        w.pieces = piece >> 16u;
+        w.segment = (word & (DRAW_INTERSECTION << 2u)) != 0u;
+        return w;
+    }
+    let o = overflow_list();
+    let j = (k - min(k, room)) / 64u;
+    if k < room || j >= min(atomicLoad(&acc_rw[o + 3u]), frame.overflow_room) {
+        return w;
+    }
+    let entry = atomicLoad(&acc_rw[o + 4u + j]);
+    w.overflow = true;
+    if (entry & OVERFLOW_SEGMENTS) != 0u {
+        w.t = (entry & ~OVERFLOW_SEGMENTS) * 64u + lane;
+        w.segment = true;
+        w.found.count = select(0u, 1u, w.t < frame.intersections);
+        w.found.words[0] = (DRAW_VISIBLE | DRAW_INTERSECTION) << 2u;
+        return w;
+    }
+    let item = cull.items[entry];
+    w.inst = item.x;
+    w.t = item.y * CLUSTER_TRIANGLES + lane;
+    if w.t < instances[slot(item.x)].triangles {
+        w.found = outline_lines(item.x, w.t);
+    }
+    return w;
+}
+
+// The segment of line `item` of a lane's work: an intersection segment's (`segment`), or
+// a listed edge's (`listed_edge`). One call of clip_outline serves both.
+fn lane_line(item: Listed, segment: bool) -> Clipped {
+    // A segment's item names no triangle: the edge's part reads triangle 0 instead.
+    let t = select(item.t, 0u, segment);
+    let e = edge_ends(item.inst, t, triangle_corners(item.inst, t), item.i, item.mode);
+    var on = On(item.inst, t, item.inst, e.n, false);
+    var a = e.a;
+    var b = e.b;
+    var anchor = pattern_anchor(item.inst, t, item.i, e.a, e.b, item.mode);
+    var cap = capped(item.inst, t, item.i, item.mode);
+    if segment {
+        let s = intersections[min(item.t, max(frame.intersections, 1u) - 1u)];
+        on = On(s.slot, s.t, s.other, s.u, true);
+        a = s.a;
+        b = s.b;
+        anchor = vec4<f32>(0.0, 1.0, 0.0, 1.0);
+        cap = CAP_NONE;
+    }
+    var c = clip_outline(on, a, b, anchor, cut_plane(item.mode));
+    c.seg.cap = cap;
+    return c;
+}
+
+// Draws a lane's work (`lane_work`): one loop over the pieces of each of its lines, so that
+// the shader holds one copy of the drawing code.
+fn draw_lane(w: LaneWork) {
+    var e = 0u;
+    var piece = w.piece;
+    loop {
+        if e >= w.found.count {
+            break;
+        }
+        let word = w.found.words[e];
+        var item = Listed(w.inst, w.t, word & 3u, word >> 2u, piece, w.pieces);
+        let c = lane_line(item, w.segment);
+        item.inst = c.seg.on.inst;
+        // An overflowed lane draws every piece within reach of the targets.
+        var end = piece + 1u;
+        if w.overflow {
+            item.pieces = c.pieces;
+            let range = pieces_in_reach(c, line_reach_of(item.inst, item.mode));
+            piece = max(piece, range.x);
+            item.piece = piece;
+            end = range.y;
+        }
+        if piece < end {
+            draw_listed(item, c);
+            piece++;
+        }
+        if piece >= end {
+            e++;
+            piece = 0u;
+        }
+    }
+}
+
+// One invocation per listed piece (and 64 per overflow entry): draws it.
 @compute @workgroup_size(64)
 fn outline_pieces_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
-    var item: Listed;
-    if listed_piece(group, lane, &item) {
-        draw_listed(item, listed_edge(item));
-    }
+    draw_lane(lane_work(group, lane));
 }
 
 // The frame's intersection segments (src/gpu/frame.rs, IntersectionRecord): where
@@ -383,57 +531,74 @@ fn clip_intersection(k: u32) -> Clipped {
 // One invocation per intersection segment: lists its pieces that reach the targets, after
 // the outline edges' (a segment is no longer than its triangles, so few have more than one).
 @compute @workgroup_size(64)
-fn intersection_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+fn intersection_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
     let k = gid.x + gid.y * groups.x * CLUSTER_TRIANGLES;
-    if k >= frame.intersections {
-        return;
-    }
-    let c = clip_intersection(k);
-    let reach = line_reach(frame.intersection_width);
-    let mode = DRAW_VISIBLE | DRAW_INTERSECTION;
-    // An item holds the piece count in 16 bits; a longer segment is drawn here whole.
-    let listable = c.pieces <= 0xffffu;
-    for (var piece = 0u; piece < c.pieces; piece++) {
-        let k0 = f32(piece) / f32(c.pieces);
-        let k1 = f32(piece + 1u) / f32(c.pieces);
-        let item = Listed(c.seg.on.inst, k, 0u, mode, piece, c.pieces);
-        if piece_reaches_targets(c.seg, k0, k1, reach) && !(listable && list_piece(item)) {
-            draw_listed(item, c);
+    if k < frame.intersections {
+        let c = clip_intersection(k);
+        let mode = DRAW_VISIBLE | DRAW_INTERSECTION;
+        let item = Listed(c.seg.on.inst, k, 0u, mode, 0u, c.pieces);
+        let range = pieces_in_reach(c, line_reach(frame.intersection_width));
+        if !list_all(item, range) {
+            atomicStore(&overflowed, 1u);
         }
     }
-}
-
-// outline_pieces_main for a frame with intersection lines: its list holds their pieces too.
-@compute @workgroup_size(64)
-fn crossing_pieces_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
-    var item: Listed;
-    if listed_piece(group, lane, &item) {
-        var c: Clipped;
-        if (item.mode & DRAW_INTERSECTION) != 0u {
-            c = clip_intersection(item.t);
-        } else {
-            c = listed_edge(item);
-        }
-        draw_listed(item, c);
+    workgroupBarrier();
+    if lane == 0u && atomicLoad(&overflowed) != 0u {
+        push_overflow((k / 64u) | OVERFLOW_SEGMENTS);
     }
 }
 
-// Whether the piece of `seg` between parameters k0 and k1 lies within `reach` of the
-// targets (of a tile).
-fn piece_reaches_targets(seg: Segment, k0: f32, k1: f32, reach: f32) -> bool {
-    let p = mix(seg.start.xy, seg.end.xy, k0);
-    let q = mix(seg.start.xy, seg.end.xy, k1);
-    let first = frame.target_origin - reach;
-    let last = frame.target_origin + frame.target_size + reach;
-    return all(max(p, q) >= first) && all(min(p, q) <= last);
+// Lists the pieces `range` of a line (`item`: its edge, mode and piece count): false where
+// the list had no room for all of them, or the line has more than an item can number.
+fn list_all(item: Listed, range: vec2<u32>) -> bool {
+    let listable = item.pieces <= 0xffffu;
+    let listed = list_pieces(item, vec2<u32>(range.x, select(0u, range.y, listable)));
+    return listable && listed == range.y - min(range.x, range.y);
 }
 
-// Finds the outline edges of triangle t of instance `inst` and draws them.
-fn outline_triangle(inst: u32, t: u32) {
+// The pieces range.x..range.y of the clipped line `c` that lie within `reach` of the
+// targets (of a tile): those whose parameters meet the part of the line inside the targets
+// grown by the reach and a pixel.
+fn pieces_in_reach(c: Clipped, reach: f32) -> vec2<u32> {
+    let p = c.seg.start.xy;
+    let d = c.seg.end.xy - p;
+    let lo = frame.target_origin - reach - 1.0;
+    let hi = frame.target_origin + frame.target_size + reach + 1.0;
+    var u = keep_between(vec2<f32>(0.0, 1.0), p.x, d.x, lo.x, hi.x);
+    u = keep_between(u, p.y, d.y, lo.y, hi.y);
+    if !(u.x <= u.y) || c.pieces == 0u {
+        return vec2<u32>(0u);
+    }
+    let n = f32(c.pieces);
+    let first = min(u32(max(floor(u.x * n), 0.0)), c.pieces - 1u);
+    let end = min(u32(max(ceil(u.y * n), 0.0)), c.pieces);
+    return vec2<u32>(first, max(end, first + 1u));
+}
+
+// The lines of a triangle the outline pass draws: up to 3 edges and a cut line a section
+// plane, each i | mode << 2 (edge i, DRAW_* bits).
+struct Found {
+    count: u32,
+    words: array<u32, 9>,
+}
+
+// Lists the pieces of the lines of triangle t of `inst` (`outline_lines`): false where the
+// list had no room for them all.
+fn list_triangle(inst: u32, t: u32) -> bool {
+    let found = outline_lines(inst, t);
+    let p = triangle_corners(inst, t);
+    var all = true;
+    for (var j = 0u; j < found.count; j++) {
+        all = list_outline(inst, t, p, found.words[j]) && all;
+    }
+    return all;
+}
+
+// Finds the lines of triangle t of instance `inst` that the outline pass draws.
+fn outline_lines(inst: u32, t: u32) -> Found {
+    var found: Found;
     let base = instances[slot(inst)].triangle_base;
-    let vbase = instances[slot(inst)].vertex_base;
-    let v = corners(base + t) + vbase;
-    var p = array<vec3<f32>, 3>(vertex_at(v.x).xyz, vertex_at(v.y).xyz, vertex_at(v.z).xyz);
+    var p = triangle_corners(inst, t);
     // Most triangles are seen well away from edge-on, further than their edges fold: none of
     // their neighboured edges can be a silhouette (Mesh::outline_hints), and they skip the
     // neighbours' vertices. The angle is taken from the triangle's farthest vertex, its least.
@@ -474,15 +639,11 @@ fn outline_triangle(inst: u32, t: u32) {
     let along = !(abs(dot(eye.xyz, normal)) > fold_bound * length(eye.xyz) * length(normal));
     let may_fold = select(along, !(height > fold_bound * farthest * length(normal)), eye.w != 0.0);
     let cuts = cut_planes(inst, p[0], p[1], p[2]);
-    if !(may_fold && outlines) && !boundary && splat == 0u && drawn == 0u && cuts == 0u {
-        return;
-    }
-    // Cut lines, one a plane the triangle crosses (a loop, which a software rasterizer skips
-    // where no lane enters it).
+    // Cut lines, one a plane the triangle crosses.
     for (var rest = cuts; rest != 0u; rest &= rest - 1u) {
         let k = firstTrailingBit(rest);
-        let cut = cut_segment(inst, p[0], p[1], p[2], k);
-        list_outline(inst, t, 0u, BACKGROUND_ID, cut[0], cut[1], DRAW_VISIBLE | DRAW_CUT | (k << CUT_PLANE_SHIFT));
+        found.words[found.count] = (DRAW_VISIBLE | DRAW_CUT | (k << CUT_PLANE_SHIFT)) << 2u;
+        found.count++;
     }
     for (var i = 0u; i < 3u; i++) {
         if ((allowed | splat | drawn) & (1u << i)) == 0u {
@@ -510,9 +671,11 @@ fn outline_triangle(inst: u32, t: u32) {
         mode |= select(0u, DRAW_HIDDEN, hidden);
 #endif
         if mode != 0u {
-            list_outline(inst, t, i, n, a, b, mode);
+            found.words[found.count] = i | (mode << 2u);
+            found.count++;
         }
     }
+    return found;
 }
 
 // Whether a comes before b in (x, y, z) order: the end of an edge that anchors its line
@@ -854,32 +1017,32 @@ fn clip_outline(on: On, a: vec3<f32>, b: vec3<f32>, anchor: vec4<f32>, skip: u32
     return c;
 }
 
-// Lists the pieces of edge i (a -> b) of triangle t of `inst`, with neighbour n, that lie
-// within reach of the targets (of a tile) for outline_pieces_main, to draw as `mode` says
-// (DRAW_VISIBLE, DRAW_HIDDEN). Where the list is full the piece is drawn here.
-fn list_outline(inst: u32, t: u32, i: u32, n: u32, a: vec3<f32>, b: vec3<f32>, mode: u32) {
-    // The pattern's anchor only matters where a piece is drawn here (the piece pass finds it
-    // for the pieces it draws): looking it up for every listed edge would cost every lane.
-    let c = clip_outline(On(inst, t, inst, n, false), a, b, vec4<f32>(0.0, 1.0, 0.0, 1.0), cut_plane(mode));
+// The reach of a line of `inst` drawn as `mode` says: of its visible line and, with
+// DRAW_HIDDEN, its hidden one.
+fn line_reach_of(inst: u32, mode: u32) -> f32 {
     var visible_width = select(instances[slot(inst)].line_width, instances[slot(inst)].outline_width, (mode & DRAW_OUTLINE) != 0u);
     visible_width = select(visible_width, frame.section_width, (mode & DRAW_CUT) != 0u);
+    visible_width = select(visible_width, frame.intersection_width, (mode & DRAW_INTERSECTION) != 0u);
     var reach = select(0.0, line_reach(visible_width), (mode & DRAW_VISIBLE) != 0u);
 #if HIDDEN
     reach = max(reach, select(0.0, line_reach(instances[slot(inst)].hidden_width), (mode & DRAW_HIDDEN) != 0u));
 #endif
-    // An item holds the piece count in 16 bits; a longer edge is drawn here whole.
-    let listable = c.pieces <= 0xffffu;
-    for (var piece = 0u; piece < c.pieces; piece++) {
-        let k0 = f32(piece) / f32(c.pieces);
-        let k1 = f32(piece + 1u) / f32(c.pieces);
-        if !piece_reaches_targets(c.seg, k0, k1, reach) {
-            continue;
-        }
-        let item = Listed(inst, t, i, mode, piece, c.pieces);
-        if !(listable && list_piece(item)) {
-            draw_listed(item, listed_edge(item));
-        }
-    }
+    return reach;
+}
+
+// Lists the pieces of line `word` (i | mode << 2: edge i, or a cut line) of triangle t of
+// `inst` (local corners p) that lie within reach of the targets (of a tile) for
+// outline_pieces_main, to draw as `mode` says (DRAW_VISIBLE, DRAW_HIDDEN): false where the
+// list had no room for them all.
+fn list_outline(inst: u32, t: u32, p: array<vec3<f32>, 3>, word: u32) -> bool {
+    let i = word & 3u;
+    let mode = word >> 2u;
+    let e = edge_ends(inst, t, p, i, mode);
+    // The pattern's anchor only matters where a piece is drawn (the piece pass finds it for
+    // the pieces it draws): looking it up for every listed edge would cost every lane.
+    let c = clip_outline(On(inst, t, inst, e.n, false), e.a, e.b, vec4<f32>(0.0, 1.0, 0.0, 1.0), cut_plane(mode));
+    let item = Listed(inst, t, i, mode, 0u, c.pieces);
+    return list_all(item, pieces_in_reach(c, line_reach_of(inst, mode)));
 }
 
 // Finds the visible (and, with DRAW_HIDDEN in `mode`, the hidden) runs of the segment

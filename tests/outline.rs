@@ -249,3 +249,52 @@ fn within_bounds(name: &str, scene: &TestScene) -> Rendering {
     common::within_bounds(name, &truth, &deferred);
     truth
 }
+
+/// A frame whose pieces overflow the outline pass's piece list draws the same lines, to the
+/// bit: the clusters (and groups of intersection segments) it had no room for are drawn by
+/// lanes of their own, every piece of their lines. fandisk with dashed hidden lines and a
+/// section plane lists thousands of pieces; Suzanne's eyes add intersection lines.
+#[test]
+fn pieces_beyond_the_lists_room_are_drawn_all_the_same() {
+    use wirepass::gpu::{DeferredPass, PassOptions};
+    use wirepass::tools::offline::draw_deferred_with;
+    use wirepass::world::offscreen::Uploaded;
+    let ctx = common::gpu();
+    let hidden = Style {
+        hidden: Some(wirepass::HiddenLines::default()),
+        ..Style::default()
+    };
+    let crossing = Style {
+        intersection_lines: true,
+        ..Style::default()
+    };
+    for (mesh, style) in [("fandisk.obj", hidden), ("suzanne.obj", crossing)] {
+        let scene = scene(&load(mesh), style);
+        let up = Uploaded::new(&ctx.device, &ctx.queue, &scene.world).unwrap();
+        let draw = |room: Option<u64>| {
+            let mut pass = DeferredPass::new(&ctx.device, PassOptions::default())
+                .unwrap()
+                .with_diagnostics();
+            if let Some(room) = room {
+                pass = pass.with_piece_room(room);
+            }
+            draw_deferred_with(ctx, &scene.shot(), &up, pass).unwrap()
+        };
+        let listed = draw(None);
+        let overflowed = draw(Some(64));
+        let bits = |r: &Rendering| {
+            let maps = r.edge_distance.iter().chain(&r.hidden_distance);
+            maps.map(|d| d.to_bits()).collect::<Vec<_>>()
+        };
+        let lines = listed
+            .edge_distance
+            .iter()
+            .filter(|d| d.is_finite())
+            .count();
+        assert!(lines > 1000, "{mesh}: {lines} line pixels");
+        let (a, b) = (bits(&listed), bits(&overflowed));
+        let differ = a.iter().zip(&b).filter(|(a, b)| a != b).count();
+        assert_eq!(differ, 0, "{mesh}: {differ} pixels differ");
+        assert_eq!(listed.rgba, overflowed.rgba, "{mesh}");
+    }
+}

@@ -12,7 +12,7 @@ use super::host_depth::{HostFrame, HostImport};
 use super::mesh_store::MeshStore;
 use super::options::{OutputTarget, PassOptions, TriangleIds};
 use super::outline_pass::{piece_size_at, OutlinePass};
-use super::targets::{check_sampled, check_storage_output, TargetSpec, Targets, LIST_HEADER};
+use super::targets::{self, check_sampled, check_storage_output, TargetSpec, Targets, LIST_HEADER};
 use super::variants::{Mode, Variant};
 use super::visibility::Visibility;
 #[cfg(feature = "diagnostics")]
@@ -281,6 +281,8 @@ pub struct DeferredPass {
     /// Header every list starts a frame with: no work, one workgroup row.
     reset: wgpu::Buffer,
     diagnostics: bool,
+    /// Entries of the outline pass's piece list, where a test sets it.
+    piece_room: Option<u64>,
     targets: Option<Targets>,
     cull: Option<wgpu::Buffer>,
 }
@@ -336,6 +338,7 @@ impl DeferredPass {
             results: AtomicU64::new(0),
             reset,
             diagnostics: false,
+            piece_room: None,
             targets: None,
             cull: None,
         })
@@ -348,6 +351,15 @@ impl DeferredPass {
     #[cfg(feature = "diagnostics")]
     pub fn with_diagnostics(mut self) -> Self {
         self.diagnostics = true;
+        self.targets = None;
+        self
+    }
+
+    /// Gives the outline pass's piece list room for `pieces` entries instead of one per 8
+    /// target pixels, so that a test can draw a frame whose pieces overflow it.
+    #[cfg(feature = "diagnostics")]
+    pub fn with_piece_room(mut self, pieces: u64) -> Self {
+        self.piece_room = Some(pieces);
         self.targets = None;
         self
     }
@@ -403,6 +415,10 @@ impl DeferredPass {
             acc_colors: data.mixed_colors,
             acc_hidden: data.hidden,
             acc_phase_words: data.chain_phases().0,
+            acc_overflow_room: data.overflow_room(),
+            acc_pieces: self
+                .piece_room
+                .unwrap_or_else(|| targets::piece_room(data.target_size())),
             result: self.composite.is_some(),
             diagnostic: self.diagnostics,
             host: host.is_some(),

@@ -32,7 +32,7 @@ pub(crate) struct FrameUniforms {
     triangle_split: u32,
     clusters: u32,
     host_depth: u32,
-    _pad: u32,
+    overflow_room: u32,
     fill_opacity: f32,
     hidden_color: [f32; 4],
     chain_work: [u32; 4],
@@ -555,7 +555,7 @@ impl FrameRecords {
             triangle_split: buffers.split.triangles,
             clusters,
             host_depth: 0,
-            _pad: 0,
+            overflow_room: overflow_room(clusters, intersections_count),
             fill_opacity: style.fill_opacity,
             hidden_color: hidden_color.map_or([0.0; 4], |c| c.0),
             chain_work: [
@@ -719,6 +719,11 @@ impl FrameData {
         self.uniforms.intersections
     }
 
+    /// Entries of the outline pass's overflow list.
+    pub fn overflow_room(&self) -> u32 {
+        self.uniforms.overflow_room
+    }
+
     /// Words of the outline buffer's phase tables, and the chains `chain_phases` visits.
     pub fn chain_phases(&self) -> (u32, u32) {
         (self.uniforms.chain_work[0], self.uniforms.chain_work[1])
@@ -817,6 +822,17 @@ fn instance_record(
         edge_pattern: [0.0; 2],
         outline_pattern: [0.0; 2],
     }
+}
+
+/// Room of the outline pass's overflow list (`overflow_list` in outline.wgsl): an entry for
+/// each cluster and each group of 64 intersection segments, whose pieces the piece list may
+/// have had no room for; a power of two, so that the targets, which hold the list, are
+/// rebuilt only when a scene grows past it.
+fn overflow_room(clusters: u32, intersections: u32) -> u32 {
+    (clusters.saturating_add(intersections.div_ceil(64)))
+        .max(64)
+        .checked_next_power_of_two()
+        .unwrap_or(1 << 31)
 }
 
 /// A read-only storage buffer holding `items`, or one zeroed item where there are none

@@ -21,10 +21,10 @@
 //! [`MAX_RUNS`] runs, for its visible and its hidden line. The wider the window, the shorter
 //! the pieces. A GPU has no such cap, and its pieces are 1 px whatever the window.
 //!
-//! Three loops are not bounded here: the pieces found after the piece list is full, which
-//! the listing lane draws itself, an edge's pieces one after another; an edge of more than
-//! 65 535 pieces, drawn the same way; and the walk along a chain of drawn edges for the
-//! patterns' phases (`chain_phases`), an iteration an edge.
+//! Three loops are not bounded here: the pieces of a cluster whose lines the piece list had
+//! no room for, which a lane of the piece dispatch draws for each of its triangles, one
+//! after another; an edge of more than 65 535 pieces, drawn the same way; and the walk along
+//! a chain of drawn edges for the patterns' phases (`chain_phases`), an iteration an edge.
 //!
 //! The shaders take these constants from here ([`wgsl`]).
 

@@ -28,19 +28,17 @@ struct OutlinePipelines {
     pieces: Compute,
     /// Finds the patterns' positions along every chain (PATTERNS).
     phases: Option<Compute>,
-    /// Lists the intersection segments' pieces, and draws the pieces of a list that holds
-    /// them: built on first use, as few frames draw them.
+    /// Lists the intersection segments' pieces: built on first use, as few frames draw
+    /// them.
     intersections: OnceLock<Intersections>,
     module: wgpu::ShaderModule,
     resources: Vec<Res>,
 }
 
-/// The pipelines of a frame with intersection lines.
+/// The pipeline of a frame with intersection lines: one invocation per intersection
+/// segment, listing its pieces.
 struct Intersections {
-    /// One invocation per intersection segment, listing its pieces.
     list: Compute,
-    /// `outline_pieces_main` for a list that holds intersection pieces too.
-    pieces: Compute,
 }
 
 /// The shader flags of variant `v`'s outline module, with pieces of 1 px for a GPU
@@ -85,7 +83,7 @@ impl OutlinePass {
         Ok(())
     }
 
-    /// The intersection lines' pipelines of the set `p`, built on first use.
+    /// The intersection lines' pipeline of the set `p`, built on first use.
     fn intersections<'p>(
         &self,
         device: &wgpu::Device,
@@ -99,7 +97,6 @@ impl OutlinePass {
             |entry| Compute::new(device, &p.module, entry, p.resources.clone(), self.format);
         let c = Intersections {
             list: build("intersection_main")?,
-            pieces: build("crossing_pieces_main")?,
         };
         if let Some(e) = scope.end() {
             return Err(Error::Device(format!(
@@ -151,21 +148,23 @@ impl OutlinePass {
             ],
             self.format,
         )?;
+        // Both the listing and the piece dispatch read the cluster list (the pieces for the
+        // overflow list's clusters), and the pieces and the intersection lines' listing the
+        // intersection segments.
         let mut draw_res = store_resources(v.split, true, v.uniform_instances);
-        draw_res.extend([Res::Ids, Res::AccRw]);
+        draw_res.extend([Res::Ids, Res::AccRw, Res::Cull]);
         if v.host {
             draw_res.push(Res::HostDepth);
         }
+        let mut resources = draw_res.clone();
+        resources.push(Res::Intersections);
         let pieces = Compute::new(
             device,
             &module,
             "outline_pieces_main",
-            draw_res.clone(),
+            resources.clone(),
             self.format,
         )?;
-        let mut resources = draw_res.clone();
-        resources.push(Res::Intersections);
-        draw_res.push(Res::Cull);
         let draw = Compute::new(device, &module, "outline_main", draw_res, self.format)?;
         let phases = if v.patterns {
             let mut res = vec![
@@ -224,6 +223,7 @@ impl OutlinePass {
         let data = sources.frame;
         encoder.clear_buffer(&t.acc, 0, Some(t.acc_phases));
         encoder.copy_buffer_to_buffer(reset, 0, &t.acc, t.acc_tiles, LIST_HEADER);
+        encoder.copy_buffer_to_buffer(reset, 0, &t.acc, t.acc_overflow, LIST_HEADER);
         encoder.copy_buffer_to_buffer(reset, 0, &t.acc, t.acc_pieces, LIST_HEADER);
         encoder.copy_buffer_to_buffer(reset, 0, list, 0, LIST_HEADER);
         let max = device.limits().max_compute_workgroups_per_dimension.max(1);
@@ -252,7 +252,7 @@ impl OutlinePass {
         // With intersection lines, their segments' pieces join the list, and the piece
         // dispatch draws both kinds.
         let segments = data.intersections();
-        let (pieces, group) = if segments > 0 {
+        if segments > 0 {
             let crossing = self.intersections(device, &p)?;
             let group = crossing.list.bind(device, sources)?;
             let names = ("wirepass intersection lines", "outline.intersections");
@@ -264,16 +264,14 @@ impl OutlinePass {
                 pipeline,
                 grid(segments),
             );
-            (&crossing.pieces, crossing.pieces.bind(device, sources)?)
-        } else {
-            (&p.pieces, p.pieces.bind(device, sources)?)
-        };
+        }
+        let group = p.pieces.bind(device, sources)?;
         // The piece dispatch's size, where no pass binding `acc` for writing reads it.
         let size_at = piece_size_at(data);
         encoder.copy_buffer_to_buffer(&t.acc, t.acc_pieces, list, size_at, LIST_HEADER);
         let names = ("wirepass outline pieces", "outline.pieces");
         let size = Size::Indirect(list, size_at);
-        dispatch(encoder, timer, names, (pieces, &group), size);
+        dispatch(encoder, timer, names, (&p.pieces, &group), size);
         Ok(())
     }
 }

@@ -85,6 +85,12 @@ const MIN_PIECES: u64 = 1 << 16;
 /// Bytes per listed piece (outline.wgsl, PIECE_WORDS).
 const PIECE_BYTES: u64 = 16;
 
+/// Entries of the outline pass's piece list for targets of `size` (before the binding limit
+/// trims it).
+pub(crate) fn piece_room(size: (u32, u32)) -> u64 {
+    (u64::from(size.0) * u64::from(size.1) / PIXELS_PER_PIECE).max(MIN_PIECES)
+}
+
 #[derive(Clone)]
 pub(crate) struct Targets {
     /// Size of the id and depth targets (the output plus the guard band).
@@ -98,13 +104,14 @@ pub(crate) struct Targets {
     /// they are drawn; a mark per output tile; the list of
     /// the tiles the lines reach, from byte `acc_tiles`; the phase tables of chains of drawn
     /// edges (`chain_phases` in outline.wgsl), from byte `acc_phases`; the outline pass's
-    /// piece list, from byte `acc_pieces`.
+    /// overflow list, from byte `acc_overflow`, and its piece list, from byte `acc_pieces`.
     pub acc: wgpu::Buffer,
     pub acc_tiles: u64,
     pub acc_phases: u64,
+    pub acc_overflow: u64,
     pub acc_pieces: u64,
-    pub acc_colors: bool,
-    pub acc_hidden: bool,
+    /// What the targets were made for.
+    spec: TargetSpec,
     /// The refine list: header, then one packed pixel per entry.
     pub work: wgpu::Buffer,
     /// The edge pass's list of 8×8 output tiles with work for its tile dispatch.
@@ -126,6 +133,10 @@ pub(crate) struct TargetSpec {
     pub acc_hidden: bool,
     /// Words of phase tables.
     pub acc_phase_words: u32,
+    /// Entries of the outline pass's overflow list.
+    pub acc_overflow_room: u32,
+    /// Entries of the outline pass's piece list ([`piece_room`]).
+    pub acc_pieces: u64,
     pub result: bool,
     pub diagnostic: bool,
     pub host: bool,
@@ -134,17 +145,7 @@ pub(crate) struct TargetSpec {
 
 impl Targets {
     pub fn spec(&self) -> TargetSpec {
-        TargetSpec {
-            size: self.size,
-            output: self.output,
-            acc_colors: self.acc_colors,
-            acc_hidden: self.acc_hidden,
-            acc_phase_words: ((self.acc_pieces - self.acc_phases) / 4) as u32,
-            result: self.result.is_some(),
-            diagnostic: self.diagnostic.is_some(),
-            host: self.host.is_some(),
-            host_seed: self.host_seed.is_some(),
-        }
+        self.spec
     }
 
     #[cfg(feature = "diagnostics")]
@@ -160,14 +161,15 @@ impl Targets {
         let pixels = u64::from(w) * u64::from(h);
         let binding = device.limits().max_storage_buffer_binding_size;
         let tiles = u64::from(spec.output.0.div_ceil(8)) * u64::from(spec.output.1.div_ceil(8));
-        // The lines, the tile marks and list, then the outline pass's piece list: its header,
-        // then room for a piece per PIXELS_PER_PIECE target pixels (at least MIN_PIECES),
-        // less where the binding limit leaves less (the outline pass draws the pieces it has
-        // no room for itself).
+        // The lines, the tile marks and list, the phase tables, the overflow list, then the
+        // outline pass's piece list: its header, then room for a piece per PIXELS_PER_PIECE
+        // target pixels (at least MIN_PIECES), less where the binding limit leaves less (the
+        // overflow list takes the clusters whose pieces it has no room for).
         let words = (1 + u64::from(spec.acc_colors)) * (1 + u64::from(spec.acc_hidden));
         let acc_tiles = pixels * 4 * words + 4 * tiles;
         let acc_phases = acc_tiles + LIST_HEADER + 4 * tiles;
-        let acc_pieces = acc_phases + 4 * u64::from(spec.acc_phase_words);
+        let acc_overflow = acc_phases + 4 * u64::from(spec.acc_phase_words);
+        let acc_pieces = acc_overflow + LIST_HEADER + 4 * u64::from(spec.acc_overflow_room);
         if acc_pieces + LIST_HEADER > binding {
             return Err(Error::OverLimit {
                 what: format!("the outline buffer for a {w}x{h} target, in bytes"),
@@ -176,8 +178,8 @@ impl Targets {
                 limit: binding,
             });
         }
-        let pieces = (pixels / PIXELS_PER_PIECE).max(MIN_PIECES);
-        let acc_bytes = (acc_pieces + LIST_HEADER + PIECE_BYTES * pieces).min(binding / 4 * 4);
+        let acc_bytes =
+            (acc_pieces + LIST_HEADER + PIECE_BYTES * spec.acc_pieces).min(binding / 4 * 4);
         // The list: header, then one packed pixel per entry (a pixel is listed once).
         let work_bytes = LIST_HEADER + 4 * pixels;
         if work_bytes > binding {
@@ -225,9 +227,9 @@ impl Targets {
             ),
             acc_tiles,
             acc_phases,
+            acc_overflow,
             acc_pieces,
-            acc_colors: spec.acc_colors,
-            acc_hidden: spec.acc_hidden,
+            spec,
             // Read back by PreparedFrame::edge_work.
             work: buffer(
                 "wirepass refine list",
