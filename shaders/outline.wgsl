@@ -145,7 +145,11 @@ fn outline_cull(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     let in_view = cluster_in_view(instances[slot(inst)].clip, cluster);
     let drawn = listed && cluster_draws(cluster) && in_view;
     // A section plane cuts it: it has cut lines to draw.
-    let cut = frame.sections_on != 0u && cluster_cut(instances[slot(inst)].clip, cluster) && in_view;
+#if SECTIONS
+    let cut = cluster_cut(instances[slot(inst)].clip, cluster) && in_view;
+#else
+    let cut = false;
+#endif
     if !outlines && !splats && !drawn && !cut {
         return;
     }
@@ -246,6 +250,9 @@ const CAP_OUTSIDE: u32 = 1u;
 const CAP_INSIDE: u32 = 2u;
 
 fn capped(inst: u32, t: u32, i: u32, mode: u32) -> u32 {
+#if !SECTIONS
+    return CAP_NONE;
+#else
     let base = instances[slot(inst)].triangle_base;
     let v = corners(base + t) + instances[slot(inst)].vertex_base;
     let p0 = vertex_at(v.x);
@@ -260,7 +267,8 @@ fn capped(inst: u32, t: u32, i: u32, mode: u32) -> u32 {
     let concave = dot(cross(p1.xyz - p0.xyz, p2.xyz - p0.xyz), centroid - p0.xyz) > 0.0;
     let inside = select(away && beyond, concave && word != BACKGROUND_ID, away != beyond);
     let cap = select(CAP_OUTSIDE, CAP_INSIDE, inside);
-    return select(CAP_NONE, cap, frame.sections_on != 0u && (mode & DRAW_CUT) == 0u);
+    return select(CAP_NONE, cap, (mode & DRAW_CUT) == 0u);
+#endif
 }
 
 // The plane of a cut line's `mode` (DRAW_CUT), else NO_PLANE.
@@ -360,10 +368,12 @@ struct EdgeEnds {
 
 fn edge_ends(inst: u32, t: u32, p: array<vec3<f32>, 3>, i: u32, mode: u32) -> EdgeEnds {
     var e = EdgeEnds(p[i], p[(i + 1u) % 3u], neighbour(instances[slot(inst)].triangle_base + t, i));
+#if SECTIONS
     if (mode & DRAW_CUT) != 0u {
         let cut = cut_segment(inst, p[0], p[1], p[2], cut_plane(mode));
         e = EdgeEnds(cut[0], cut[1], BACKGROUND_ID);
     }
+#endif
     return e;
 }
 
@@ -456,6 +466,7 @@ fn lane_line(item: Listed, segment: bool) -> Clipped {
     var b = e.b;
     var anchor = pattern_anchor(item.inst, t, item.i, e.a, e.b, item.mode);
     var cap = capped(item.inst, t, item.i, item.mode);
+#if CROSSINGS
     if segment {
         let s = intersections[min(item.t, max(frame.intersections, 1u) - 1u)];
         on = On(s.slot, s.t, s.other, s.u, true);
@@ -464,6 +475,7 @@ fn lane_line(item: Listed, segment: bool) -> Clipped {
         anchor = vec4<f32>(0.0, 1.0, 0.0, 1.0);
         cap = CAP_NONE;
     }
+#endif
     var c = clip_outline(on, a, b, anchor, cut_plane(item.mode));
     c.seg.cap = cap;
     return c;
@@ -638,6 +650,7 @@ fn outline_lines(inst: u32, t: u32) -> Found {
     // Seen along one direction (w = 0): the angle to edge-on is the same from every vertex.
     let along = !(abs(dot(eye.xyz, normal)) > fold_bound * length(eye.xyz) * length(normal));
     let may_fold = select(along, !(height > fold_bound * farthest * length(normal)), eye.w != 0.0);
+#if SECTIONS
     let cuts = cut_planes(inst, p[0], p[1], p[2]);
     // Cut lines, one a plane the triangle crosses.
     for (var rest = cuts; rest != 0u; rest &= rest - 1u) {
@@ -645,6 +658,7 @@ fn outline_lines(inst: u32, t: u32) -> Found {
         found.words[found.count] = (DRAW_VISIBLE | DRAW_CUT | (k << CUT_PLANE_SHIFT)) << 2u;
         found.count++;
     }
+#endif
     for (var i = 0u; i < 3u; i++) {
         if ((allowed | splat | drawn) & (1u << i)) == 0u {
             continue;
@@ -956,10 +970,12 @@ fn edge_span(inst: u32, a: vec3<f32>, b: vec3<f32>, skip: u32) -> Span {
     s = keep_positive(s, dot(depth_row, ha), dot(depth_row, hb));
     // Not behind a section plane (unused planes are 0, which keeps everything); a cut line
     // is not clipped by its own plane, on which it lies (`skip`).
+#if SECTIONS
     for (var k = 0u; k < 6u; k++) {
         let own = k == skip;
         s = keep_positive(s, select(dot(frame.sections[k], ca), 1.0, own), select(dot(frame.sections[k], cb), 1.0, own));
     }
+#endif
     span.s = s;
     if !(s.x <= s.y) {
         return span;
@@ -1345,6 +1361,7 @@ fn class_at(x: vec2<f32>, near: f32, w: f32, reverse: f32, on: On, cap: u32) -> 
             return 1u;
         }
     }
+#if WIDE
     if wide {
         // And the line's own triangles' other neighbours, and a few triangles on from them
         // that face the same way: a sheet that folds back over the line starts there (the
@@ -1364,6 +1381,7 @@ fn class_at(x: vec2<f32>, near: f32, w: f32, reverse: f32, on: On, cap: u32) -> 
             }
         }
     }
+#endif
     return select(0u, 1u, cap != CAP_NONE && front.y > 0.0);
 }
 
@@ -1377,6 +1395,9 @@ struct Window {
 }
 
 fn line_window(on: On) -> Window {
+#if !WIDE
+    return Window(1, false);
+#else
     // Through a section's cut the eye sees the inside of folded surfaces, where the sheet in
     // front of an interior silhouette thins out near a fold of its own: look two pixels
     // round for it there.
@@ -1388,6 +1409,7 @@ fn line_window(on: On) -> Window {
     // An intersection line lies on both surfaces that cross there, so no surface passes
     // into view beyond it: it takes a section's window.
     return Window(select(select(select(1, 2, wide), 4, crossed), 2, on.crossing), wide);
+#endif
 }
 
 // Whether triangle `tri` of instance `inst` is one the line lies on.
@@ -1405,8 +1427,10 @@ fn hides(s: Sample, on: On, near: f32, w: f32, front: ptr<function, vec2<f32>>) 
     if nearer(s.near, near, w) {
         return true;
     }
+#if SECTIONS
     if nearer_than_cap(s.near, near, w) && s.near < (*front).x {
         *front = vec2<f32>(s.near, select(0.0, 1.0, faces_away(s.inst, s.v0.xyz, s.v1.xyz, s.v2.xyz)));
     }
+#endif
     return false;
 }

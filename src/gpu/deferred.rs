@@ -554,6 +554,8 @@ impl DeferredPass {
             colors: frame.data.outlines && frame.data.mixed_colors,
             hidden: frame.data.hidden,
             patterns: frame.data.outlines && frame.data.patterns,
+            sections: frame.data.outlines && frame.data.sections(),
+            crossing: frame.data.outlines && frame.data.crossing,
             host: frame.host.is_some(),
             uniform_instances: frame.data.uniform_instances,
             one_instance: frame.data.uniforms.instances() == 1,

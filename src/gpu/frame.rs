@@ -212,6 +212,10 @@ pub(crate) struct FrameData {
     /// Whether instances differ in line colour (the outline pass then keeps, per pixel,
     /// which instance's line it holds).
     pub mixed_colors: bool,
+    /// Whether surfaces may cross: a mesh passes through itself, instances may pass through
+    /// each other, or the frame draws intersection lines (the outline pass then looks wider
+    /// round its lines' points).
+    pub crossing: bool,
     /// The instances whose chains' pattern positions `chain_phases` finds ([`ChainWork`]),
     /// at least one (empty) entry, for binding.
     pub chain_work: wgpu::Buffer,
@@ -241,6 +245,7 @@ pub(crate) struct FrameRecords {
     pub hidden: bool,
     pub patterns: bool,
     pub mixed_colors: bool,
+    pub crossing: bool,
     pub chain_work: Vec<ChainWork>,
     pub intersections: Vec<IntersectionRecord>,
 }
@@ -590,6 +595,7 @@ impl FrameRecords {
             hidden,
             patterns,
             mixed_colors,
+            crossing: crossing || intersections_count > 0,
             chain_work,
             intersections,
         })
@@ -651,6 +657,7 @@ impl FrameData {
             patterns,
             region,
             mixed_colors,
+            crossing,
             chain_work,
             intersections,
         } = built;
@@ -700,6 +707,7 @@ impl FrameData {
             hidden,
             patterns,
             mixed_colors,
+            crossing,
             uniform_instances,
         }
     }

@@ -62,6 +62,12 @@ pub(crate) struct Variant {
     pub hidden: bool,
     /// A line is dashed or dotted; only with outlines, and only the outline pass reads it.
     pub patterns: bool,
+    /// The frame has section planes; only with outlines, and only the outline pass reads it
+    /// (the edge pass's section colour is a select on the frame's value).
+    pub sections: bool,
+    /// Surfaces may cross ([`FrameData::crossing`](super::frame::FrameData)); only with
+    /// outlines, and only the outline pass reads it.
+    pub crossing: bool,
     pub host: bool,
     /// The instance records are bound as a uniform array.
     pub uniform_instances: bool,
@@ -75,12 +81,15 @@ impl Variant {
     pub(crate) fn for_edges(self) -> Variant {
         Variant {
             patterns: false,
+            sections: false,
+            crossing: false,
             ..self
         }
     }
 
-    /// Every variant a frame can select: `colors`, `hidden` and `patterns` need `outlines`,
-    /// `one_instance` needs `uniform_instances`.
+    /// Every variant a frame can select: `colors`, `hidden`, `patterns`, `sections` and
+    /// `crossing` need `outlines`, `one_instance` needs `uniform_instances`; for validation,
+    /// sections and crossings are taken each alone, and both together with patterns.
     pub(crate) fn all() -> Vec<Variant> {
         let mut all = Vec::new();
         for split in [false, true] {
@@ -97,17 +106,30 @@ impl Variant {
                             [(false, false), (true, false), (true, true)]
                         {
                             for patterns in [false, true].into_iter().filter(|&p| outlines || !p) {
-                                all.push(Variant {
-                                    split,
-                                    outlines,
-                                    patches,
-                                    colors,
-                                    hidden,
-                                    patterns,
-                                    host,
-                                    uniform_instances,
-                                    one_instance,
-                                });
+                                // Sections and crossings: only with outlines, and each
+                                // alone or both, the last with patterns only.
+                                let cuts: &[(bool, bool)] = match (outlines, patterns) {
+                                    (false, _) => &[(false, false)],
+                                    (true, false) => {
+                                        &[(false, false), (true, false), (false, true)]
+                                    }
+                                    (true, true) => &[(false, false), (true, true)],
+                                };
+                                for &(sections, crossing) in cuts {
+                                    all.push(Variant {
+                                        split,
+                                        outlines,
+                                        patches,
+                                        colors,
+                                        hidden,
+                                        patterns,
+                                        sections,
+                                        crossing,
+                                        host,
+                                        uniform_instances,
+                                        one_instance,
+                                    });
+                                }
                             }
                         }
                     }
@@ -126,6 +148,10 @@ impl Variant {
             (self.colors, "COLORS"),
             (self.hidden, "HIDDEN"),
             (self.patterns, "PATTERNS"),
+            (self.sections, "SECTIONS"),
+            (self.crossing, "CROSSINGS"),
+            // Sections and crossings both widen the window round a line's points.
+            (self.sections || self.crossing, "WIDE"),
             (self.host, "HOST"),
             (self.uniform_instances, "UNIFORM_INSTANCES"),
             (self.one_instance, "ONE_INSTANCE"),
@@ -173,7 +199,8 @@ pub fn shader_modules() -> Vec<(String, String)> {
             edge_source(format, FLOOR_FLAGS),
         ));
         for mode in Mode::all() {
-            for v in variants.iter().filter(|v| !v.patterns) {
+            // The edge pass's own variants: those of the settings it reads.
+            for v in variants.iter().filter(|v| v.for_edges() == **v) {
                 let mut flags = v.flags();
                 flags.extend_from_slice(mode.flags());
                 out.push((
