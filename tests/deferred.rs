@@ -606,18 +606,18 @@ fn warm_up_builds_what_the_first_encode_would() {
         };
 
         pass.warm_up(d, &frame, &shaded).unwrap();
-        let built = pass.built_pipelines();
+        let built = pass.pipelines_built();
         assert!(built >= 1, "silhouettes {silhouettes}");
         encode(&pass, &frame, shaded);
-        assert_eq!(pass.built_pipelines(), built, "silhouettes {silhouettes}");
+        assert_eq!(pass.pipelines_built(), built, "silhouettes {silhouettes}");
 
         // Another output kind, not warmed up: its first encode builds its pipelines.
         encode(&pass, &frame, overlay());
-        let after = pass.built_pipelines();
+        let after = pass.pipelines_built();
         assert!(after > built, "silhouettes {silhouettes}");
         pass.warm_up(d, &frame, &overlay()).unwrap();
         encode(&pass, &frame, overlay());
-        assert_eq!(pass.built_pipelines(), after, "silhouettes {silhouettes}");
+        assert_eq!(pass.pipelines_built(), after, "silhouettes {silhouettes}");
     }
     ctx.finish().unwrap();
 }

@@ -3,12 +3,16 @@
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::time::{Duration, Instant};
 use wirepass::glam::Vec3;
 use wirepass::gpu::GpuContext;
 use wirepass::style::{DepthFade, DEFAULT_LINE_WIDTH};
 use wirepass::tools::bench::Timed;
 use wirepass::tools::load::{load_world, parse_size, parse_vec3, CameraPlacement, WorldOptions};
-use wirepass::tools::offline::{draw, Method};
+use wirepass::tools::offline::{
+    draw, draw_deferred_image, draw_deferred_timed, FirstImage, Method,
+};
+use wirepass::tools::regression::save_rgba_png;
 use wirepass::world::{Shot, World};
 use wirepass::{Color, EdgeSelection, HiddenLines, Highlight, LinePattern, Result, Style, View};
 
@@ -309,6 +313,12 @@ struct RenderArgs {
     /// this directory.
     #[arg(long)]
     dump: Option<PathBuf>,
+    /// Print where the time to the image goes (deferred method): reading the scene, each
+    /// mesh's preprocessing and upload, the pipelines built, the first frame (where a
+    /// driver that compiles shaders on first use compiles them), the readback; and the
+    /// process's peak memory.
+    #[arg(long)]
+    timings: bool,
 }
 
 fn parse_method(s: &str) -> std::result::Result<Method, String> {
@@ -316,17 +326,46 @@ fn parse_method(s: &str) -> std::result::Result<Method, String> {
 }
 
 fn render_command(args: &RenderArgs) -> Result<()> {
+    let start = Instant::now();
     let (world, view, style, size) = args.scene.load()?;
+    let read = start.elapsed();
+    let context = Instant::now();
     let ctx = GpuContext::new()?;
+    let context = context.elapsed();
     let shot = Shot {
         world: &world,
         view,
         style: &style,
         size,
     };
-    let frame = draw(&ctx, &shot, args.method)?;
-    frame.save_png(&args.output)?;
-    if let Some(dir) = &args.dump {
+    // The image alone where nothing else is asked for: no maps to compute and read back.
+    let image_only = args.method == Method::Deferred && args.dump.is_none();
+    if args.timings && args.method != Method::Deferred {
+        return Err(wirepass::Error::InvalidSetting(
+            "--timings times the deferred method only".into(),
+        ));
+    }
+    let (frame, first) = if image_only {
+        let (rgba, first) = draw_deferred_image(&ctx, &shot)?;
+        save_rgba_png(&args.output, &rgba, size)?;
+        (None, Some(first))
+    } else if args.timings {
+        let (frame, first) = draw_deferred_timed(&ctx, &shot)?;
+        frame.save_png(&args.output)?;
+        (Some(frame), Some(first))
+    } else {
+        let frame = draw(&ctx, &shot, args.method)?;
+        frame.save_png(&args.output)?;
+        (Some(frame), None)
+    };
+    if let (true, Some(first)) = (args.timings, &first) {
+        print_timings(
+            (read, context, start.elapsed()),
+            first,
+            world.triangle_count(),
+        );
+    }
+    if let (Some(dir), Some(frame)) = (&args.dump, &frame) {
         frame.dump(dir, &view)?;
     }
     eprintln!(
@@ -340,6 +379,54 @@ fn render_command(args: &RenderArgs) -> Result<()> {
         ctx.describe()
     );
     Ok(())
+}
+
+/// Prints `render --timings`: the steps to the first image, one a line, in milliseconds.
+fn print_timings(
+    (read, context, total): (Duration, Duration, Duration),
+    first: &FirstImage,
+    triangles: u64,
+) {
+    let ms = |d: Duration| d.as_secs_f64() * 1e3;
+    let line = |what: &str, d: Duration| eprintln!("{what:<44}{:>9.1} ms", ms(d));
+    line("read the scene", read);
+    line("open the GPU", context);
+    for (k, u) in first.uploads.iter().enumerate() {
+        let name = |step: &str| format!("mesh {k}: {step}");
+        line(&name("adjacency"), u.adjacency);
+        line(&name("outline hints"), u.outline_hints);
+        line(&name("clusters"), u.clusters);
+        line(&name("crossings (beside the three above)"), u.crossings);
+        line(&name("edges: patches, chains"), u.edges);
+        line(&name("records"), u.records);
+        line(&name("queue the upload"), u.upload);
+    }
+    line("all uploads, wall clock", first.upload);
+    line("make the pass", first.pass);
+    line("prepare the frame", first.prepare);
+    line(
+        &format!("build {} more pipelines", first.warm_up.pipelines),
+        first.warm_up.elapsed,
+    );
+    line("first frame (shader compilation)", first.frame);
+    line("read back", first.readback);
+    line("total, with the PNG", total);
+    if let Some(peak) = peak_memory() {
+        eprintln!(
+            "{:<44}{:>9.1} MB ({:.0} bytes a triangle)",
+            "peak memory",
+            peak as f64 / 1e6,
+            peak as f64 / triangles.max(1) as f64
+        );
+    }
+}
+
+/// The process's peak resident memory in bytes, where the system says (Linux).
+fn peak_memory() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
 }
 
 #[derive(clap::Args)]

@@ -78,6 +78,50 @@ fn a_render_without_a_display_says_only_what_it_wrote() {
     assert!(said.starts_with("wrote "), "{said}");
 }
 
+/// `render` without `--dump` draws the image alone, without the maps: the same image as a
+/// render that dumps them. `--timings` says where the time went, a line a step.
+#[test]
+fn the_image_alone_is_the_image_with_maps_and_timings_name_each_step() {
+    let (alone, with_maps) = (temp("alone.png"), temp("with_maps.png"));
+    let dump = temp("with_maps_dump");
+    let mesh = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../tests/data/meshes/suzanne.obj"
+    );
+    let scene = ["render", mesh, "--size", "96x72"];
+    let (ok, timings) =
+        wirepass(&[&scene[..], &["--timings", "-o", alone.to_str().unwrap()]].concat());
+    assert!(ok, "{timings}");
+    let (ok, err) = wirepass(
+        &[
+            &scene[..],
+            &[
+                "-o",
+                with_maps.to_str().unwrap(),
+                "--dump",
+                dump.to_str().unwrap(),
+            ],
+        ]
+        .concat(),
+    );
+    assert!(ok, "{err}");
+    let pixels = |p: &std::path::Path| image::open(p).unwrap().to_rgba8().into_raw();
+    assert_eq!(pixels(&alone), pixels(&with_maps));
+    for step in [
+        "read the scene",
+        "mesh 0: adjacency",
+        "mesh 0: crossings",
+        "mesh 0: edges: patches, chains",
+        "first frame",
+        "total, with the PNG",
+    ] {
+        assert!(timings.contains(step), "no {step:?} in:\n{timings}");
+    }
+    assert!(timings.contains(" bytes a triangle)"), "{timings}");
+    let (ok, err) = wirepass(&[&scene[..], &["--timings", "--method", "forward"]].concat());
+    assert!(!ok && err.lines().count() == 1, "{err}");
+}
+
 #[test]
 fn bad_settings_give_one_clear_line() {
     let out = temp("bad.png");

@@ -22,6 +22,7 @@ use crate::error::{Error, Result};
 use crate::scene::Scene;
 use crate::style::Style;
 use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
+use web_time::Instant;
 use wgpu::util::DeviceExt;
 
 /// A frame ready to encode: its scene data on the GPU and the targets it draws with.
@@ -287,6 +288,17 @@ pub struct DeferredPass {
     cull: Option<wgpu::Buffer>,
 }
 
+/// What [`DeferredPass::warm_up`] did: the pipelines it built and the time it took. A
+/// driver may compile a pipeline's shaders when it is first dispatched rather than when it
+/// is built (Mesa's lavapipe does), so the first frame can still take longer than the next.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct WarmUp {
+    /// Pipelines built by this call.
+    pub pipelines: usize,
+    /// The time it took.
+    pub elapsed: std::time::Duration,
+}
+
 impl DeferredPass {
     /// Builds the pipelines, the visibility pass as `options.triangle_ids` says.
     pub fn new(device: &wgpu::Device, options: PassOptions) -> Result<Self> {
@@ -521,29 +533,37 @@ impl DeferredPass {
         device: &wgpu::Device,
         frame: &PreparedFrame,
         target: &OutputTarget<'_>,
-    ) -> Result<()> {
+    ) -> Result<WarmUp> {
         if frame.pass != self.id {
             return Err(Error::Misuse(
                 "the frame was prepared by another DeferredPass".into(),
             ));
         }
-        let Some(mode) = self.mode(target)? else {
-            // The floor's pipeline is built with the pass.
-            return Ok(());
-        };
-        let variant = self.variant(frame);
-        if variant.outlines {
-            let intersections = frame.data.intersections() > 0;
-            self.outline.warm_up(device, variant, intersections)?;
+        let start = Instant::now();
+        let before = self.pipelines_built();
+        // The floor's pipeline is built with the pass.
+        if let Some(mode) = self.mode(target)? {
+            let variant = self.variant(frame);
+            if variant.outlines {
+                let intersections = frame.data.intersections() > 0;
+                self.outline.warm_up(device, variant, intersections)?;
+            }
+            self.edge.pipelines(device, mode, variant)?;
         }
-        self.edge.pipelines(device, mode, variant)?;
-        Ok(())
+        Ok(WarmUp {
+            pipelines: self.pipelines_built() - before,
+            elapsed: start.elapsed(),
+        })
     }
 
-    /// How many outline and edge pipeline sets the pass has built so far.
-    #[cfg(feature = "diagnostics")]
-    pub fn built_pipelines(&self) -> usize {
-        self.outline.built() + self.edge.built()
+    /// How many pipelines the pass has built so far: it builds each on first use, for
+    /// the kinds of frame and output it is given.
+    pub fn pipelines_built(&self) -> usize {
+        self.visibility.built()
+            + self.host.built()
+            + usize::from(self.composite.is_some())
+            + self.outline.built()
+            + self.edge.built()
     }
 
     fn variant(&self, frame: &PreparedFrame) -> Variant {

@@ -40,10 +40,14 @@ pub(crate) struct EdgePass {
 }
 
 impl EdgePass {
-    /// How many pipeline sets the cache holds.
-    #[cfg(feature = "diagnostics")]
+    /// How many pipelines the pass holds (the floor's, in a diagnostics build, among them).
     pub(crate) fn built(&self) -> usize {
-        self.cache.lock().map_or(0, |c| c.len())
+        let sets: usize = self.cache.lock().map_or(0, |c| {
+            c.values()
+                .map(|p| 5 + usize::from(p.outlined.is_some()))
+                .sum()
+        });
+        sets + usize::from(cfg!(feature = "diagnostics"))
     }
 
     /// The pass for storage outputs of `format`, clearing the background where it can

@@ -957,6 +957,7 @@ mod tests {
             intersections: vec![].into(),
             positions: vec![].into(),
             indices: vec![].into(),
+            report: Default::default(),
         };
         let transform = DMat4::from_scale_rotation_translation(
             DVec3::new(-1.0, 2.0, 0.5),

@@ -44,6 +44,13 @@ pub(crate) struct HostImport {
     seed: Option<(wgpu::RenderPipeline, wgpu::BindGroupLayout)>,
 }
 
+impl HostImport {
+    /// How many pipelines it holds.
+    pub fn built(&self) -> usize {
+        self.resolve.iter().flatten().count() + usize::from(self.seed.is_some())
+    }
+}
+
 /// A frame's host depth, ready to seed its targets.
 pub(crate) struct HostFrame {
     view: wgpu::TextureView,

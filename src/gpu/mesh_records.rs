@@ -7,9 +7,12 @@
 // `!(a > b)` is deliberate throughout: NaN must take the rejecting branch.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+use super::mesh_store::UploadReport;
+use crate::mesh::par::join;
 use crate::mesh::{adjacency::NO_NEIGHBOUR, patches::Patches, EdgeSelection, Mesh, ALL_EDGES};
 use glam::{DVec3, Vec2, Vec3};
 use std::sync::Arc;
+use web_time::Instant;
 
 /// The packed normal of a vertex without one (a zero normal, next to degenerate triangles
 /// only): both components at the snorm code that unpacking clamps, which no unit vector
@@ -57,7 +60,36 @@ pub(crate) struct StoredCrossing {
 }
 
 impl MeshData {
-    pub(crate) fn new(mesh: &Mesh, edges: EdgeSelection) -> MeshData {
+    /// The records of `mesh` drawing the edges `edges`, and what each step of making them
+    /// took (the upload's fields stay empty). The mesh's crossings are found while its
+    /// adjacency, outline hints and clusters are made, one after the other, beside them.
+    pub(crate) fn new(mesh: &Mesh, edges: EdgeSelection) -> (MeshData, UploadReport) {
+        let timed = |f: &dyn Fn()| {
+            let start = Instant::now();
+            f();
+            start.elapsed()
+        };
+        let ((adjacency, outline_hints, cluster_time), crossings) = join(
+            || {
+                (
+                    timed(&|| {
+                        mesh.edge_neighbours();
+                    }),
+                    timed(&|| {
+                        mesh.outline_hints();
+                    }),
+                    timed(&|| {
+                        mesh.outline_clusters();
+                    }),
+                )
+            },
+            || {
+                timed(&|| {
+                    mesh.intersections();
+                })
+            },
+        );
+        let start = Instant::now();
         let (lo, hi) = mesh.bounds_f64();
         let origin = (lo + hi) * 0.5;
         let extent = (hi - lo).max_element() * 0.5;
@@ -100,7 +132,11 @@ impl MeshData {
             })
             .collect();
         let bounds: Arc<[[f32; 8]]> = bounds.into();
+        let mut records = start.elapsed();
+        let start = Instant::now();
         let edges = EdgeData::new(mesh, edges, &order);
+        let edge_time = start.elapsed();
+        let start = Instant::now();
         let intersections = mesh
             .intersections()
             .iter()
@@ -110,7 +146,7 @@ impl MeshData {
                 ends: c.ends.map(|p| ((p - origin) / scale).as_vec3().to_array()),
             })
             .collect();
-        MeshData {
+        let data = MeshData {
             intersections,
             positions: mesh.positions().into(),
             vertices,
@@ -125,7 +161,18 @@ impl MeshData {
             scale,
             order,
             bounds: (lo, hi),
-        }
+        };
+        records += start.elapsed();
+        let report = UploadReport {
+            adjacency,
+            outline_hints,
+            clusters: cluster_time,
+            crossings,
+            edges: edge_time,
+            records,
+            ..UploadReport::default()
+        };
+        (data, report)
     }
 }
 

@@ -27,6 +27,8 @@ use crate::mesh::{EdgeSelection, Mesh};
 use glam::{DMat4, DVec3, Vec3};
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::sync::{Arc, Mutex};
+use std::time::Duration;
+use web_time::Instant;
 
 /// Bytes per stored vertex: position (3 × f32) and packed normal.
 pub(crate) const VERTEX_BYTES: u64 = 16;
@@ -40,6 +42,44 @@ pub(crate) const CHAIN_BYTES: u64 = 16;
 /// bindings need (`wgpu::Limits::default()` allows 8; without them, such a mesh is an error
 /// naming the binding limit).
 pub(crate) const SPLIT_STORAGE_BUFFERS: u32 = 11;
+
+/// What inserting a mesh into a [`MeshStore`] took, step by step
+/// ([`MeshStore::upload_report`]). A step the mesh had already done (its adjacency, say,
+/// asked for before) takes no time here. The crossings are found beside the adjacency,
+/// hints and clusters (on another core, with the `parallel` feature), so the steps' times
+/// may add up to more than the insert's.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct UploadReport {
+    /// Edge adjacency: the triangle across each edge, vertices welded by position.
+    pub adjacency: Duration,
+    /// The outline hints: how far each triangle's edges fold.
+    pub outline_hints: Duration,
+    /// The clusters of 64 triangles and their bounds.
+    pub clusters: Duration,
+    /// The triangles that cross others of the mesh, and their intersection lines.
+    pub crossings: Duration,
+    /// The edge selection's patches, chains and per-triangle edge data.
+    pub edges: Duration,
+    /// The store's records: packed vertices, triangles in cluster order, neighbour words.
+    pub records: Duration,
+    /// Writing the records into the store's buffers (queued, not yet on the GPU).
+    pub upload: Duration,
+    /// Bytes written to the GPU.
+    pub gpu_bytes: u64,
+}
+
+impl UploadReport {
+    /// The steps' times added up.
+    pub fn total(&self) -> Duration {
+        self.adjacency
+            + self.outline_hints
+            + self.clusters
+            + self.crossings
+            + self.edges
+            + self.records
+            + self.upload
+    }
+}
 
 /// A mesh in a [`MeshStore`]. Copy it into as many [`Instance`](crate::Instance)s as you
 /// like: instances of one mesh share its storage and are drawn instanced.
@@ -95,12 +135,14 @@ pub(crate) struct MeshRecord {
     /// (`instance_crossings.rs`).
     pub positions: Arc<[Vec3]>,
     pub indices: Arc<[[u32; 3]]>,
+    /// What inserting it took.
+    pub report: UploadReport,
 }
 
 impl MeshRecord {
     /// The record of `data` placed at `bases` (vertices, triangles, clusters, chain records),
     /// of `counts` each.
-    fn new(data: MeshData, bases: [u32; 4], counts: [u32; 4]) -> MeshRecord {
+    fn new(data: MeshData, bases: [u32; 4], counts: [u32; 4], report: UploadReport) -> MeshRecord {
         let [vertex_base, triangle_base, cluster_base, chain_base] = bases;
         let [vertices, triangles, clusters, chain_records] = counts;
         MeshRecord {
@@ -123,13 +165,14 @@ impl MeshRecord {
             intersections: data.intersections,
             positions: data.positions,
             indices: data.indices,
+            report,
         }
     }
 
     /// The record of `mesh` as the store would make it, at the start of empty buffers.
     #[cfg(test)]
     pub fn unstored(mesh: &Mesh) -> MeshRecord {
-        let data = MeshData::new(mesh, EdgeSelection::All);
+        let (data, report) = MeshData::new(mesh, EdgeSelection::All);
         let counts = [
             data.vertices.len(),
             data.indices.len(),
@@ -137,7 +180,7 @@ impl MeshRecord {
             data.chains.records.len(),
         ]
         .map(|n| n as u32);
-        MeshRecord::new(data, [0; 4], counts)
+        MeshRecord::new(data, [0; 4], counts, report)
     }
 
     /// Stored (rebased, scaled) coordinates → the mesh's own coordinates.
@@ -355,7 +398,8 @@ impl MeshStore {
             self.triangles.used() + u64::from(triangles),
             triangles,
         )?;
-        let data = MeshData::new(mesh, edges);
+        let (data, mut report) = MeshData::new(mesh, edges);
+        let start = Instant::now();
 
         let vertex_base = self.alloc(device, queue, Kind::Vertex, vertices)?;
         let triangle_base = self.alloc(device, queue, Kind::Triangle, triangles)?;
@@ -375,11 +419,22 @@ impl MeshStore {
         write(t, triangle_base, bytemuck::cast_slice(&data.info));
         write(c, cluster_base, bytemuck::cast_slice(&data.clusters));
         write(h, chain_base, bytemuck::cast_slice(&chains.records));
+        report.upload = start.elapsed();
+        let bytes: [&[u8]; 6] = [
+            bytemuck::cast_slice(&data.vertices),
+            bytemuck::cast_slice(&data.indices),
+            bytemuck::cast_slice(&data.neighbours),
+            bytemuck::cast_slice(&data.info),
+            bytemuck::cast_slice(&data.clusters),
+            bytemuck::cast_slice(&chains.records),
+        ];
+        report.gpu_bytes = bytes.iter().map(|b| b.len() as u64).sum();
 
         let record = MeshRecord::new(
             data,
             [vertex_base, triangle_base, cluster_base, chain_base],
             [vertices, triangles, clusters, chain_records],
+            report,
         );
         let slot = match self.free_slots.pop() {
             Some(s) => s,
@@ -471,6 +526,11 @@ impl MeshStore {
         }
         self.version += 1;
         Ok(())
+    }
+
+    /// What inserting `id` took, step by step.
+    pub fn upload_report(&self, id: MeshId) -> Result<UploadReport> {
+        Ok(self.record(id)?.report)
     }
 
     /// Number of triangles of `id`.

@@ -47,7 +47,7 @@ pub use composite::{Composite, RenderTarget};
 pub use context::GpuContext;
 #[cfg(feature = "diagnostics")]
 pub use deferred::EdgeWork;
-pub use deferred::{DeferredPass, PreparedFrame};
+pub use deferred::{DeferredPass, PreparedFrame, WarmUp};
 #[cfg(feature = "diagnostics")]
 pub use diagnostics::EncodeOptions;
 // For the ground truth, which shades and reads host depth as the pass does.
@@ -55,7 +55,7 @@ pub use diagnostics::EncodeOptions;
 pub(crate) use frame::light_world_dir;
 #[cfg(feature = "truth")]
 pub(crate) use host_depth::depth_quantum;
-pub use mesh_store::{MeshId, MeshStore};
+pub use mesh_store::{MeshId, MeshStore, UploadReport};
 // For the tools' OpenGL baseline, which draws the same store and records.
 pub use options::{OutputTarget, PassOptions, TriangleIds, Tuning};
 pub use pick::{

@@ -106,10 +106,16 @@ impl OutlinePass {
         Ok(p.intersections.get_or_init(|| c))
     }
 
-    /// How many pipeline sets the cache holds.
-    #[cfg(feature = "diagnostics")]
+    /// How many pipelines the pass holds.
     pub(crate) fn built(&self) -> usize {
-        self.cache.lock().map_or(0, |c| c.len())
+        self.cache.lock().map_or(0, |c| {
+            c.values()
+                .map(|p| {
+                    3 + usize::from(p.phases.is_some())
+                        + usize::from(p.intersections.get().is_some())
+                })
+                .sum()
+        })
     }
 
     /// The pass, drawing outline edges in pieces for a software rasterizer (`software`) or

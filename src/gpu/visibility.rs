@@ -150,6 +150,11 @@ impl Visibility {
         })
     }
 
+    /// How many pipelines it holds.
+    pub fn built(&self) -> usize {
+        self.pipelines.iter().flatten().count()
+    }
+
     /// Builds what a frame with a split store, or with section planes, needs, before it is
     /// encoded.
     pub fn prepare(&mut self, device: &wgpu::Device, split: bool, sections: bool) -> Result<()> {

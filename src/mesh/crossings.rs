@@ -132,7 +132,8 @@ fn find(
     const MOST_CELLS: u64 = 512;
     let cells = |(a, b): (U64Vec3, U64Vec3)| (b - a + 1).element_product();
     let span_in = |cell: f64, b: &[DVec3; 2]| {
-        let at = |p: DVec3| ((p - lo) / cell).floor().as_u64vec3();
+        // p - lo >= 0, so truncation is the floor (and no call to libm's floor).
+        let at = |p: DVec3| ((p - lo) / cell).as_u64vec3();
         (at(b[0]), at(b[1]))
     };
     let mut cell = median
@@ -148,7 +149,6 @@ fn find(
     {
         cell *= 2.0;
     }
-    let cell_of = |p: DVec3| ((p - lo) / cell).floor().as_u64vec3();
     let key = |c: U64Vec3| c.x | c.y << 21 | c.z << 42;
     let spans: Vec<(U64Vec3, U64Vec3)> = boxes.iter().map(|b| span_in(cell, b)).collect();
     let mut entries: Vec<(u64, u32)> = Vec::with_capacity(n);
@@ -171,12 +171,15 @@ fn find(
         let (a, b) = (boxes[t], boxes[u]);
         a[0].cmple(b[1] + tolerance).all() && b[0].cmple(a[1] + tolerance).all()
     };
+    // Unit normals, none for a degenerate triangle: computed once, not for every pair.
+    let normals: Vec<Option<DVec3>> = (0..n).into_par_iter().map(|t| plane(corners(t))).collect();
     let test = |t: usize, u: usize| -> Option<Crossing> {
         let (t, u) = (t.min(u), t.max(u));
         if !overlap(t, u) || !admits(t, u) {
             return None;
         }
-        let ends = crossing_segment(corners(t), corners(u), tolerance)?;
+        let (nt, nu) = (normals[t]?, normals[u]?);
+        let ends = crossing_on_planes((corners(t), nt), (corners(u), nu), tolerance)?;
         let (t, u) = (t as u32, u as u32);
         Some(Crossing { t, u, ends })
     };
@@ -199,8 +202,9 @@ fn find(
             for (i, &(_, t)) in run.iter().enumerate() {
                 for &(_, u) in &run[i + 1..] {
                     let (t, u) = (t as usize, u as usize);
-                    let low = boxes[t][0].max(boxes[u][0]);
-                    if key(cell_of(low).min(spans[t].1).min(spans[u].1)) == here {
+                    // The cell of the overlap's low corner: the larger of the low cells.
+                    let low = spans[t].0.max(spans[u].0);
+                    if key(low.min(spans[t].1).min(spans[u].1)) == here {
                         pairs.extend(test(t, u));
                     }
                 }
@@ -245,7 +249,15 @@ pub fn cross(t: [DVec3; 3], u: [DVec3; 3], tolerance: f64) -> bool {
 /// plane and they meet in more than a point (by more than `tolerance`); coplanar ones never. Its ends are where one triangle's edges
 /// pass through the other's plane, or the other's edges through the first's.
 pub fn crossing_segment(t: [DVec3; 3], u: [DVec3; 3], tolerance: f64) -> Option<[DVec3; 2]> {
-    let (nt, nu) = (plane(t)?, plane(u)?);
+    crossing_on_planes((t, plane(t)?), (u, plane(u)?), tolerance)
+}
+
+/// [`crossing_segment`] of triangles `t` and `u` with unit normals `nt` and `nu`.
+fn crossing_on_planes(
+    (t, nt): ([DVec3; 3], DVec3),
+    (u, nu): ([DVec3; 3], DVec3),
+    tolerance: f64,
+) -> Option<[DVec3; 2]> {
     let side = |n: DVec3, origin: DVec3, p: [DVec3; 3]| {
         p.map(|q| {
             let d = n.dot(q - origin);

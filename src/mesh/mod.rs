@@ -9,7 +9,7 @@ pub mod clusters;
 pub mod crossings;
 #[cfg(feature = "formats")]
 pub mod formats;
-mod par;
+pub(crate) mod par;
 pub mod patches;
 #[cfg(feature = "formats")]
 pub(crate) mod polygon;

@@ -3,13 +3,22 @@
 //! rayon and the code reads the same either way.
 
 #[cfg(feature = "parallel")]
-pub(crate) use rayon::prelude::*;
+pub(crate) use rayon::{join, prelude::*};
 
 #[cfg(not(feature = "parallel"))]
 pub(crate) use sequential::*;
 
 #[cfg(not(feature = "parallel"))]
 mod sequential {
+    /// `rayon::join`: `a`, then `b`.
+    pub(crate) fn join<A, B, RA, RB>(a: A, b: B) -> (RA, RB)
+    where
+        A: FnOnce() -> RA,
+        B: FnOnce() -> RB,
+    {
+        (a(), b())
+    }
+
     /// `into_par_iter` as a plain iterator.
     pub(crate) trait IntoParallelIterator: IntoIterator + Sized {
         fn into_par_iter(self) -> Self::IntoIter {

@@ -5,10 +5,12 @@ use crate::camera::View;
 use crate::error::{Error, Result};
 use crate::gpu::{
     texture_2d, Canvas, DeferredPass, EncodeOptions, ForwardPass, GpuContext, PassOptions, TwoPass,
+    UploadReport, WarmUp,
 };
 use crate::world::offscreen;
 use crate::world::{Rendering, Shot};
 use std::path::Path;
+use std::time::{Duration, Instant};
 
 pub use crate::world::offscreen::Uploaded;
 
@@ -82,6 +84,102 @@ pub fn draw_deferred(ctx: &GpuContext, shot: &Shot<'_>) -> Result<Rendering> {
     let up = Uploaded::new(&ctx.device, &ctx.queue, shot.world)?;
     let pass = DeferredPass::new(&ctx.device, PassOptions::default())?.with_diagnostics();
     draw_deferred_with(ctx, shot, &up, pass)
+}
+
+/// Where the time to a first deferred image goes ([`draw_deferred_timed`]; `wirepass
+/// render --timings`).
+#[derive(Clone, Debug)]
+pub struct FirstImage {
+    /// Each mesh's upload, step by step.
+    pub uploads: Vec<UploadReport>,
+    /// All uploads, as the wall clock saw them.
+    pub upload: Duration,
+    /// Making the pass.
+    pub pass: Duration,
+    /// Preparing the frame: its records, targets and the visibility pipelines.
+    pub prepare: Duration,
+    /// Building the frame's other pipelines.
+    pub warm_up: WarmUp,
+    /// Encoding the frame and waiting for the GPU: where a driver that compiles shaders on
+    /// first use (lavapipe) compiles them.
+    pub frame: Duration,
+    /// Reading the image and maps back.
+    pub readback: Duration,
+}
+
+/// [`draw_deferred`], timing each step ([`FirstImage`]).
+pub fn draw_deferred_timed(ctx: &GpuContext, shot: &Shot<'_>) -> Result<(Rendering, FirstImage)> {
+    let (drawn, timings) = first_image(ctx, shot, true)?;
+    match drawn {
+        Drawn::Rendering(r) => Ok((r, timings)),
+        Drawn::Image(_) => Err(Error::Device("the frame read back no maps".into())),
+    }
+}
+
+/// The deferred image of `shot` alone (8-bit sRGB RGBA), without the maps the tools read
+/// back, by a pass without diagnostics, timing each step: what `wirepass render` needs.
+pub fn draw_deferred_image(ctx: &GpuContext, shot: &Shot<'_>) -> Result<(Vec<u8>, FirstImage)> {
+    let (drawn, timings) = first_image(ctx, shot, false)?;
+    match drawn {
+        Drawn::Image(rgba) => Ok((rgba, timings)),
+        Drawn::Rendering(r) => Ok((r.rgba, timings)),
+    }
+}
+
+/// What [`first_image`] read back.
+enum Drawn {
+    Rendering(Rendering),
+    Image(Vec<u8>),
+}
+
+/// Uploads `shot`'s world, draws it with a new deferred pass and reads back the image, and
+/// with `maps` every map ([`Rendering`]), timing each step.
+fn first_image(ctx: &GpuContext, shot: &Shot<'_>, maps: bool) -> Result<(Drawn, FirstImage)> {
+    let (device, queue) = (&ctx.device, &ctx.queue);
+    let start = Instant::now();
+    let up = Uploaded::new(device, queue, shot.world)?;
+    let upload = start.elapsed();
+    let uploads = up
+        .ids
+        .iter()
+        .map(|&id| up.store.upload_report(id))
+        .collect::<Result<Vec<_>>>()?;
+    let start = Instant::now();
+    let mut pass = DeferredPass::new(device, PassOptions::default())?;
+    if maps {
+        pass = pass.with_diagnostics();
+    }
+    let pass_time = start.elapsed();
+    let start = Instant::now();
+    let canvas = Canvas::new(shot.size);
+    let (frame, output) = offscreen::prepare_shaded(device, shot, &up, &mut pass, canvas)?;
+    let prepare = start.elapsed();
+    let view = output.create_view(&Default::default());
+    let warm_up = pass.warm_up(device, &frame, &crate::gpu::OutputTarget::Shaded(&view))?;
+    let start = Instant::now();
+    offscreen::encode_prepared(device, queue, &up, &pass, &frame, &view)?;
+    ctx.finish()?;
+    let frame_time = start.elapsed();
+    let start = Instant::now();
+    let drawn = if maps {
+        let read = offscreen::read_deferred(device, queue, shot, &up, &mut pass, &frame, &output);
+        Drawn::Rendering(pollster::block_on(read)?)
+    } else {
+        let all = wgpu::TextureAspect::All;
+        let rgba = crate::gpu::read_texture_async(device, queue, &output, all);
+        Drawn::Image(pollster::block_on(rgba)?)
+    };
+    ctx.finish()?;
+    let timings = FirstImage {
+        uploads,
+        upload,
+        pass: pass_time,
+        prepare,
+        warm_up,
+        frame: frame_time,
+        readback: start.elapsed(),
+    };
+    Ok((drawn, timings))
 }
 
 /// [`draw_deferred`] with a pass and upload of the caller's (a pass with lowered limits,

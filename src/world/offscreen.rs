@@ -100,6 +100,21 @@ pub fn encode_shaded(
     pass: &mut DeferredPass,
     canvas: Canvas<'_>,
 ) -> Result<(PreparedFrame, wgpu::Texture)> {
+    let (frame, output) = prepare_shaded(device, shot, up, pass, canvas)?;
+    let view = output.create_view(&Default::default());
+    encode_prepared(device, queue, up, pass, &frame, &view)?;
+    Ok((frame, output))
+}
+
+/// The first half of [`encode_shaded`]: prepares `shot` on `canvas` and makes the storage
+/// texture it is drawn into.
+pub fn prepare_shaded(
+    device: &wgpu::Device,
+    shot: &Shot<'_>,
+    up: &Uploaded,
+    pass: &mut DeferredPass,
+    canvas: Canvas<'_>,
+) -> Result<(PreparedFrame, wgpu::Texture)> {
     let region = canvas.region;
     if region.image != shot.size {
         return Err(Error::Misuse(format!(
@@ -120,17 +135,28 @@ pub fn encode_shaded(
         pass.output_format(),
         usage,
     );
-    let view = output.create_view(&Default::default());
+    Ok((frame, output))
+}
+
+/// The second half of [`encode_shaded`]: encodes a prepared frame into `view` and submits.
+pub fn encode_prepared(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    up: &Uploaded,
+    pass: &DeferredPass,
+    frame: &PreparedFrame,
+    view: &wgpu::TextureView,
+) -> Result<()> {
     let mut encoder = device.create_command_encoder(&Default::default());
     pass.encode(
         device,
         &mut encoder,
         &up.store,
-        &frame,
-        OutputTarget::Shaded(&view),
+        frame,
+        OutputTarget::Shaded(view),
     )?;
     queue.submit([encoder.finish()]);
-    Ok((frame, output))
+    Ok(())
 }
 
 /// Reads back a deferred frame that `pass` has encoded and submitted, wherever its output
