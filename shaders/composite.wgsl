@@ -16,10 +16,15 @@
 
 @group(0) @binding(34) var result: texture_2d<f32>;
 
+// One 8×8 output tile an instance (two triangles), from the tiles the edge pass listed
+// (`composite_rw` in edge_pass.wgsl): the others' result is transparent, and drawing them
+// would cost a software rasterizer a fragment each.
 @vertex
-fn vs_main(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
-    let uv = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));
-    return vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
+fn vs_main(@builtin(vertex_index) i: u32, @location(0) tile: u32) -> @builtin(position) vec4<f32> {
+    let corner = vec2<u32>(select(0u, 1u, i == 1u || i == 4u || i == 5u), select(0u, 1u, i == 2u || i == 3u || i == 5u));
+    let size = vec2<f32>(textureDimensions(result));
+    let p = min(vec2<f32>((vec2<u32>(tile & 0xffffu, tile >> 16u) + corner) * 8u), size);
+    return vec4<f32>(p.x / size.x * 2.0 - 1.0, 1.0 - p.y / size.y * 2.0, 0.0, 1.0);
 }
 
 fn result_at(position: vec4<f32>) -> vec4<f32> {

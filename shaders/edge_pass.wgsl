@@ -78,6 +78,18 @@ struct ListRead {
 #if MODE_RESULT
 // Premultiplied linear RGBA, drawn into the host's render pass by composite.wgsl.
 @group(0) @binding(20) var out_color: texture_storage_2d<rgba16float, write>;
+
+// The output tiles composite.wgsl draws (every other tile's result is transparent): the
+// indirect draw's arguments (6 vertices a tile, a tile an instance), then the tiles, which
+// the draw reads as an instance-rate vertex buffer.
+struct CompositeTiles {
+    vertices: atomic<u32>,
+    tiles: atomic<u32>,
+    first_vertex: u32,
+    first_instance: u32,
+    items: array<atomic<u32>>,
+}
+@group(0) @binding(36) var<storage, read_write> composite_rw: CompositeTiles;
 #endif
 #if MODE_DIAGNOSTIC
 // Distance in pixels to the line (r) and reverse depth (g); the resolved (instance, triangle).
@@ -541,16 +553,16 @@ fn store_pixel(xy: vec2<u32>, p: Pixel) {
 #if HIDDEN
         surface = mix(surface, hidden, h);
 #endif
-        color = vec4<f32>(mix(surface, p.wire.rgb, i), 1.0);
-        if frame.fill_opacity < 1.0 {
-            // Premultiplied: the surface at its opacity, the hidden line over it, the line
-            // over both; the host's image shows through what is left.
-            var under = see_through(p.surface, vec4<f32>(0.0), frame.fill_opacity);
+        // Premultiplied where the surface is see-through: the surface at its opacity, the
+        // hidden line over it, the line over both; the host's image shows through what is
+        // left. (A select, not an if on the uniform: lavapipe specialises a pipeline again
+        // at every dispatch for a branch on uniform values alone.)
+        var under = see_through(p.surface, vec4<f32>(0.0), frame.fill_opacity);
 #if HIDDEN
-            under = under * (1.0 - h) + vec4<f32>(hidden * h, h);
+        under = under * (1.0 - h) + vec4<f32>(hidden * h, h);
 #endif
-            color = under * (1.0 - i) + vec4<f32>(p.wire.rgb * i, i);
-        }
+        let opaque = vec4<f32>(mix(surface, p.wire.rgb, i), 1.0);
+        color = select(under * (1.0 - i) + vec4<f32>(p.wire.rgb * i, i), opaque, frame.fill_opacity >= 1.0);
     }
 #endif
     textureStore(out_color, out, color);
@@ -654,6 +666,22 @@ fn classify_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let from_above = vec2<u32>((fg.x << 8u) | (top & 0xffu), (fg.y << 8u) | (fg.x >> 24u));
     let from_below = vec2<u32>((fg.x >> 8u) | (fg.y << 24u), (fg.y >> 8u) | (bottom << 24u));
     var listed = (from_left | from_right | from_above | from_below) & inside & ~fg;
+#if MODE_RESULT
+    // The tiles whose result may be other than transparent: foreground, background the
+    // refine dispatch decides, the outline pass's lines.
+    var drawn = any((fg | listed) != vec2<u32>(0u));
+#if OUTLINES
+    let columns_out = (u32(frame.output_size.x) + 7u) / 8u;
+    drawn = drawn || acc[outline_tile_marks() + gid.y * columns_out + gid.x] != 0u;
+#endif
+    if all(gid.xy == vec2<u32>(0u)) {
+        atomicStore(&composite_rw.vertices, 6u);
+    }
+    if drawn {
+        let k = atomicAdd(&composite_rw.tiles, 1u);
+        atomicStore(&composite_rw.items[k], gid.x | (gid.y << 16u));
+    }
+#endif
     if any(fg != vec2<u32>(0u)) {
         let k = atomicAdd(&tiles_rw.count, 1u);
         atomicStore(&tiles_rw.items[k], gid.x | (gid.y << 16u));

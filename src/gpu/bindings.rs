@@ -66,6 +66,8 @@ pub(crate) enum Res {
     /// The visibility pass's depth target (reverse depth), which the composite tests the
     /// host's depth samples against.
     Depth = 35,
+    /// The output tiles the composite draws, which the edge pass lists in its result mode.
+    CompositeRw = 36,
 }
 
 impl Res {
@@ -96,7 +98,7 @@ impl Res {
         use Res::*;
         let ty = match self {
             Frame | UniformInstances | HostParams => buffer(wgpu::BufferBindingType::Uniform),
-            AccRw | CullRw | WorkRw | TilesRw => write,
+            AccRw | CullRw | WorkRw | TilesRw | CompositeRw => write,
             Ids | HostDepth => texture(wgpu::TextureSampleType::Uint),
             // Unfilterable float: what every backend can load a depth texture as.
             HostColor | HostSource | Result | Depth => {
@@ -263,6 +265,7 @@ pub(crate) struct Sources<'a> {
     pub cull: Option<&'a wgpu::Buffer>,
     pub work: Option<&'a wgpu::Buffer>,
     pub tiles: Option<&'a wgpu::Buffer>,
+    pub composite: Option<&'a wgpu::Buffer>,
     pub out_color: Option<&'a wgpu::TextureView>,
     pub host_color: Option<&'a wgpu::TextureView>,
     pub out_diagnostic: Option<&'a wgpu::TextureView>,
@@ -283,6 +286,7 @@ impl<'a> Sources<'a> {
             cull: None,
             work: None,
             tiles: None,
+            composite: None,
             out_color: None,
             host_color: None,
             out_diagnostic: None,
@@ -361,6 +365,10 @@ pub(crate) fn bind_group(
             CullRw | Cull => sources.cull.ok_or_else(|| missing(r))?.as_entire_binding(),
             WorkRw | Work => sources.work.ok_or_else(|| missing(r))?.as_entire_binding(),
             TilesRw | Tiles => sources.tiles.ok_or_else(|| missing(r))?.as_entire_binding(),
+            CompositeRw => sources
+                .composite
+                .ok_or_else(|| missing(r))?
+                .as_entire_binding(),
             OutColor => {
                 wgpu::BindingResource::TextureView(sources.out_color.ok_or_else(|| missing(r))?)
             }
@@ -486,6 +494,7 @@ mod tests {
             "seed_out" => HostSeedOut,
             "result" => Result,
             "depth" => Depth,
+            "composite_rw" => CompositeRw,
             _ => return None,
         })
     }

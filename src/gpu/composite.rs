@@ -5,7 +5,7 @@
 use super::bindings::Res;
 use super::host_depth::HostFrame;
 use super::shaders;
-use super::targets::RESULT_FORMAT;
+use super::targets::{LIST_HEADER, RESULT_FORMAT};
 use crate::error::{Error, Result};
 
 /// What [`DeferredPass::render`](super::DeferredPass::render) draws over the host's image.
@@ -225,8 +225,15 @@ impl CompositePipeline {
         FrameComposite { group, tested }
     }
 
-    /// Records a frame's draw into the host's render pass.
-    pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>, frame: &FrameComposite) -> Result<()> {
+    /// Records a frame's draw into the host's render pass: a quad for each output tile the
+    /// edge pass listed in `tiles` (`composite_rw` in edge_pass.wgsl, its own indirect
+    /// arguments).
+    pub fn draw(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        frame: &FrameComposite,
+        tiles: &wgpu::Buffer,
+    ) -> Result<()> {
         let draw = match (&self.tested, frame.tested) {
             (_, None) => &self.plain,
             (Some(tested), Some(reversed)) => &tested[usize::from(reversed)],
@@ -238,7 +245,8 @@ impl CompositePipeline {
         };
         pass.set_pipeline(&draw.pipeline);
         pass.set_bind_group(0, &frame.group, &[]);
-        pass.draw(0..3, 0..1);
+        pass.set_vertex_buffer(0, tiles.slice(LIST_HEADER..));
+        pass.draw_indirect(tiles, 0);
         Ok(())
     }
 }
@@ -252,7 +260,9 @@ impl Draw {
         compare: Option<wgpu::CompareFunction>,
     ) -> Draw {
         let stage = wgpu::ShaderStages::FRAGMENT;
-        let mut entries = vec![Res::Result.layout_entry(stage, RESULT_FORMAT)];
+        // The vertex stage reads the result's size.
+        let both = wgpu::ShaderStages::VERTEX_FRAGMENT;
+        let mut entries = vec![Res::Result.layout_entry(both, RESULT_FORMAT)];
         if compare.is_some() {
             entries.extend(
                 [Res::Frame, Res::HostParams, Res::Ids, Res::Depth]
@@ -284,7 +294,12 @@ impl Draw {
                 module: &module,
                 entry_point: Some("vs_main"),
                 compilation_options: Default::default(),
-                buffers: &[],
+                // The tile of each instance.
+                buffers: &[Some(wgpu::VertexBufferLayout {
+                    array_stride: 4,
+                    step_mode: wgpu::VertexStepMode::Instance,
+                    attributes: &wgpu::vertex_attr_array![0 => Uint32],
+                })],
             },
             primitive: wgpu::PrimitiveState::default(),
             // Neither draw writes the host's depth or stencil.

@@ -706,6 +706,7 @@ impl DeferredPass {
             cull: Some(&frame.cull),
             work: Some(&t.work),
             tiles: Some(&t.tiles),
+            composite: t.composite.as_ref(),
             out_color,
             host_color,
             out_diagnostic: diag.as_ref(),
@@ -787,6 +788,11 @@ impl DeferredPass {
                     .into(),
             ));
         }
-        pipeline.draw(pass, group)
+        let tiles = frame
+            .targets
+            .composite
+            .as_ref()
+            .ok_or_else(|| Error::Device("the frame has no composite tiles".into()))?;
+        pipeline.draw(pass, group, tiles)
     }
 }

@@ -139,13 +139,15 @@ impl EdgePass {
             r
         };
         let background = Compute::new(device, &module, "background_main", with(&[]), color)?;
-        let classify = Compute::new(
-            device,
-            &module,
-            "classify_main",
-            vec![Res::Frame, Res::Ids, Res::TilesRw, Res::WorkRw],
-            color,
-        )?;
+        let mut classify_res = vec![Res::Frame, Res::Ids, Res::TilesRw, Res::WorkRw];
+        if let Mode::Result { .. } = mode {
+            // It lists the tiles the composite draws, the outline pass's among them.
+            classify_res.push(Res::CompositeRw);
+            if v.outlines {
+                classify_res.push(Res::Acc);
+            }
+        }
+        let classify = Compute::new(device, &module, "classify_main", classify_res, color)?;
         let outlined = if v.outlines {
             Some(Compute::new(
                 device,
@@ -256,6 +258,10 @@ impl EdgePass {
             .collect::<Result<Vec<_>>>()?;
         encoder.copy_buffer_to_buffer(reset, 0, &t.tiles, 0, LIST_HEADER);
         encoder.copy_buffer_to_buffer(reset, 0, &t.work, 0, LIST_HEADER);
+        if let (Mode::Result { .. }, Some(composite)) = (mode, &t.composite) {
+            // The draw's arguments: classify_main sets the vertex count and counts the tiles.
+            encoder.clear_buffer(composite, 0, Some(LIST_HEADER));
+        }
         // Each dispatch is a pass of its own, timed on its own (the benchmark sums the
         // `edge.*` spans into the edge pass).
         for (k, ((label, span, pipeline, size), group)) in

@@ -116,6 +116,9 @@ pub(crate) struct Targets {
     pub work: wgpu::Buffer,
     /// The edge pass's list of 8×8 output tiles with work for its tile dispatch.
     pub tiles: wgpu::Buffer,
+    /// With a result: the tiles the composite draws, after its indirect draw's arguments
+    /// (`composite_rw` in edge_pass.wgsl).
+    pub composite: Option<wgpu::Buffer>,
     pub result: Option<wgpu::Texture>,
     pub diagnostic: Option<(wgpu::Texture, wgpu::Texture)>,
     /// The host's depth, where the frame has one.
@@ -241,6 +244,13 @@ impl Targets {
                 tiles_bytes,
                 wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_SRC,
             ),
+            composite: spec.result.then(|| {
+                buffer(
+                    "wirepass composite tiles",
+                    tiles_bytes,
+                    wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::VERTEX,
+                )
+            }),
             result: spec.result.then(|| {
                 texture(
                     "wirepass result",

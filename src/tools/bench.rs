@@ -5,8 +5,9 @@
 use crate::camera::Camera;
 use crate::error::{Error, Result};
 use crate::gpu::{
-    texture_2d, DeferredPass, EdgeLines, EncodeOptions, ForwardPass, GpuContext, GpuTimer,
-    MeshStore, OutputTarget, PassOptions, PreparedFrame, RasterFrame, TwoPass,
+    texture_2d, Composite, DeferredPass, EdgeLines, EncodeOptions, ForwardPass, GpuContext,
+    GpuTimer, MeshStore, OutputTarget, PassOptions, PreparedFrame, RasterFrame, RenderTarget,
+    TwoPass,
 };
 use crate::mesh::EdgeSelection;
 use crate::style::Style;
@@ -99,6 +100,9 @@ pub struct EdgeShares {
 enum Subject {
     Floor(DeferredPass, PreparedFrame, wgpu::Texture),
     Deferred(DeferredPass, PreparedFrame, wgpu::Texture),
+    /// The deferred method as a host draws it into its own render pass
+    /// ([`OutputTarget::RenderPass`], then `DeferredPass::render` with `Composite::Shaded`).
+    RenderPass(DeferredPass, PreparedFrame, wgpu::Texture),
     /// The deferred method drawing another edge selection, on its own upload of the scene.
     Edges(
         EdgeSelection,
@@ -118,6 +122,7 @@ impl Subject {
         match self {
             Subject::Floor(..) => "floor".into(),
             Subject::Deferred(..) => "deferred".into(),
+            Subject::RenderPass(..) => "render-pass".into(),
             Subject::Edges(edges, ..) => format!("deferred {}", edges_name(*edges)),
             Subject::Forward(..) => "forward".into(),
             Subject::TwoPass(..) => "two-pass".into(),
@@ -184,6 +189,39 @@ impl Subject {
                     },
                 )
             }
+            Subject::RenderPass(pass, frame, out) => {
+                pass.encode_with(
+                    device,
+                    encoder,
+                    store,
+                    frame,
+                    OutputTarget::RenderPass,
+                    EncodeOptions {
+                        timer: Some(&mut *timer),
+                        ..Default::default()
+                    },
+                )?;
+                // The host's render pass, over what the host drew (its own draws and clear
+                // are the host's cost, not the method's): the frame composited.
+                let view = out.create_view(&Default::default());
+                let mut rpass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("wirepass bench host pass"),
+                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                        view: &view,
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Load,
+                            store: wgpu::StoreOp::Store,
+                        },
+                    })],
+                    depth_stencil_attachment: None,
+                    timestamp_writes: timer.render_span("composite"),
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                pass.render(&mut rpass, frame)
+            }
             Subject::Edges(_, up, pass, frame, out) => {
                 let view = out.create_view(&Default::default());
                 let target = OutputTarget::Shaded(&view);
@@ -240,7 +278,9 @@ impl Subject {
         // Colour, id (8 bytes), depth and diagnostic targets of the forward methods.
         let forward = |t: &wgpu::Texture| 4 * texture(t);
         match self {
-            Subject::Floor(p, _, t) | Subject::Deferred(p, _, t) => p.target_bytes() + texture(t),
+            Subject::Floor(p, _, t) | Subject::Deferred(p, _, t) | Subject::RenderPass(p, _, t) => {
+                p.target_bytes() + texture(t)
+            }
             Subject::Edges(_, up, p, _, t) => up.store.gpu_bytes() + p.target_bytes() + texture(t),
             Subject::Forward(_, _, t) => forward(t),
             Subject::TwoPass(_, _, t) => forward(t) + lines.gpu_bytes(),
@@ -255,8 +295,12 @@ pub enum Timed {
     /// The floor: the visibility pass and a compute pass that reads the id and writes a
     /// flat colour.
     Floor,
-    /// The deferred method (visibility, outline and edge passes).
+    /// The deferred method (visibility, outline and edge passes) into a storage texture.
     Deferred,
+    /// The deferred method as a host draws it into its own render pass: the passes write
+    /// the frame's result, which a draw composites (`Composite::Shaded`) into the host's
+    /// colour attachment (`Rgba8UnormSrgb`).
+    RenderPass,
     /// The forward single-pass method.
     Forward,
     /// The two-pass method (biased fill, then lines).
@@ -267,9 +311,10 @@ pub enum Timed {
 
 impl Timed {
     /// Every method, in the order they are timed within a frame.
-    pub const ALL: [Timed; 5] = [
+    pub const ALL: [Timed; 6] = [
         Timed::Floor,
         Timed::Deferred,
+        Timed::RenderPass,
         Timed::Forward,
         Timed::TwoPass,
         Timed::Gs,
@@ -277,7 +322,7 @@ impl Timed {
 
     /// Whether the method draws outlines, and so is timed with them on and off.
     pub fn draws_outlines(self) -> bool {
-        matches!(self, Timed::Floor | Timed::Deferred)
+        matches!(self, Timed::Floor | Timed::Deferred | Timed::RenderPass)
     }
 
     /// The method's name in tables and `bench.json`.
@@ -285,6 +330,7 @@ impl Timed {
         match self {
             Timed::Floor => "floor",
             Timed::Deferred => "deferred",
+            Timed::RenderPass => "render-pass",
             Timed::Forward => "forward",
             Timed::TwoPass => "two-pass",
             Timed::Gs => "gs",
@@ -301,7 +347,7 @@ impl std::str::FromStr for Timed {
             .find(|m| m.name() == s.trim())
             .ok_or_else(|| {
                 Error::InvalidSetting(format!(
-                    "unknown method {s:?}: floor, deferred, forward, two-pass or gs"
+                    "unknown method {s:?}: floor, deferred, render-pass, forward, two-pass or gs"
                 ))
             })
     }
@@ -409,6 +455,21 @@ pub fn bench_scene(
         let frame = pass.prepare(device, &up.store, &scene, shot.style, size)?;
         subjects.push(Subject::Edges(selection, up, pass, frame, storage()));
     }
+    if timed(Timed::RenderPass) {
+        let target = RenderTarget {
+            format: forward_format,
+            sample_count: 1,
+            depth_stencil: None,
+            content: Composite::Shaded,
+        };
+        let options = PassOptions {
+            render_target: Some(target),
+            ..PassOptions::default()
+        };
+        let mut pass = DeferredPass::new(device, options)?;
+        let frame = pass.prepare(device, &up.store, &scene, shot.style, size)?;
+        subjects.push(Subject::RenderPass(pass, frame, attachment()));
+    }
     if timed(Timed::Forward) {
         let mut forward = ForwardPass::new(device, forward_format)?;
         let frame = forward.prepare(device, &up.store, &scene, shot.style, size)?;
@@ -465,7 +526,9 @@ pub fn bench_scene(
     let mut shares = Vec::new();
     for subject in &subjects {
         shares.push(match subject {
-            Subject::Deferred(_, frame, _) | Subject::Edges(_, _, _, frame, _) => {
+            Subject::Deferred(_, frame, _)
+            | Subject::RenderPass(_, frame, _)
+            | Subject::Edges(_, _, _, frame, _) => {
                 let w = frame.edge_work(device, queue)?;
                 Some(EdgeShares {
                     tiles: f64::from(w.tiles) / f64::from(w.all_tiles.max(1)),
