@@ -76,8 +76,8 @@ struct OutlineListRead {
 // outline edges while the other lanes of its cluster, most of them without any, wait for it.
 //
 // Where the piece list has no room for all of a cluster's pieces (or all of a group of 64
-// intersection segments'), its entry goes to the overflow list (a header, then up to
-// `frame.overflow_room` entries), and the piece dispatch grows by 64 lanes for it, each
+// intersection segments'), its entry goes to the overflow list (a header, whose first word
+// counts the lines listed and last the entries, then up to `frame.overflow_room` entries), and the piece dispatch grows by 64 lanes for it, each
 // drawing every piece of one of its triangles (`lane_work`): the listing dispatch itself
 // holds no drawing code, which a software rasterizer would run for every lane.
 fn overflow_list() -> u32 {
@@ -336,6 +336,9 @@ fn list_pieces(item: Listed, range: vec2<u32>) -> u32 {
     if range.x >= range.y {
         return 0u;
     }
+    // Counted for the work counters (PreparedFrame::edge_work): the overflow list's
+    // header keeps the lines listed in its first word.
+    atomicAdd(&acc_rw[overflow_list()], 1u);
     let n = range.y - range.x;
     let list = piece_list();
     let room = piece_room(list);

@@ -60,12 +60,17 @@ pub struct EdgeWork {
     /// Clusters of 64 triangles the outline pass's cull listed (those that may hold an
     /// outline edge from the eye, or a drawn edge of a large patch), 0 where it did not run.
     pub outline_clusters: u32,
-    /// Pieces (up to 2 px, or 1 px for [`Tuning::Gpu`](super::Tuning::Gpu)) of outline
-    /// edges the outline pass listed or found beyond its list's room, 0 where it did not run.
+    /// Lines the outline pass listed pieces of (outline and drawn edges, cut and
+    /// intersection lines with a piece within reach of the targets), 0 where it did not run.
+    pub outline_lines: u32,
+    /// Pieces (up to 2 px, or 1 px for [`Tuning::Gpu`](super::Tuning::Gpu)) of those lines
+    /// the outline pass listed or found beyond its list's room, 0 where it did not run.
     pub outline_pieces: u32,
-    /// How many of them its piece list has room for; it draws the others where it finds
-    /// them.
+    /// How many of them its piece list has room for.
     pub piece_room: u32,
+    /// Clusters (and groups of 64 intersection segments) whose pieces the list had no room
+    /// for, which the piece dispatch drew 64 lanes each.
+    pub overflowed: u32,
 }
 
 #[cfg(feature = "diagnostics")]
@@ -76,10 +81,10 @@ impl PreparedFrame {
     /// reads it without blocking.
     #[cfg(not(target_arch = "wasm32"))]
     pub fn edge_work(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<EdgeWork> {
-        let mut counts = [0u32; 5];
+        let mut counts = [0u32; 7];
         for (count, (buffer, at)) in counts.iter_mut().zip(self.counters()) {
             if let Some(buffer) = buffer {
-                let bytes = super::readback::read_buffer(device, queue, buffer, at + 12, 4)?;
+                let bytes = super::readback::read_buffer(device, queue, buffer, at, 4)?;
                 *count = u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]);
             }
         }
@@ -92,10 +97,10 @@ impl PreparedFrame {
         device: &wgpu::Device,
         queue: &wgpu::Queue,
     ) -> Result<EdgeWork> {
-        let mut counts = [0u32; 5];
+        let mut counts = [0u32; 7];
         for (count, (buffer, at)) in counts.iter_mut().zip(self.counters()) {
             if let Some(buffer) = buffer {
-                let read = super::readback::read_buffer_async(device, queue, buffer, at + 12, 4);
+                let read = super::readback::read_buffer_async(device, queue, buffer, at, 4);
                 let bytes = read.await?;
                 *count = u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]);
             }
@@ -103,24 +108,28 @@ impl PreparedFrame {
         Ok(self.edge_work_of(counts))
     }
 
-    /// Where the lists' counts lie: the tile list, the outlined tiles, the refine list, the
-    /// cluster list and the pieces (the last three's only where the outline pass ran).
-    fn counters(&self) -> [(Option<&wgpu::Buffer>, u64); 5] {
+    /// Where the counts lie (a list's is the last word of its header): the tile list, the
+    /// outlined tiles, the refine list, the cluster list, the lines and the pieces listed,
+    /// and the overflow list (the last five only where the outline pass ran).
+    fn counters(&self) -> [(Option<&wgpu::Buffer>, u64); 7] {
         let t = &self.targets;
         let outlines = |b| self.data.outlines.then_some(b);
+        let count = LIST_HEADER - 4;
         [
-            (Some(&t.tiles), 0),
-            (outlines(&t.acc), t.acc_tiles),
-            (Some(&t.work), 0),
-            (outlines(&self.cull), 0),
-            (outlines(&t.acc), t.acc_pieces),
+            (Some(&t.tiles), count),
+            (outlines(&t.acc), t.acc_tiles + count),
+            (Some(&t.work), count),
+            (outlines(&self.cull), count),
+            (outlines(&t.acc), t.acc_overflow),
+            (outlines(&t.acc), t.acc_pieces + count),
+            (outlines(&t.acc), t.acc_overflow + count),
         ]
     }
 
     /// The work from the counts at [`counters`](Self::counters).
     fn edge_work_of(
         &self,
-        [tiles, outlined_tiles, refined, clusters, pieces]: [u32; 5],
+        [tiles, outlined_tiles, refined, clusters, lines, pieces, overflowed]: [u32; 7],
     ) -> EdgeWork {
         let (w, h) = self.targets.output;
         let tile = super::edge_pass::TILE;
@@ -131,8 +140,10 @@ impl PreparedFrame {
             refined,
             pixels: w * h,
             outline_clusters: clusters,
+            outline_lines: lines,
             outline_pieces: pieces,
             piece_room: self.targets.piece_room(),
+            overflowed,
         }
     }
 }
