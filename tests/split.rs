@@ -187,10 +187,10 @@ fn an_image_past_the_outline_buffer_limit_is_a_clear_error() {
 }
 
 /// The outline pass lists the pieces of outline edges after the lines (and their tiles) in its
-/// buffer; where the buffer has no room left for them, it draws them where it finds them, to
-/// the same image.
+/// buffer; where the buffer has no room left for them, the piece dispatch draws the
+/// clusters it could not list in lanes of their own, to the same image.
 #[test]
-fn outline_pieces_past_the_list_s_room_are_drawn_where_they_are_found() {
+fn outline_pieces_past_the_list_s_room_are_drawn_all_the_same() {
     let (small, _turn) = small_device();
     let mesh = Arc::new(Procedural::Sphere(2000).build().unwrap());
     // Two spheres with lines of different colours keep two words a target pixel: at 82 × 81
@@ -256,7 +256,7 @@ fn outline_pieces_past_the_list_s_room_are_drawn_where_they_are_found() {
     small.queue.submit([encoder.finish()]);
     let work = frame.edge_work(&small.device, &small.queue).unwrap();
     assert!(
-        work.piece_room < 64 && work.outline_pieces > 2 * work.piece_room,
+        work.piece_room < 64 && work.outline_pieces > 2 * work.piece_room && work.overflowed > 0,
         "{work:?}"
     );
 
