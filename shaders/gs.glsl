@@ -1,8 +1,8 @@
 // The single-pass wireframe as published (Bærentzen et al. 2006, "Single-pass wireframe
 // rendering"; NVIDIA's "Solid Wireframe" white paper, 2007): an indexed draw whose geometry
 // shader gives each corner its screen-space altitude, interpolated without perspective.
-// OpenGL 3.3 core; src/tools/gs/mod.rs prepends the version and one of VERTEX, GEOMETRY,
-// FRAGMENT (and MAPS for the id and distance maps).
+// OpenGL 3.3 core (4.3 with STORAGE_INFO); src/tools/gs/mod.rs prepends the version and one
+// of VERTEX, GEOMETRY, FRAGMENT (and MAPS for the id and distance maps).
 //
 // It draws what forward.wgsl draws (the same frame and instance records, drawn-edge masks,
 // line profile, shading and reverse depth), so that the two compare pixel for pixel:
@@ -72,7 +72,11 @@ layout(std140) uniform Instances {
 // What the geometry stage hands the fragment stage: `dist` component j is the distance in
 // pixels to the edge opposite corner j, interpolated without perspective; the local point and
 // normal; the face normal; the instance (within the draw) and the triangle (of its mesh).
+#ifdef MAPS
 #define VARYINGS Fragment { noperspective vec3 dist; vec3 local; vec3 normal; flat vec3 face_normal; flat uint instance; flat uint tri; }
+#else
+#define VARYINGS Fragment { noperspective vec3 dist; vec3 local; vec3 normal; flat vec3 face_normal; flat uint instance; }
+#endif
 
 const uint INSTANCE_EDGES = 1u;
 // The distance a masked edge's component carries (forward.wgsl's MASKED).
@@ -123,8 +127,17 @@ in Corner {
 
 out VARYINGS fragment;
 
-// Per stored triangle: bits 0-2 the drawn edges (src/gpu/mesh_store.rs, triangle_info).
+// Per stored triangle: bits 0-2 the drawn edges (src/gpu/mesh_store.rs, triangle_info): a
+// storage buffer where OpenGL 4.3 has them (STORAGE_INFO: a plain load, where llvmpipe's
+// buffer texture fetch in the geometry stage cost a fifth of the frame), else a buffer
+// texture.
+#ifdef STORAGE_INFO
+layout(std430, binding = 0) readonly buffer Info {
+    uint info[];
+};
+#else
 uniform usamplerBuffer info;
+#endif
 // The published WIN_SCALE, corrected to half the image size.
 uniform vec2 WIN_SCALE;
 
@@ -145,7 +158,11 @@ void main() {
     // Component j belongs to edge (j + 1) % 3, as in forward.wgsl.
     uint mask = 0u;
     if ((inst.flags & INSTANCE_EDGES) != 0u) {
+#ifdef STORAGE_INFO
+        mask = info[inst.triangle_base + uint(gl_PrimitiveIDIn)] & 7u;
+#else
         mask = texelFetch(info, int(inst.triangle_base) + gl_PrimitiveIDIn).x & 7u;
+#endif
     }
     bvec3 drawn = bvec3((mask & 2u) != 0u, (mask & 4u) != 0u, (mask & 1u) != 0u);
     vec3 base = mix(vec3(MASKED), vec3(0.0), drawn);
@@ -161,7 +178,9 @@ void main() {
         fragment.normal = unpack_normal(corners[k].packed_normal);
         fragment.face_normal = face_normal;
         fragment.instance = i;
+#ifdef MAPS
         fragment.tri = uint(gl_PrimitiveIDIn);
+#endif
         gl_Position = gl_in[k].gl_Position;
         EmitVertex();
     }

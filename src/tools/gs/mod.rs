@@ -4,7 +4,8 @@
 //! pulling; this is the method itself, for the benchmark and `compare` to measure the
 //! deferred pass against.
 //!
-//! It runs in an OpenGL 3.3+ core context of its own, made headless through EGL (`egl.rs`),
+//! It runs in an OpenGL 3.3+ core context of its own (the per-triangle data in a storage
+//! buffer where the context is 4.3 or newer, else a buffer texture), made headless through EGL (`egl.rs`),
 //! rather than in wgpu's GL device: the comparison then runs beside whichever backend wgpu
 //! uses (lavapipe's Vulkan by default), the context's state is this module's alone, and
 //! desktop GL is what the method was written for. It draws the bytes the wgpu passes draw:
@@ -53,7 +54,9 @@ struct Store {
     bytes: u64,
     vertex_array: glow::VertexArray,
     buffers: [glow::Buffer; 3],
-    info: glow::Texture,
+    /// The per-triangle buffer as a buffer texture, where it is not read as a storage
+    /// buffer.
+    info: Option<glow::Texture>,
 }
 
 /// The published geometry-shader method on OpenGL: see the [module](self) documentation.
@@ -66,6 +69,9 @@ pub struct GsPass {
     queries: [glow::Query; 2],
     /// A software renderer, timed by the wall clock (`draw_timed`).
     software: bool,
+    /// OpenGL 4.3's storage buffers hold the per-triangle data, where the context has them
+    /// (gs.glsl's STORAGE_INFO), else a buffer texture.
+    storage_info: bool,
     capacity: u32,
     alignment: u32,
     description: String,
@@ -118,14 +124,16 @@ impl GsPass {
         GsPass::build(true)
     }
 
-    /// [`new`](Self::new) drawing as on a driver without `glClipControl` (OpenGL 4.5 or
-    /// ARB_clip_control), whose depth range and first row the vertex stage turns instead:
-    /// the same image, for tests of that path on drivers that have it.
-    pub fn without_clip_control() -> Result<GsPass> {
+    /// [`new`](Self::new) drawing as on an OpenGL 3.3 driver: without `glClipControl`
+    /// (OpenGL 4.5 or ARB_clip_control), whose depth range and first row the vertex stage
+    /// turns instead, and without storage buffers (OpenGL 4.3), the per-triangle data read
+    /// from a buffer texture: the same image, for tests of those paths on drivers that have
+    /// more.
+    pub fn as_on_opengl_3_3() -> Result<GsPass> {
         GsPass::build(false)
     }
 
-    fn build(clip_control_if_any: bool) -> Result<GsPass> {
+    fn build(newer_if_any: bool) -> Result<GsPass> {
         let context = egl::Context::new()?;
         let gl = context.load();
         // SAFETY: `gl` belongs to the context current on this thread; every call below
@@ -153,12 +161,13 @@ impl GsPass {
             let alignment = gl
                 .get_parameter_i32(glow::UNIFORM_BUFFER_OFFSET_ALIGNMENT)
                 .max(1) as u32;
-            let clip_control = clip_control_if_any
+            let clip_control = newer_if_any
                 && ((version.major, version.minor) >= (4, 5)
                     || gl.supported_extensions().contains("GL_ARB_clip_control"));
+            let storage_info = newer_if_any && (version.major, version.minor) >= (4, 3);
             let programs = [
-                program(&gl, capacity, clip_control, false)?,
-                program(&gl, capacity, clip_control, true)?,
+                program(&gl, capacity, (clip_control, storage_info), false)?,
+                program(&gl, capacity, (clip_control, storage_info), true)?,
             ];
             if clip_control {
                 type ClipControl = extern "system" fn(u32, u32);
@@ -186,6 +195,7 @@ impl GsPass {
                 programs,
                 queries,
                 software,
+                storage_info,
                 capacity,
                 alignment,
                 description,
@@ -299,13 +309,23 @@ impl GsPass {
         let source = store.buffers();
         // SAFETY: as in `new`.
         unsafe {
-            let limit = gl.get_parameter_i32(glow::MAX_TEXTURE_BUFFER_SIZE).max(0) as u64;
-            let texels = source.info.size() / 4;
-            if texels > limit {
+            let (limit, limit_name, value) = if self.storage_info {
+                let bytes = gl.get_parameter_i32(glow::MAX_SHADER_STORAGE_BLOCK_SIZE);
+                let bytes = bytes.max(0) as u64;
+                (
+                    bytes,
+                    "GL_MAX_SHADER_STORAGE_BLOCK_SIZE",
+                    source.info.size(),
+                )
+            } else {
+                let texels = gl.get_parameter_i32(glow::MAX_TEXTURE_BUFFER_SIZE).max(0) as u64;
+                (texels, "GL_MAX_TEXTURE_BUFFER_SIZE", source.info.size() / 4)
+            };
+            if value > limit {
                 return Err(Error::OverLimit {
-                    what: "triangles in the store (OpenGL's per-triangle texture buffer)".into(),
-                    value: texels,
-                    limit_name: "GL_MAX_TEXTURE_BUFFER_SIZE",
+                    what: "the store's per-triangle data in OpenGL".into(),
+                    value,
+                    limit_name,
                     limit,
                 });
             }
@@ -344,9 +364,14 @@ impl GsPass {
             gl.enable_vertex_attrib_array(1);
             gl.vertex_attrib_pointer_i32(1, 1, glow::UNSIGNED_INT, stride, 12);
             gl.bind_vertex_array(None);
-            let info = gl.create_texture().map_err(gl_error)?;
-            gl.bind_texture(glow::TEXTURE_BUFFER, Some(info));
-            gl.tex_buffer(glow::TEXTURE_BUFFER, glow::R32UI, Some(buffers[2]));
+            let info = if self.storage_info {
+                None
+            } else {
+                let info = gl.create_texture().map_err(gl_error)?;
+                gl.bind_texture(glow::TEXTURE_BUFFER, Some(info));
+                gl.tex_buffer(glow::TEXTURE_BUFFER, glow::R32UI, Some(buffers[2]));
+                Some(info)
+            };
             check(gl, "copying the mesh store")?;
             Ok(Store {
                 version,
@@ -397,8 +422,12 @@ impl GsPass {
                 0.5 * frame.size.0 as f32,
                 0.5 * frame.size.1 as f32,
             );
-            gl.active_texture(glow::TEXTURE0);
-            gl.bind_texture(glow::TEXTURE_BUFFER, Some(store.info));
+            if let Some(info) = store.info {
+                gl.active_texture(glow::TEXTURE0);
+                gl.bind_texture(glow::TEXTURE_BUFFER, Some(info));
+            } else {
+                gl.bind_buffer_base(glow::SHADER_STORAGE_BUFFER, 0, Some(store.buffers[2]));
+            }
             gl.bind_buffer_base(glow::UNIFORM_BUFFER, FRAME_BINDING, Some(frame.frame));
             gl.bind_vertex_array(Some(store.vertex_array));
             let block = (self.capacity * INSTANCE_BYTES as u32) as i32;
@@ -560,7 +589,9 @@ impl GsPass {
         // SAFETY: as in `new`; the store is not used again.
         unsafe {
             gl.delete_vertex_array(store.vertex_array);
-            gl.delete_texture(store.info);
+            if let Some(info) = store.info {
+                gl.delete_texture(info);
+            }
             for b in store.buffers {
                 gl.delete_buffer(b);
             }
@@ -607,7 +638,7 @@ impl Drop for GsPass {
 unsafe fn program(
     gl: &glow::Context,
     capacity: u32,
-    clip_control: bool,
+    (clip_control, storage_info): (bool, bool),
     maps: bool,
 ) -> Result<Program> {
     let program = gl.create_program().map_err(gl_error)?;
@@ -617,8 +648,13 @@ unsafe fn program(
         (glow::GEOMETRY_SHADER, "GEOMETRY"),
         (glow::FRAGMENT_SHADER, "FRAGMENT"),
     ] {
+        let version = if storage_info {
+            "430 core\n#define STORAGE_INFO"
+        } else {
+            "330 core"
+        };
         let mut source =
-            format!("#version 330 core\n#define INSTANCE_CAPACITY {capacity}\n#define {stage}\n");
+            format!("#version {version}\n#define INSTANCE_CAPACITY {capacity}\n#define {stage}\n");
         if maps {
             source += "#define MAPS\n";
         }
