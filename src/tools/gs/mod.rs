@@ -5,8 +5,8 @@
 //! deferred pass against.
 //!
 //! It runs in an OpenGL 3.3+ core context of its own (the per-triangle data in a storage
-//! buffer where the context is 4.3 or newer, else a buffer texture), made headless through EGL (`egl.rs`),
-//! rather than in wgpu's GL device: the comparison then runs beside whichever backend wgpu
+//! buffer where the context is 4.3 or newer, else a buffer texture), made headless through
+//! EGL (`egl.rs`), rather than in wgpu's GL device: the comparison then runs beside whichever backend wgpu
 //! uses (lavapipe's Vulkan by default), the context's state is this module's alone, and
 //! desktop GL is what the method was written for. It draws the bytes the wgpu passes draw:
 //! the mesh store is read back from the GPU, and the frame and instance records are the ones
