@@ -548,6 +548,20 @@ struct BenchArgs {
     /// dashed[:DASH,GAP], dotted[:SPACING]); the other methods draw them solid.
     #[arg(long, default_value = "solid", value_name = "PATTERN")]
     edge_pattern: String,
+    /// Print this run's ratios (deferred ÷ gs, edge ÷ floor, …) against a baseline of
+    /// record (bench/baseline.json), flagging those that worsened by more than 15 %.
+    #[arg(long, value_name = "BASELINE")]
+    against: Option<PathBuf>,
+    /// Write this run's ratios as a baseline of record to this file, marked with --commit
+    /// and --date (bench/tables.sh does).
+    #[arg(long, value_name = "BASELINE", requires_all = ["commit", "date"])]
+    record: Option<PathBuf>,
+    /// The commit a recorded baseline was measured at.
+    #[arg(long)]
+    commit: Option<String>,
+    /// The day a recorded baseline was measured.
+    #[arg(long)]
+    date: Option<String>,
 }
 
 fn parse_timed(s: &str) -> std::result::Result<Timed, String> {
@@ -555,6 +569,12 @@ fn parse_timed(s: &str) -> std::result::Result<Timed, String> {
 }
 
 fn bench_command(args: &BenchArgs) -> Result<()> {
+    // The baseline is read before the run, so that a bad path fails at once.
+    let baseline = args
+        .against
+        .as_deref()
+        .map(wirepass::tools::bench::Baseline::read)
+        .transpose()?;
     let sizes = args
         .size
         .split(',')
@@ -640,6 +660,26 @@ fn bench_command(args: &BenchArgs) -> Result<()> {
         wirepass::tools::bench::report_markdown(&device, &runs)
     );
     wirepass::tools::bench::write_outputs(&args.out, &device, &runs)?;
+    let ratios = wirepass::tools::bench::ratios(&runs);
+    if let Some(baseline) = &baseline {
+        let (table, _) = wirepass::tools::bench::against(baseline, &ratios);
+        println!("\n{table}");
+    }
+    if let (Some(path), Some(commit), Some(date)) = (&args.record, &args.commit, &args.date) {
+        // The OpenGL renderer gs ran on, without how it was timed.
+        let gl = runs.iter().find_map(|r| r.gl.as_deref());
+        let adapter = match gl.and_then(|gl| gl.split("; timed by").next()) {
+            Some(gl) => format!("{}; gs on {gl}", device.describe()),
+            None => device.describe(),
+        };
+        let record = wirepass::tools::bench::Baseline {
+            adapter,
+            commit: commit.clone(),
+            date: date.clone(),
+            ratios,
+        };
+        record.write(path)?;
+    }
     eprintln!("wrote {}", args.out.display());
     Ok(())
 }

@@ -123,6 +123,30 @@ fn the_image_alone_is_the_image_with_maps_and_timings_name_each_step() {
 }
 
 #[test]
+fn a_baseline_that_is_not_one_is_a_clear_error() {
+    let bad = temp("not-a-baseline.json");
+    std::fs::write(&bad, "{\"ratios\": 3}").unwrap();
+    let out = temp("bench-against");
+    for path in [bad.to_str().unwrap(), "/nonexistent/baseline.json"] {
+        let (ok, err) = wirepass(&[
+            "bench",
+            "sphere:200",
+            "--frames",
+            "1",
+            "--out",
+            out.to_str().unwrap(),
+            "--against",
+            path,
+        ]);
+        assert!(!ok && err.lines().count() == 1, "{err}");
+        assert!(
+            err.contains("baseline") || err.contains("nonexistent"),
+            "{err}"
+        );
+    }
+}
+
+#[test]
 fn bad_settings_give_one_clear_line() {
     let out = temp("bad.png");
     let o = out.to_str().unwrap();

@@ -535,10 +535,10 @@ impl DeferredPass {
     /// Builds now every pipeline that encoding `frame` into outputs like `target` uses, so
     /// that the first encode does not build them. The pass builds each pipeline on first use
     /// (its modules are specialised for what a frame holds: outlines, host depth, one or many
-    /// instances, the output), so the first frame of each kind costs more than the next (the
-    /// README's library section has lavapipe's figures). A host calls this while loading, with a
-    /// frame prepared like the ones it will draw; `prepare` has already built the visibility
-    /// and host-depth pipelines, and `new` the composite.
+    /// instances, the output), so the first frame of each kind costs more than the next
+    /// (`wirepass render --timings` shows by how much). A host calls this while loading, with
+    /// a frame prepared like the ones it will draw; `prepare` has already built the
+    /// visibility and host-depth pipelines, and `new` the composite.
     pub fn warm_up(
         &self,
         device: &wgpu::Device,

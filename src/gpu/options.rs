@@ -37,9 +37,8 @@ impl Default for PassOptions {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum TriangleIds {
     /// [`VertexPulling`](TriangleIds::VertexPulling) on a CPU adapter, whose rasterizer
-    /// takes a slower path for a fragment shader that reads the primitive index (the README's
-    /// speed section has lavapipe's figures), and on a device without
-    /// `Features::PRIMITIVE_INDEX`;
+    /// takes a slower path for a fragment shader that reads the primitive index, and on a
+    /// device without `Features::PRIMITIVE_INDEX`;
     /// [`PrimitiveIndex`](TriangleIds::PrimitiveIndex) elsewhere.
     #[default]
     Auto,
