@@ -59,7 +59,7 @@ run's ratios against it and flags those that worsened by more than 15 %.
   stages there), by its timestamps on a GPU.
 - Ratios: \`deferred ÷ gs\` and \`÷ forward\`, the whole frame; \`edge ÷ floor\`, the edge
   pass's dispatches against the floor's one compute pass; \`edge ÷ edge at sphere:20000\`,
-  the edge pass against its time on the fewest triangles (flat is 1).
+  the edge pass against its time on the sphere of fewest triangles (flat is 1).
 
 Adapter:
 EOF

@@ -1210,12 +1210,19 @@ pub struct Ratio {
     pub size: String,
     /// What is divided by what: `deferred ÷ gs`, `deferred ÷ forward`, `edge ÷ floor`,
     /// `render-pass ÷ deferred`, `edge ÷ edge at SCENE` (the edge pass against its time on the
-    /// scene of the fewest triangles at the same size: flat in triangles is 1).
+    /// scene of fewest triangles of the same procedural kind and size: flat in triangles is
+    /// 1).
     pub ratio: String,
     /// `on` or `off`.
     pub outlines: String,
     /// The ratio.
     pub value: f64,
+}
+
+/// The kind of a procedural scene (`sphere` of `sphere:20000`), none for a file.
+fn family(r: &Run) -> Option<&str> {
+    let (kind, _) = r.scene.split_once(':')?;
+    (!r.scene.contains(['/', '\\', '.'])).then_some(kind)
 }
 
 /// The ratios of a run, each measured within it (the methods interleaved frame by frame).
@@ -1260,11 +1267,13 @@ pub fn ratios(runs: &[Run]) -> Vec<Ratio> {
             "render-pass ÷ deferred".into(),
             host.map(|h| h / d.total_median_ms),
         );
-        // The edge pass against the same size's scene of fewest triangles.
+        // The edge pass against the scene of fewest triangles of the same family (the
+        // procedural meshes of one kind, `sphere:N`) and size.
         let fewest = runs
             .iter()
             .filter(timed)
             .filter(|r| r.method == "deferred" && r.size == d.size && r.outlines == d.outlines)
+            .filter(|r| family(r).is_some() && family(r) == family(d))
             .min_by_key(|r| r.triangles);
         if let Some(f) = fewest.filter(|f| f.scene != d.scene) {
             let name = format!("edge ÷ edge at {}", f.scene);
