@@ -536,8 +536,8 @@ struct BenchArgs {
     /// (`polygon,feature:30`), each on its own upload, beside --edges in the same run.
     #[arg(long, value_delimiter = ',', value_parser = parse_edges)]
     compare_edges: Vec<EdgeSelection>,
-    /// Time only these methods, comma separated: floor, deferred, forward, two-pass, gs
-    /// [default: all of them].
+    /// Time only these methods, comma separated: floor, deferred, render-pass, forward,
+    /// two-pass, gs [default: all of them].
     #[arg(long, value_delimiter = ',', value_parser = parse_timed)]
     methods: Vec<Timed>,
     /// Hidden lines for the deferred method (off, solid, dashed[:DASH,GAP],

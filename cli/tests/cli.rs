@@ -295,8 +295,8 @@ fn bench_writes_table_json_csv_and_plots() {
     );
     assert!(json["device"]["name"].is_string());
     let runs = json["runs"].as_array().unwrap();
-    // 2 scenes × 2 sizes × (floor, deferred, forward, two-pass, gs).
-    assert_eq!(runs.len(), 20);
+    // 2 scenes × 2 sizes × (floor, deferred, render-pass, forward, two-pass, gs).
+    assert_eq!(runs.len(), 24);
     for run in runs {
         for key in [
             "scene",
@@ -324,7 +324,14 @@ fn bench_writes_table_json_csv_and_plots() {
         runs.iter().map(|r| r["method"].as_str().unwrap()).collect();
     assert_eq!(
         methods.into_iter().collect::<Vec<_>>(),
-        ["deferred", "floor", "forward", "gs", "two-pass"]
+        [
+            "deferred",
+            "floor",
+            "forward",
+            "gs",
+            "render-pass",
+            "two-pass"
+        ]
     );
     let gs = runs.iter().find(|r| r["method"] == "gs").unwrap();
     assert!(gs["gl"].as_str().unwrap().contains("OpenGL"), "{gs}");
@@ -332,6 +339,24 @@ fn bench_writes_table_json_csv_and_plots() {
     assert!(csv.lines().count() > 20);
     let report = std::fs::read_to_string(out.join("bench.md")).unwrap();
     assert!(report.contains("| deferred ÷ gs |"), "{report}");
+    // The ratios of the run, in the report and as the baseline's records.
+    assert!(report.contains("| render-pass ÷ deferred |"), "{report}");
+    let ratios: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("ratios.json")).unwrap()).unwrap();
+    let names: std::collections::BTreeSet<_> = ratios
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r["ratio"].as_str().unwrap())
+        .collect();
+    for name in [
+        "deferred ÷ gs",
+        "deferred ÷ forward",
+        "edge ÷ floor",
+        "render-pass ÷ deferred",
+    ] {
+        assert!(names.contains(name), "{names:?}");
+    }
     for plot in ["time_vs_triangles.png", "time_vs_pixels.png"] {
         let img = image::open(out.join(plot)).unwrap();
         assert!(img.width() > 100, "{plot}");
