@@ -410,8 +410,7 @@ impl ChainRecords {
             }
         }
         let tris = mesh.triangles();
-        let weld = crate::mesh::adjacency::weld_by_position(mesh.positions());
-        let all = crate::mesh::chains::chains(mesh.positions(), &weld, tris, &listed);
+        let all = crate::mesh::chains::chains(mesh.positions(), mesh.welded(), tris, &listed);
         let mut chains = crate::mesh::chains::Chains::default();
         let mut chained = vec![0u8; tris.len()];
         for chain in all.iter().filter(|c| c.len() > 1) {

@@ -2,7 +2,6 @@
 //! exact position first, so split normals or texture seams do not cut the surface apart.
 
 use crate::mesh::par::*;
-use std::collections::HashMap;
 
 /// Marks an edge with no unique neighbour: a boundary, or an edge shared by three or more
 /// triangles (non-manifold).
@@ -87,7 +86,11 @@ pub fn outline_hints(
 /// For each triangle, the triangle across each of its edges (edge `i` runs from corner `i`
 /// to corner `i + 1`), or [`NO_NEIGHBOUR`].
 pub fn edge_neighbours(positions: &[glam::Vec3], triangles: &[[u32; 3]]) -> Vec<[u32; 3]> {
-    let weld = weld_by_position(positions);
+    welded_neighbours(&weld_by_position(positions), triangles)
+}
+
+/// [`edge_neighbours`] with the vertices already welded (`weld`, [`weld_by_position`]).
+pub fn welded_neighbours(weld: &[u32], triangles: &[[u32; 3]]) -> Vec<[u32; 3]> {
     // One entry per half-edge: (undirected welded edge key, triangle * 3 + edge). Sorting
     // by key groups the two sides of each edge; a sort scales to tens of millions of edges
     // with far less memory than a hash map.
@@ -127,15 +130,24 @@ pub fn edge_neighbours(positions: &[glam::Vec3], triangles: &[[u32; 3]]) -> Vec<
 
 /// Maps every vertex to the first vertex with bit-identical coordinates (−0.0 equals 0.0).
 pub fn weld_by_position(positions: &[glam::Vec3]) -> Vec<u32> {
-    let mut first: HashMap<[u32; 3], u32> = HashMap::with_capacity(positions.len());
-    positions
-        .iter()
-        .enumerate()
-        .map(|(i, p)| {
-            let key = (*p + glam::Vec3::ZERO).to_array().map(f32::to_bits);
-            *first.entry(key).or_insert(i as u32)
-        })
-        .collect()
+    // Sorted by coordinates' bits, then by index, each run of one position points at its
+    // first vertex: a parallel sort, where a hash map of a million positions is serial.
+    let key = |i: usize| {
+        (positions[i] + glam::Vec3::ZERO)
+            .to_array()
+            .map(f32::to_bits)
+    };
+    let mut order: Vec<u32> = (0..positions.len() as u32).collect();
+    order.par_sort_unstable_by_key(|&i| (key(i as usize), i));
+    let mut weld = vec![0u32; positions.len()];
+    let mut first = 0;
+    for (k, &i) in order.iter().enumerate() {
+        if k == 0 || key(i as usize) != key(order[k - 1] as usize) {
+            first = i;
+        }
+        weld[i as usize] = first;
+    }
+    weld
 }
 
 #[cfg(test)]

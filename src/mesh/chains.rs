@@ -86,9 +86,9 @@ pub fn chains(
 
     let mut used = vec![false; listed.len()];
     // Walks from end `entry` (the end of its edge at the walk's start) while the far end's
-    // vertex joins exactly two ends and the other is unused; returns the ends entered.
-    let walk = |entry: u32, used: &mut Vec<bool>| {
-        let mut path = Vec::new();
+    // vertex joins exactly two ends and the other is unused; the ends entered go to `path`.
+    let walk = |entry: u32, used: &mut Vec<bool>, path: &mut Vec<u32>| {
+        path.clear();
         let mut end = entry;
         loop {
             used[end as usize / 2] = true;
@@ -104,14 +104,16 @@ pub fn chains(
                 _ => break,
             }
         }
-        path
     };
     // A path as entered ends; reversed, each edge is entered at its other end.
     let first_vertex = |path: &[u32]| at(end_vertex(path[0] as usize));
     let second_vertex = |path: &[u32]| at(end_vertex(path[0] as usize ^ 1));
-    let reversed = |path: &[u32]| path.iter().rev().map(|&e| e ^ 1).collect::<Vec<u32>>();
+    let reverse = |path: &[u32], back: &mut Vec<u32>| {
+        back.clear();
+        back.extend(path.iter().rev().map(|&e| e ^ 1));
+    };
     let mut out = Chains::default();
-    let push = |path: Vec<u32>, out: &mut Chains| {
+    let push = |path: &[u32], out: &mut Chains| {
         out.starts.push(out.edges.len() as u32);
         out.edges.extend(path.iter().map(|&end| {
             let (t, i) = listed[end as usize / 2];
@@ -122,6 +124,8 @@ pub fn chains(
             }
         }));
     };
+    // One pair of buffers for every walk: most chains of a dense mesh are one edge long.
+    let (mut path, mut back) = (Vec::new(), Vec::new());
 
     // Open chains: from every vertex where other than two ends meet.
     for v in 0..n as u32 {
@@ -133,14 +137,14 @@ pub fn chains(
             if used[end as usize / 2] {
                 continue;
             }
-            let path = walk(end, &mut used);
-            let back = reversed(&path);
+            walk(end, &mut used, &mut path);
+            reverse(&path, &mut back);
             let (a, b) = (first_vertex(&path), first_vertex(&back));
             // From the end that comes first; a chain from a vertex back to it runs towards
             // the nearer neighbour that comes first.
             let flip = comes_first(b, a)
                 || (a == b && comes_first(second_vertex(&back), second_vertex(&path)));
-            push(if flip { back } else { path }, &mut out);
+            push(if flip { &back } else { &path }, &mut out);
         }
     }
     // What is left is closed loops through vertices of two ends each.
@@ -148,7 +152,7 @@ pub fn chains(
         if used[e] {
             continue;
         }
-        let path = walk(2 * e as u32, &mut used);
+        walk(2 * e as u32, &mut used, &mut path);
         // Start at the vertex that comes first, towards its neighbour that comes first.
         let start = (0..path.len())
             .min_by(|&j, &k| {
@@ -162,17 +166,14 @@ pub fn chains(
                 }
             })
             .unwrap_or(0);
-        let mut path: Vec<u32> = path[start..]
-            .iter()
-            .chain(&path[..start])
-            .copied()
-            .collect();
+        path.rotate_left(start);
         // The other way round from the same start.
-        let back = reversed(&path);
+        reverse(&path, &mut back);
         if comes_first(second_vertex(&back), second_vertex(&path)) {
-            path = back;
+            push(&back, &mut out);
+        } else {
+            push(&path, &mut out);
         }
-        push(path, &mut out);
     }
     out
 }

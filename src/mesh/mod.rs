@@ -107,6 +107,8 @@ pub struct Mesh {
     outline_mask: Option<Vec<u8>>,
     /// The edges the file says to draw, when it says.
     authored_edges: Option<Vec<u8>>,
+    /// Each vertex's first vertex at its position, computed on first use.
+    weld: std::sync::OnceLock<Vec<u32>>,
     /// Edge adjacency, computed on first use.
     neighbours: std::sync::OnceLock<Vec<[u32; 3]>>,
     /// Per triangle, what lets the outline pass skip it: see [`Mesh::outline_hints`].
@@ -197,6 +199,7 @@ impl Mesh {
             polygon_edges,
             outline_mask: None,
             authored_edges: None,
+            weld: Default::default(),
             neighbours: Default::default(),
             outline_hints: Default::default(),
             outline_clusters: Default::default(),
@@ -344,7 +347,15 @@ impl Mesh {
     /// non-manifold edges. Computed once, on first use.
     pub fn edge_neighbours(&self) -> &[[u32; 3]] {
         self.neighbours
-            .get_or_init(|| adjacency::edge_neighbours(&self.positions, &self.triangles))
+            .get_or_init(|| adjacency::welded_neighbours(self.welded(), &self.triangles))
+    }
+
+    /// Each vertex's first vertex of bit-identical position
+    /// ([`adjacency::weld_by_position`]), which the adjacency and the chains of drawn edges
+    /// join vertices by. Computed once, on first use.
+    pub fn welded(&self) -> &[u32] {
+        self.weld
+            .get_or_init(|| adjacency::weld_by_position(&self.positions))
     }
 
     /// Per triangle, 5 bits that let the GPU outline pass skip triangles that cannot have an

@@ -34,6 +34,7 @@ mod sequential {
         fn par_sort_unstable(&mut self)
         where
             T: Ord;
+        fn par_sort_unstable_by_key<K: Ord, F: Fn(&T) -> K>(&mut self, key: F);
     }
     impl<T> ParallelSlice<T> for [T] {
         fn par_iter(&self) -> std::slice::Iter<'_, T> {
@@ -47,6 +48,9 @@ mod sequential {
             T: Ord,
         {
             self.sort_unstable()
+        }
+        fn par_sort_unstable_by_key<K: Ord, F: Fn(&T) -> K>(&mut self, key: F) {
+            self.sort_unstable_by_key(key)
         }
     }
 

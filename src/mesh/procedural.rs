@@ -276,6 +276,7 @@ pub fn default_scene() -> Mesh {
         polygon_edges: scene.edges,
         outline_mask: None,
         authored_edges: None,
+        weld: Default::default(),
         neighbours: Default::default(),
         outline_hints: Default::default(),
         outline_clusters: Default::default(),
