@@ -53,7 +53,7 @@ struct Frame {
     // Linear RGBA of back faces seen through a section's cut (`sections_on` 1), and the
     // section planes as coefficients of clip-space points (`section_sides`; unused: 0).
     section_color: vec4<f32>,
-    sections: array<vec4<f32>, 6>,
+    sections: array<vec4<f32>, MAX_SECTIONS>,
     sections_on: u32,
     // The cut lines' width in pixels and linear RGBA colour.
     section_width: f32,
@@ -117,26 +117,6 @@ struct Instance {
     outline_pattern: vec2<f32>,
 }
 
-const INSTANCE_EDGES: u32 = 1u;
-const INSTANCE_OUTLINES: u32 = 2u;
-// Its hidden lines are drawn (HIDDEN); those the host's depth hides count as hidden; its
-// drawn edges' too, not only its outline's.
-const INSTANCE_HIDDEN: u32 = 4u;
-const INSTANCE_BEHIND_HOST: u32 = 8u;
-const INSTANCE_HIDDEN_EDGES: u32 = 16u;
-// Its drawn edges are drawn by the outline pass (patterned, cut by section planes, or perhaps
-// crossed by another instance), and the edge pass leaves them.
-const INSTANCE_LISTED_EDGES: u32 = 32u;
-// It has a phase table (`chain_phases`).
-const INSTANCE_PHASES: u32 = 64u;
-// Another instance may pass through it (scene::overlapping): its lines' visibility is tested
-// more widely (outline.wgsl, class_at).
-const INSTANCE_CROSSED: u32 = 128u;
-// Bit of a triangle's `info` (mesh_records::EdgeData): its patch crosses another surface of
-// the mesh (edge_pass.wgsl: its pixels take no lines of their own; outline.wgsl: its lines'
-// visibility is tested more widely).
-const INFO_CROSSED: u32 = 536870912u;
-
 // A colour packed as two pairs of f16 (src/gpu/frame.rs, pack_color).
 fn unpack_color(c: vec2<u32>) -> vec4<f32> {
     return vec4<f32>(unpack2x16float(c.x), unpack2x16float(c.y));
@@ -199,9 +179,6 @@ fn host_axis_slope(h: f32, a: f32, b: f32) -> f32 {
 fn host_hides(host: f32, point: f32, distance: f32, slope: f32) -> bool {
     return host - point > 2.0 * (distance + 1.0) * slope;
 }
-
-// Distance returned for an edge that is not drawn or not visible.
-const NO_EDGE: f32 = 3.0e38;
 
 // Homogeneous pixel coordinates of a clip-space vertex, relative to the pixel centre `pixel`:
 // ((x + w)/2 * W - px * w, (w - y)/2 * H - py * w, w). Working relative to the pixel keeps the
@@ -366,10 +343,8 @@ fn dash_nearest(s: f32, lo: f32, hi: f32, dash: f32, period: f32) -> f32 {
 
 // Which line colours a pixel most: lines are ranked by their intensity in 1/4095 steps, and
 // equal ones by nearness (src/style.rs, line_key, is the twin). The outline pass keeps the
-// greatest key per pixel with an atomic max; the distance is kept in 1/4096 px steps.
-const KEY_DISTANCE_STEPS: f32 = 4096.0;
-const KEY_DISTANCE_MAX: u32 = 0xfffffu;
-
+// greatest key per pixel with an atomic max; the distance is kept in KEY_DISTANCE_STEPS a
+// pixel.
 fn line_key(intensity: f32, d: f32) -> u32 {
     let level = u32(round(clamp(intensity, 0.0, 1.0) * 4095.0));
     let q = u32(clamp(d * KEY_DISTANCE_STEPS, 0.0, f32(KEY_DISTANCE_MAX)));
@@ -404,8 +379,6 @@ fn towards_eye(a: vec3<f32>, eye: vec4<f32>) -> vec3<f32> {
 // triangle counts as folded: one within EDGE_ON of it, since the eye in a face's plane (a
 // box seen along a face, an axis-aligned orthographic view) puts it at 0 only to rounding,
 // which f32 and the ground truth's f64 round differently.
-const EDGE_ON: f32 = 1e-5;
-
 fn is_silhouette(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>, d: vec3<f32>, eye: vec4<f32>) -> bool {
     let to_eye = towards_eye(a, eye);
     let normal_c = cross(b - a, c - a);

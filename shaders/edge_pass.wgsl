@@ -114,13 +114,6 @@ struct Pixel {
     kind: u32,
 }
 
-// Line classes of the diagnostic map's a channel (src/world/offscreen.rs, LineClass).
-const LINE_CLASS_EDGE: u32 = 1u;
-const LINE_CLASS_OUTLINE: u32 = 2u;
-const LINE_CLASS_HIDDEN: u32 = 3u;
-const LINE_CLASS_CUT: u32 = 4u;
-const LINE_CLASS_INTERSECTION: u32 = 5u;
-
 // The class of the outline pass's line with owner word `owner` (COLORS; an edge without).
 fn owner_kind(owner: u32) -> u32 {
     let kind = owner & OWNER_CLASS;
@@ -185,17 +178,11 @@ fn empty_pixel(xy: vec2<u32>, inst: u32, outline: vec2<u32>) -> Pixel {
     return p;
 }
 
-// Bits of `info` (mesh_store::EdgeData): the triangle's patch is larger than PATCH_TRIANGLES
-// or crosses another surface (its drawn edges come from the outline pass), or is two
-// triangles. (INFO_CROSSED, in common.wgsl: the patch crosses another surface, and its pixels
-// take no lines of their own, which the crossing surface may hide right beside them.)
-const INFO_LARGE_PATCH: u32 = 2048u;
-const INFO_QUAD: u32 = 32768u;
-
+// Bits of `info` (mesh_records.rs, EdgeData; INFO_*): the triangle's patch is larger than
+// PATCH_TRIANGLES or crosses another surface (its drawn edges come from the outline pass), or
+// is two triangles. Where the patch crosses another surface (INFO_CROSSED) its pixels take
+// no lines of their own, which the crossing surface may hide right beside them.
 #if PATCHES
-// Most triangles of a patch searched per pixel. Twin of patches::PATCH_TRIANGLES.
-const PATCH_TRIANGLES: u32 = 16u;
-
 // Corner k of a sampled triangle.
 fn sample_corner(s: Sample, k: u32) -> vec3<f32> {
     return select(select(s.v2.xyz, s.v1.xyz, k == 1u), s.v0.xyz, k == 0u);
@@ -260,14 +247,8 @@ fn across(s: Sample, q0: vec3<f32>, q1: vec3<f32>, q2: vec3<f32>, mask: u32, a: 
 // other triangle without reading it: the diagonal (this triangle's undrawn edge, bits
 // 16-17), the other triangle's corner off the diagonal (18-19), whether its next corner is
 // the diagonal's start (bit 20) or its end, its drawn edges (21-23), and whether it is
-// stored right after this one (bit 24) or right before it (bit 25).
-const QUAD_EDGE_SHIFT: u32 = 16u;
-const QUAD_CORNER_SHIFT: u32 = 18u;
-const QUAD_SAME: u32 = 1048576u;
-const QUAD_MASK_SHIFT: u32 = 21u;
-const QUAD_NEXT: u32 = 16777216u;
-const QUAD_PREVIOUS: u32 = 33554432u;
-
+// stored right after this one (bit 24) or right before it (bit 25): QUAD_* from
+// mesh_records.rs.
 // A quad as its sampled triangle `s` sees it, from two reads (three where its halves are
 // not stored side by side): the diagonal a -> b (the sample's undrawn edge i) and its third
 // corner c, the other triangle's fourth corner d (its corner k) and that triangle's corners

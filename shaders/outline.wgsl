@@ -96,10 +96,8 @@ fn phase_tables() -> u32 {
     return outline_tile_list() + 4u + outline_tile_count();
 }
 
-// Words per listed piece: instance slot, triangle, edge, and piece | pieces << 16.
-const PIECE_WORDS: u32 = 4u;
-
-// How many pieces the list has room for, after its header at word `list`.
+// A listed piece's words (PIECE_WORDS, from targets.rs): instance slot, triangle, edge, and
+// piece | pieces << 16. How many pieces the list has room for, after its header at word `list`.
 fn piece_room(list: u32) -> u32 {
     return (arrayLength(&acc_rw) - list - 4u) / PIECE_WORDS;
 }
@@ -184,7 +182,7 @@ fn cluster_in_view(clip: mat4x4<f32>, c: Cluster) -> bool {
 // `clip`; unused planes are 0 and pass through nothing).
 fn cluster_cut(clip: mat4x4<f32>, c: Cluster) -> bool {
     var cut = false;
-    for (var k = 0u; k < 6u; k++) {
+    for (var k = 0u; k < MAX_SECTIONS; k++) {
         let r = frame.sections[k] * clip;
         let reach = cluster_radius(c) * length(r.xyz);
         cut = cut || (reach > 0.0 && abs(dot(r.xyz, c.center) + r.w) <= reach);
@@ -200,7 +198,7 @@ fn cut_planes(inst: u32, p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>) -> u32 {
     let c1 = clip * vec4<f32>(p1, 1.0);
     let c2 = clip * vec4<f32>(p2, 1.0);
     var cuts = 0u;
-    for (var k = 0u; k < 6u; k++) {
+    for (var k = 0u; k < MAX_SECTIONS; k++) {
         let s = vec3<f32>(dot(frame.sections[k], c0), dot(frame.sections[k], c1), dot(frame.sections[k], c2));
         let away = s < vec3<f32>(0.0);
         cuts |= select(0u, 1u << k, any(away) && !all(away));
@@ -275,12 +273,6 @@ fn capped(inst: u32, t: u32, i: u32, mode: u32) -> u32 {
 fn cut_plane(mode: u32) -> u32 {
     return select(NO_PLANE, (mode >> CUT_PLANE_SHIFT) & 7u, (mode & DRAW_CUT) != 0u);
 }
-
-// Twin of adjacency::EDGE_ON_MARGIN: added to every decoded fold bound.
-const EDGE_ON_MARGIN: f32 = 2e-5;
-
-// Triangles per cluster, and invocations per workgroup of both entry points.
-const CLUSTER_TRIANGLES: u32 = 64u;
 
 // Whether a lane of this workgroup found more pieces than the piece list had room for.
 var<workgroup> overflowed: atomic<u32>;
@@ -625,7 +617,7 @@ fn outline_lines(inst: u32, t: u32) -> Found {
     // Drawn edges of a large patch, drawn here like outlines (mesh_store::EdgeData); all
     // drawn edges where they are patterned.
     let patterned = select(0u, bits & 7u, (flags & INSTANCE_LISTED_EDGES) != 0u);
-    let splat = select(0u, (bits >> 12u) & 7u, (flags & INSTANCE_EDGES) != 0u && patterned == 0u);
+    let splat = select(0u, (bits >> INFO_SPLAT_SHIFT) & 7u, (flags & INSTANCE_EDGES) != 0u && patterned == 0u);
 #if HIDDEN
     // Drawn edges: their hidden parts, wherever they are, where the instance draws them.
     let hidden_lines = (flags & INSTANCE_HIDDEN) != 0u;
@@ -730,9 +722,6 @@ fn pattern_anchor(inst: u32, t: u32, i: u32, a: vec3<f32>, b: vec3<f32>, mode: u
 }
 
 #if PATTERNS
-// First of the triangle info bits marking the drawn edges in chains (mesh_records.rs).
-const INFO_CHAINED_SHIFT: u32 = 26u;
-
 // The mesh store's chain records (src/gpu/mesh_records.rs, ChainRecords): per chain (first
 // edge record, edge count), then per edge (start vertex, end vertex, key | forward << 31,
 // phase table slot), the vertices as the listing triangle runs the edge.
@@ -797,10 +786,8 @@ fn chain_phases(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     }
 }
 
-// Words of a phase table entry: key | forward << 31, the hidden lines' position, the
-// edges' (src/gpu/frame.rs).
-const PHASE_ENTRY_WORDS: u32 = 3u;
-
+// A phase table entry (PHASE_ENTRY_WORDS): key | forward << 31, the hidden lines' position,
+// the edges'.
 // The patterns' positions (the hidden lines', the edges') and their direction
 // (`pattern_anchor`) on the chained edge `key` of `inst`, from its phase table: probed from
 // `phase_slot` on, every slot up to the key's was written this frame (the table's layout is
@@ -833,16 +820,9 @@ const DRAW_OUTLINE: u32 = 4u;
 const DRAW_CUT: u32 = 8u;
 const CUT_PLANE_SHIFT: u32 = 4u;
 // No section plane (`edge_span`'s `skip`).
-const NO_PLANE: u32 = 6u;
+const NO_PLANE: u32 = MAX_SECTIONS;
 // An intersection line, of its own class.
 const DRAW_INTERSECTION: u32 = 128u;
-
-// The classes of line splat_runs writes.
-const LINE_EDGE: u32 = 0u;
-const LINE_OUTLINE: u32 = 1u;
-const LINE_HIDDEN: u32 = 2u;
-const LINE_CUT: u32 = 3u;
-const LINE_INTERSECTION: u32 = 4u;
 
 // Narrows [range.x, range.y] to the parameters u where lo <= p0 + u d <= hi.
 fn keep_between(range: vec2<f32>, p0: f32, d: f32, lo: f32, hi: f32) -> vec2<f32> {
@@ -875,8 +855,6 @@ fn lerp_projected(a: Projected, b: Projected, k: f32) -> Projected {
     return Projected(mix(a.xy, b.xy, k), mix(a.inv_w, b.inv_w, k), mix(a.near_w, b.near_w, k), mix(a.reverse, b.reverse, k), mix(a.fade_w, b.fade_w, k));
 }
 
-// Pixels inside a line's ends at which their class is taken (`seg_class`).
-const END_INSET: f32 = 1.0 / 256.0;
 // The loops' constants (RUN_SAMPLES_PER_PX visibility samples per pixel of edge length, each
 // change between two then bisected RUN_BISECTIONS times; FOLD_STEPS and WALK_STEPS; up to
 // MAX_RUNS visible runs a piece, the last absorbing the rest) and the pieces' lengths on a
@@ -894,13 +872,6 @@ fn piece_px(r: i32) -> f32 {
     return select(select(SOFTWARE_PIECE_PX.z, SOFTWARE_PIECE_PX.y, r <= 2), SOFTWARE_PIECE_PX.x, r <= 1);
 #endif
 }
-// Pixels this far past a line's reach still get its key (`splat_runs`); twin of
-// edge_math::REACH_SLACK.
-const REACH_SLACK: f32 = 1e-3;
-// A dash reaching this many pixels past a run's end is drawn from the end (the pattern's
-// first dash starts where a chain's first edge ends); twin of edge_math::DASH_SLACK.
-const DASH_SLACK: f32 = 1e-3;
-
 // The triangles a line lies on: t of `inst`, and n of `other`: an edge's neighbour across
 // it (of the same instance; BACKGROUND_ID for none), or for an intersection line
 // (`crossing`) the triangle it crosses, of the same instance or of another.
@@ -974,7 +945,7 @@ fn edge_span(inst: u32, a: vec3<f32>, b: vec3<f32>, skip: u32) -> Span {
     // Not behind a section plane (unused planes are 0, which keeps everything); a cut line
     // is not clipped by its own plane, on which it lies (`skip`).
 #if SECTIONS
-    for (var k = 0u; k < 6u; k++) {
+    for (var k = 0u; k < MAX_SECTIONS; k++) {
         let own = k == skip;
         s = keep_positive(s, select(dot(frame.sections[k], ca), 1.0, own), select(dot(frame.sections[k], cb), 1.0, own));
     }
@@ -1131,13 +1102,13 @@ fn draw_piece(seg: Segment, k0: f32, k1: f32, length_px: f32, mode: u32) {
         }
     }
     if (mode & DRAW_VISIBLE) != 0u && count > 0u {
-        var kind = select(select(LINE_EDGE, LINE_OUTLINE, (mode & DRAW_OUTLINE) != 0u), LINE_CUT, (mode & DRAW_CUT) != 0u);
-        kind = select(kind, LINE_INTERSECTION, (mode & DRAW_INTERSECTION) != 0u);
+        var kind = select(select(LINE_CLASS_EDGE, LINE_CLASS_OUTLINE, (mode & DRAW_OUTLINE) != 0u), LINE_CLASS_CUT, (mode & DRAW_CUT) != 0u);
+        kind = select(kind, LINE_CLASS_INTERSECTION, (mode & DRAW_INTERSECTION) != 0u);
         splat_runs(seg, k0, k1, &runs, count, kind);
     }
 #if HIDDEN
     if (mode & DRAW_HIDDEN) != 0u && hidden_count > 0u {
-        splat_runs(seg, k0, k1, &hidden_runs, hidden_count, LINE_HIDDEN);
+        splat_runs(seg, k0, k1, &hidden_runs, hidden_count, LINE_CLASS_HIDDEN);
     }
 #endif
 }
@@ -1164,20 +1135,20 @@ fn push_run(runs: ptr<function, array<vec2<f32>, MAX_RUNS>>, count: ptr<function
 
 // Writes into every pixel within reach of the segment's `runs` (parameters, between k0 and
 // k1) the key of their nearest point, for a line of class `kind`: an edge's or an
-// outline's visible line, or (LINE_HIDDEN) a dash of the hidden-line pattern, in the hidden
+// outline's visible line, or (LINE_CLASS_HIDDEN) a dash of the hidden-line pattern, in the hidden
 // lines' word.
 fn splat_runs(seg: Segment, k0: f32, k1: f32, runs: ptr<function, array<vec2<f32>, MAX_RUNS>>, count: u32, kind: u32) {
-    var width = select(instances[slot(seg.on.inst)].line_width, instances[slot(seg.on.inst)].outline_width, kind == LINE_OUTLINE);
-    width = select(width, frame.section_width, kind == LINE_CUT);
-    width = select(width, frame.intersection_width, kind == LINE_INTERSECTION);
+    var width = select(instances[slot(seg.on.inst)].line_width, instances[slot(seg.on.inst)].outline_width, kind == LINE_CLASS_OUTLINE);
+    width = select(width, frame.section_width, kind == LINE_CLASS_CUT);
+    width = select(width, frame.intersection_width, kind == LINE_CLASS_INTERSECTION);
     var pattern = vec2<f32>(0.0);
     var phase = seg.phase;
     var phase_dir = seg.phase_dir;
     var behind_host = false;
-    let hidden = kind == LINE_HIDDEN;
+    let hidden = kind == LINE_CLASS_HIDDEN;
 #if PATTERNS
-    pattern = select(instances[slot(seg.on.inst)].edge_pattern, instances[slot(seg.on.inst)].outline_pattern, kind == LINE_OUTLINE);
-    pattern = select(pattern, vec2<f32>(0.0), kind == LINE_CUT || kind == LINE_INTERSECTION);
+    pattern = select(instances[slot(seg.on.inst)].edge_pattern, instances[slot(seg.on.inst)].outline_pattern, kind == LINE_CLASS_OUTLINE);
+    pattern = select(pattern, vec2<f32>(0.0), kind == LINE_CLASS_CUT || kind == LINE_CLASS_INTERSECTION);
 #endif
 #if HIDDEN
     if hidden {
@@ -1280,8 +1251,8 @@ fn splat_runs(seg: Segment, k0: f32, k1: f32, runs: ptr<function, array<vec2<f32
 #endif
 #if COLORS
             atomicMax(&acc_rw[2u * index], key);
-            var owner = select(select(0u, OWNER_OUTLINE, kind == LINE_OUTLINE), OWNER_CUT, kind == LINE_CUT);
-            owner = select(owner, OWNER_INTERSECTION, kind == LINE_INTERSECTION);
+            var owner = select(select(0u, OWNER_OUTLINE, kind == LINE_CLASS_OUTLINE), OWNER_CUT, kind == LINE_CLASS_CUT);
+            owner = select(owner, OWNER_INTERSECTION, kind == LINE_CLASS_INTERSECTION);
             atomicMax(&acc_rw[2u * index + 1u], (key & 0xfff00000u) | owner | seg.on.inst);
 #else
             atomicMax(&acc_rw[index], key);
@@ -1411,7 +1382,7 @@ fn line_window(on: On) -> Window {
     let wide = frame.sections_on != 0u || crossed;
     // An intersection line lies on both surfaces that cross there, so no surface passes
     // into view beyond it: it takes a section's window.
-    return Window(select(select(select(1, 2, wide), 4, crossed), 2, on.crossing), wide);
+    return Window(select(select(select(WINDOW_RADII.x, WINDOW_RADII.y, wide), WINDOW_RADII.z, crossed), WINDOW_RADII.y, on.crossing), wide);
 #endif
 }
 

@@ -47,13 +47,7 @@ fn outline_tile_count() -> u32 {
 // bits | instance slot): an outline's line (the instance's outline colour, not its line
 // colour), a section's cut line (the frame's section line colour), both for an
 // intersection line (the frame's intersection line colour; of equal intensity, it wins
-// over the others); then the slot's bits.
-const OWNER_OUTLINE: u32 = 0x80000u;
-const OWNER_CUT: u32 = 0x40000u;
-const OWNER_INTERSECTION: u32 = 0xc0000u;
-const OWNER_CLASS: u32 = 0xc0000u;
-const OWNER_INSTANCE: u32 = 0x3ffffu;
-
+// over the others); then the slot's bits (OWNER_*, from src/gpu/shaders.rs).
 // The colour of the outline pass's line whose owner word is `owner`: the owning instance's
 // outline colour for an outline, the section line colour for a cut line, the intersection
 // line colour for an intersection line, its line colour for a drawn edge.
@@ -169,10 +163,6 @@ fn neighbour_word(t: u32, i: u32) -> u32 {
 #endif
     return neighbours[3u * t + i];
 }
-
-const NEIGHBOUR_INDEX: u32 = 0x1fffffffu;
-const NEIGHBOUR_CORNER_SHIFT: u32 = 29u;
-const NEIGHBOUR_SAME_WAY: u32 = 0x80000000u;
 
 // The triangle a neighbour word names (relative to its mesh), or BACKGROUND_ID.
 fn neighbour_of(word: u32) -> u32 {
@@ -361,9 +351,7 @@ fn sample_corners(inst: u32, tri: u32, v0: vec4<f32>, v1: vec4<f32>, v2: vec4<f3
 }
 
 // True when `a` is nearer than `b` at the same screen point by more than f32 rounding:
-// triangles that meet at an edge or a vertex agree there only to rounding.
-const HIDDEN_MARGIN: f32 = 1.0e-4;
-
+// triangles that meet at an edge or a vertex agree there only to rounding (HIDDEN_MARGIN).
 fn nearer(a_near: f32, b_near: f32, b_w: f32) -> bool {
     return a_near < b_near - HIDDEN_MARGIN * (abs(b_near) + b_w);
 }
@@ -371,8 +359,6 @@ fn nearer(a_near: f32, b_near: f32, b_w: f32) -> bool {
 // How much nearer than a line's point a surface within HIDDEN_MARGIN of it must be to tell
 // how the eye's ray reaches that point (`class_at`, in a frame with section planes): from
 // the section face of a cut solid, through a back face, or through a front face.
-const CAP_MARGIN: f32 = 1.0e-6;
-
 fn nearer_than_cap(a_near: f32, b_near: f32, b_w: f32) -> bool {
     return a_near < b_near - CAP_MARGIN * (abs(b_near) + b_w);
 }

@@ -525,11 +525,14 @@ impl Style {
 /// with the greatest key, the one that colours it most.
 pub fn line_key(intensity: f64, d: f64) -> u32 {
     let level = (intensity.clamp(0.0, 1.0) * 4095.0).round() as u32;
-    let q = (d * 4096.0).clamp(0.0, f64::from(KEY_DISTANCE_MAX)) as u32;
+    let q = (d * KEY_DISTANCE_STEPS).clamp(0.0, f64::from(KEY_DISTANCE_MAX)) as u32;
     (level << 20) | (KEY_DISTANCE_MAX - q)
 }
 
-const KEY_DISTANCE_MAX: u32 = 0xf_ffff;
+/// The largest distance a line key holds, in its steps (the key's low 20 bits).
+pub(crate) const KEY_DISTANCE_MAX: u32 = 0xf_ffff;
+/// Steps of a line key's distance per pixel.
+pub(crate) const KEY_DISTANCE_STEPS: f64 = 4096.0;
 
 /// How far from an edge its line can colour a pixel, in pixels.
 pub fn line_reach(width: f64) -> f64 {

@@ -309,8 +309,8 @@ struct RenderArgs {
     output: PathBuf,
     /// Also write ids.npy (global triangle ids), depth.npy, edge_distance.npy,
     /// hidden_distance.npy, line_class.npy (deferred and raycast: 0 no line, 1 drawn edge, 2
-    /// outline, 3 hidden line, 4 section cut line) and camera.json (the view and projection matrices used) into
-    /// this directory.
+    /// outline, 3 hidden line, 4 section cut line, 5 intersection line) and camera.json (the
+    /// view and projection matrices used) into this directory.
     #[arg(long)]
     dump: Option<PathBuf>,
     /// Print where the time to the image goes (deferred method): reading the scene, each

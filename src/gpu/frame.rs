@@ -83,24 +83,24 @@ pub(crate) struct InstanceRecord {
 }
 
 /// `Instance.flags`: the instance's edges are drawn.
-const INSTANCE_EDGES: u32 = 1;
+pub(crate) const INSTANCE_EDGES: u32 = 1;
 /// `Instance.flags`: the instance's outline is drawn.
-const INSTANCE_OUTLINES: u32 = 2;
+pub(crate) const INSTANCE_OUTLINES: u32 = 2;
 /// `Instance.flags`: the instance's hidden lines are drawn.
-const INSTANCE_HIDDEN: u32 = 4;
+pub(crate) const INSTANCE_HIDDEN: u32 = 4;
 /// `Instance.flags`: the parts of its lines the host's depth hides are drawn as hidden.
-const INSTANCE_BEHIND_HOST: u32 = 8;
+pub(crate) const INSTANCE_BEHIND_HOST: u32 = 8;
 /// `Instance.flags`: the hidden parts of its drawn edges are drawn, not only its outline's.
-const INSTANCE_HIDDEN_EDGES: u32 = 16;
+pub(crate) const INSTANCE_HIDDEN_EDGES: u32 = 16;
 /// `Instance.flags`: its drawn edges are patterned, cut by section planes or perhaps crossed
 /// by another instance, so the outline pass draws them (their visible runs) and the edge pass
 /// leaves them.
-const INSTANCE_LISTED_EDGES: u32 = 32;
+pub(crate) const INSTANCE_LISTED_EDGES: u32 = 32;
 /// `Instance.flags`: it has a phase table (`chain_phases`).
-const INSTANCE_PHASES: u32 = 64;
+pub(crate) const INSTANCE_PHASES: u32 = 64;
 /// `Instance.flags`: another instance may pass through it ([`crate::scene::overlapping`]), so
 /// its lines' visibility is tested over a wider window ([`CROSSING_BAND`]).
-const INSTANCE_CROSSED: u32 = 128;
+pub(crate) const INSTANCE_CROSSED: u32 = 128;
 
 /// Pixels the guard band grows by in a frame where surfaces may cross: the outline pass
 /// tests the visibility of their lines against the ids up to four pixels around each point
@@ -633,7 +633,7 @@ fn section_planes(
 
 /// Words of a phase table entry: the edge's key, the hidden-line pattern's position and the
 /// edge pattern's (`chain_phases`).
-const PHASE_ENTRY_WORDS: u32 = 3;
+pub(crate) const PHASE_ENTRY_WORDS: u32 = 3;
 
 fn too_many_chains() -> Error {
     Error::InvalidScene(

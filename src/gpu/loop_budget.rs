@@ -111,13 +111,15 @@ const _: () = {
 /// The constants above, as WGSL declarations.
 pub(crate) fn wgsl() -> String {
     let [narrow, section, crossed] = SOFTWARE_PIECE_PX;
+    let [r0, r1, r2] = WINDOW_RADII;
     format!(
         "const WALK_STEPS: u32 = {WALK_STEPS}u;\n\
          const FOLD_STEPS: u32 = {FOLD_STEPS}u;\n\
          const RUN_SAMPLES_PER_PX: f32 = {RUN_SAMPLES_PER_PX}.0;\n\
          const RUN_BISECTIONS: u32 = {RUN_BISECTIONS}u;\n\
          const MAX_RUNS: u32 = {MAX_RUNS}u;\n\
-         const SOFTWARE_PIECE_PX: vec3<f32> = vec3<f32>({narrow}.0, {section}.0, {crossed}.0);"
+         const SOFTWARE_PIECE_PX: vec3<f32> = vec3<f32>({narrow}.0, {section}.0, {crossed}.0);\n\
+         const WINDOW_RADII: vec3<i32> = vec3<i32>({r0}, {r1}, {r2});"
     )
 }
 

@@ -181,10 +181,10 @@ impl MeshData {
 pub(crate) const MAX_MESH_TRIANGLES: u32 = (1 << 29) - 1;
 /// The neighbour word's bits below this hold the neighbour's stored index (relative to its
 /// mesh); the next two its corner off the shared edge.
-const NEIGHBOUR_CORNER_SHIFT: u32 = 29;
+pub(crate) const NEIGHBOUR_CORNER_SHIFT: u32 = 29;
 /// Bit of a neighbour word: the neighbour runs along the shared edge the same way as this
 /// triangle (the two are wound oppositely); clear, the other way.
-const NEIGHBOUR_SAME_WAY: u32 = 1 << 31;
+pub(crate) const NEIGHBOUR_SAME_WAY: u32 = 1 << 31;
 
 /// What the passes read of the triangle across edge `i` of triangle `t` (`scene.wgsl`,
 /// `neighbour_word`): its stored index, its corner k off the shared edge and whether its
@@ -223,29 +223,29 @@ fn neighbour_word(mesh: &Mesh, stored: &[u32], t: usize, i: usize) -> u32 {
 }
 
 /// Bit of [`EdgeData::info`]: the triangle's patch is large ([`Patches::large`]).
-const INFO_LARGE_PATCH: u32 = 1 << 11;
+pub(crate) const INFO_LARGE_PATCH: u32 = 1 << 11;
 /// First of the three bits of [`EdgeData::info`] that mark the edges the outline pass draws
 /// for a large patch ([`Patches::splat`]).
-const INFO_SPLAT_SHIFT: u32 = 12;
+pub(crate) const INFO_SPLAT_SHIFT: u32 = 12;
 /// Bit of [`EdgeData::info`]: the triangle's patch crosses another surface of the mesh
 /// ([`Patches::crossed`]): its pixels take their lines from the outline pass only.
-const INFO_CROSSED: u32 = 1 << 29;
+pub(crate) const INFO_CROSSED: u32 = 1 << 29;
 /// Bit of [`EdgeData::info`]: the triangle's patch is a quad (two triangles), which the edge
 /// pass searches without a queue.
-const INFO_QUAD: u32 = 1 << 15;
+pub(crate) const INFO_QUAD: u32 = 1 << 15;
 
 /// First bit of [`EdgeData::info`] of a quad: its diagonal (edge 0–2, two bits), then the
 /// other triangle's corner off the diagonal (two bits), whether that triangle's next corner
 /// is the diagonal's start (one bit) and its drawn edges (three bits): `quad_of` in
 /// edge_pass.wgsl reads the other triangle from these, its id and one corner's position.
-const QUAD_SHIFT: u32 = 16;
+pub(crate) const QUAD_SHIFT: u32 = 16;
 
 /// Bits of [`EdgeData::info`] of a quad: its other triangle is stored right after this one
 /// ([`QUAD_NEXT`]) or right before it ([`QUAD_PREVIOUS`]), as the cluster order keeps the
 /// halves of a source quad ([`Mesh::quad_partners`]); with neither, `quad_of` reads it from
 /// the adjacency.
-const QUAD_NEXT: u32 = 1 << 24;
-const QUAD_PREVIOUS: u32 = 1 << 25;
+pub(crate) const QUAD_NEXT: u32 = 1 << 24;
+pub(crate) const QUAD_PREVIOUS: u32 = 1 << 25;
 
 /// [`INFO_QUAD`] and the bits after [`QUAD_SHIFT`] for triangle `t` of a two-triangle patch
 /// under edge mask `mask` (`stored` maps triangles to their stored places), or 0 (the
@@ -292,7 +292,7 @@ fn quad_bits(mesh: &Mesh, mask: &[u8], stored: &[u32], t: usize) -> u32 {
 /// First of the three bits of [`EdgeData::info`] that mark the drawn edges in a chain of more
 /// than one edge, whose pattern position the outline pass looks up ([`ChainRecords`]); an
 /// edge alone starts its pattern at its end that comes first, as its chain would.
-const INFO_CHAINED_SHIFT: u32 = 26;
+pub(crate) const INFO_CHAINED_SHIFT: u32 = 26;
 
 /// A mesh's edge data under one edge selection, in stored order.
 pub(crate) struct EdgeData {

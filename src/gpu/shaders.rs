@@ -100,14 +100,93 @@ pub fn assemble(parts: &[&str], flags: &[&str]) -> String {
     )
 }
 
-/// The constants the shaders share with the Rust side, declared from their Rust values.
-fn constants() -> String {
-    format!(
-        "const BACKGROUND_ID: u32 = {}u;\nconst HOST_ID: u32 = {}u;\n{}",
-        super::BACKGROUND_ID,
-        super::HOST_ID,
-        super::loop_budget::wgsl()
-    )
+/// The distance the shaders write where no edge is drawn: a finite sentinel, since WGSL has
+/// no infinity literal (`edge_math::NO_EDGE`, the f64 twins' "none", is infinite).
+pub(crate) const NO_EDGE: f32 = 3.0e38;
+
+/// Bits of an owner word above its instance slot (`OWNER_INSTANCE`): the class of the
+/// outline pass's line at a pixel.
+const OWNER_CLASS_SHIFT: u32 = crate::scene::MAX_INSTANCES.trailing_zeros();
+const _: () = assert!(crate::scene::MAX_INSTANCES.is_power_of_two());
+// The owner word shares a line key's low 20 bits with nothing: slot and class fit below.
+const _: () = assert!(OWNER_CLASS_SHIFT + 2 <= 20);
+
+/// Every constant the shaders share with the Rust side, declared in WGSL from its Rust
+/// value, so each is written once: the ids, the loop budget, the edge math's margins, the
+/// line key, the mesh records' bit layouts, the instance flags and the line classes.
+pub fn constants() -> String {
+    use super::frame as fr;
+    use super::mesh_records as mr;
+    use crate::edge_math as em;
+    use crate::world::LineClass;
+    let u32s: &[(&str, u32)] = &[
+        ("BACKGROUND_ID", super::BACKGROUND_ID),
+        ("HOST_ID", super::HOST_ID),
+        ("MAX_SECTIONS", crate::scene::MAX_SECTIONS as u32),
+        ("OWNER_INSTANCE", crate::scene::MAX_INSTANCES - 1),
+        ("OWNER_CUT", 1 << OWNER_CLASS_SHIFT),
+        ("OWNER_OUTLINE", 2 << OWNER_CLASS_SHIFT),
+        ("OWNER_INTERSECTION", 3 << OWNER_CLASS_SHIFT),
+        ("OWNER_CLASS", 3 << OWNER_CLASS_SHIFT),
+        ("LINE_CLASS_EDGE", LineClass::Edge as u32),
+        ("LINE_CLASS_OUTLINE", LineClass::Outline as u32),
+        ("LINE_CLASS_HIDDEN", LineClass::Hidden as u32),
+        ("LINE_CLASS_CUT", LineClass::Cut as u32),
+        ("LINE_CLASS_INTERSECTION", LineClass::Intersection as u32),
+        ("KEY_DISTANCE_MAX", crate::style::KEY_DISTANCE_MAX),
+        (
+            "CLUSTER_TRIANGLES",
+            crate::mesh::clusters::CLUSTER_TRIANGLES as u32,
+        ),
+        (
+            "PATCH_TRIANGLES",
+            crate::mesh::patches::PATCH_TRIANGLES as u32,
+        ),
+        ("INSTANCE_EDGES", fr::INSTANCE_EDGES),
+        ("INSTANCE_OUTLINES", fr::INSTANCE_OUTLINES),
+        ("INSTANCE_HIDDEN", fr::INSTANCE_HIDDEN),
+        ("INSTANCE_BEHIND_HOST", fr::INSTANCE_BEHIND_HOST),
+        ("INSTANCE_HIDDEN_EDGES", fr::INSTANCE_HIDDEN_EDGES),
+        ("INSTANCE_LISTED_EDGES", fr::INSTANCE_LISTED_EDGES),
+        ("INSTANCE_PHASES", fr::INSTANCE_PHASES),
+        ("INSTANCE_CROSSED", fr::INSTANCE_CROSSED),
+        ("PHASE_ENTRY_WORDS", fr::PHASE_ENTRY_WORDS),
+        ("PIECE_WORDS", super::targets::PIECE_WORDS),
+        ("NEIGHBOUR_INDEX", mr::MAX_MESH_TRIANGLES),
+        ("NEIGHBOUR_CORNER_SHIFT", mr::NEIGHBOUR_CORNER_SHIFT),
+        ("NEIGHBOUR_SAME_WAY", mr::NEIGHBOUR_SAME_WAY),
+        ("INFO_LARGE_PATCH", mr::INFO_LARGE_PATCH),
+        ("INFO_SPLAT_SHIFT", mr::INFO_SPLAT_SHIFT),
+        ("INFO_QUAD", mr::INFO_QUAD),
+        ("INFO_CHAINED_SHIFT", mr::INFO_CHAINED_SHIFT),
+        ("INFO_CROSSED", mr::INFO_CROSSED),
+        ("QUAD_EDGE_SHIFT", mr::QUAD_SHIFT),
+        ("QUAD_CORNER_SHIFT", mr::QUAD_SHIFT + 2),
+        ("QUAD_SAME", 1 << (mr::QUAD_SHIFT + 4)),
+        ("QUAD_MASK_SHIFT", mr::QUAD_SHIFT + 5),
+        ("QUAD_NEXT", mr::QUAD_NEXT),
+        ("QUAD_PREVIOUS", mr::QUAD_PREVIOUS),
+    ];
+    let f32s: &[(&str, f64)] = &[
+        ("NO_EDGE", f64::from(NO_EDGE)),
+        ("KEY_DISTANCE_STEPS", crate::style::KEY_DISTANCE_STEPS),
+        ("EDGE_ON", em::EDGE_ON),
+        ("EDGE_ON_MARGIN", crate::mesh::adjacency::EDGE_ON_MARGIN),
+        ("HIDDEN_MARGIN", em::HIDDEN_MARGIN),
+        ("CAP_MARGIN", em::CAP_MARGIN),
+        ("REACH_SLACK", em::REACH_SLACK),
+        ("DASH_SLACK", em::DASH_SLACK),
+        ("END_INSET", em::END_INSET),
+    ];
+    let mut out = String::new();
+    for (name, value) in u32s {
+        out += &format!("const {name}: u32 = {value}u;\n");
+    }
+    for (name, value) in f32s {
+        // Rounded to f32 here, so the literal is the value the shader holds.
+        out += &format!("const {name}: f32 = {:e};\n", *value as f32);
+    }
+    out + &super::loop_budget::wgsl()
 }
 
 /// The colour encoding of an output format: 8-bit unorm storage textures cannot be sRGB, so
@@ -180,5 +259,46 @@ mod tests {
         assert_eq!(lines(&["X"]), ["a", "b", "c", "f"]);
         assert_eq!(lines(&["X", "Y"]), ["a", "b", "d", "f"]);
         assert_eq!(specialise(src, &[]).lines().count(), src.lines().count());
+    }
+
+    /// The constants declared from Rust (`constants`) are the only declarations of their
+    /// names, each is used by some shader, and each f32 literal is a finite f32.
+    #[test]
+    fn shared_constants_are_declared_once_from_rust() {
+        let declared = constants();
+        let sources = [
+            COMMON, SCENE, VISIBILITY, EDGE_PASS, FLOOR, OUTLINE, FORWARD, TWO_PASS, COMPOSITE,
+            HOST_DEPTH,
+        ];
+        let mut names = std::collections::HashSet::new();
+        for line in declared.lines() {
+            let rest = line.strip_prefix("const ").expect("one declaration a line");
+            let (name, rest) = rest.split_once(':').unwrap();
+            assert!(names.insert(name.to_owned()), "{name} declared twice");
+            let pattern = format!("const {name}:");
+            for source in sources {
+                assert!(
+                    !source.contains(&pattern),
+                    "{name} is also declared in a .wgsl file"
+                );
+            }
+            let used = |s: &str| {
+                s.match_indices(name).any(|(i, _)| {
+                    let after = s[i + name.len()..].chars().next();
+                    let before = s[..i].chars().last();
+                    let word = |c: Option<char>| c.is_some_and(|c| c.is_alphanumeric() || c == '_');
+                    !word(after) && !word(before)
+                })
+            };
+            assert!(
+                sources.iter().any(|s| used(s)),
+                "{name} is declared but used by no shader"
+            );
+            if let Some(literal) = rest.strip_prefix(" f32 = ") {
+                let value: f32 = literal.trim_end_matches(';').parse().unwrap();
+                assert!(value.is_finite(), "{name} = {literal}");
+            }
+        }
+        assert!(names.contains("MAX_SECTIONS") && names.contains("LINE_CLASS_INTERSECTION"));
     }
 }

@@ -82,8 +82,9 @@ pub(crate) const LIST_HEADER: u64 = 16;
 /// of a 200 k-triangle sphere and of stanford-bunny list 1 151 and 4 900 on lavapipe).
 const PIXELS_PER_PIECE: u64 = 8;
 const MIN_PIECES: u64 = 1 << 16;
-/// Bytes per listed piece (outline.wgsl, PIECE_WORDS).
-const PIECE_BYTES: u64 = 16;
+/// Words per listed piece (outline.wgsl, `list_pieces`).
+pub(crate) const PIECE_WORDS: u32 = 4;
+const PIECE_BYTES: u64 = 4 * PIECE_WORDS as u64;
 
 /// Entries of the outline pass's piece list for targets of `size` (before the binding limit
 /// trims it).

@@ -13,8 +13,7 @@ use crate::gpu::targets::{clear_color, cleared, BACKGROUND_ID, DEPTH_FORMAT, ID_
 use crate::scene::Scene;
 use crate::style::Style;
 
-/// The distance the shaders write where no edge is drawn (WGSL `NO_EDGE`).
-pub(crate) const NO_EDGE: f32 = 3.0e38;
+pub(crate) use crate::gpu::shaders::NO_EDGE;
 
 /// Format of the forward passes' diagnostic map: the **bit patterns** of `f32` values
 /// (red = distance in pixels, green = reverse depth), because float render targets are not
