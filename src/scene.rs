@@ -198,6 +198,21 @@ impl InstanceStyle {
     /// Checks the overrides; `index` names the instance in errors.
     pub fn validate(&self, index: usize) -> Result<()> {
         let bad = |m: String| Err(Error::InvalidScene(format!("instance {index}: {m}")));
+        // Colours first: a highlight's colour is the outline's and its hidden part's, and
+        // is named as the outline's.
+        for (what, c) in [("wire", self.wire_color), ("outline", self.outline_color)] {
+            if let Some(c) = c {
+                if c.0.iter().any(|v| !v.is_finite()) {
+                    return bad(format!("{what} colour {:?} is not finite", c.0));
+                }
+            }
+        }
+        if self.outlines == Some(true) && self.outline_width == Some(0.0) {
+            return bad(
+                "outline width 0 with outlines on draws no outline (turn outlines off instead)"
+                    .into(),
+            );
+        }
         if let Some(Some(h)) = self.hidden {
             if let Err(e) = h.validate() {
                 return bad(e.to_string());
@@ -217,13 +232,6 @@ impl InstanceStyle {
                     return bad(format!(
                         "{what} width {w} is not in 0..={MAX_LINE_WIDTH} pixels"
                     ));
-                }
-            }
-        }
-        for (what, c) in [("wire", self.wire_color), ("outline", self.outline_color)] {
-            if let Some(c) = c {
-                if c.0.iter().any(|v| !v.is_finite()) {
-                    return bad(format!("{what} colour {:?} is not finite", c.0));
                 }
             }
         }
@@ -484,6 +492,35 @@ pub fn validate_sections(sections: &[SectionPlane]) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_highlight_that_cannot_draw_is_named_for_what_it_sets() {
+        let style = crate::Style::default();
+        let with = |h: Highlight| {
+            InstanceStyle::default()
+                .highlighted(&h, &style)
+                .validate(3)
+                .unwrap_err()
+                .to_string()
+        };
+        let zero = with(Highlight {
+            width: 0.0,
+            ..Highlight::default()
+        });
+        assert!(
+            zero.contains("instance 3") && zero.contains("outline width 0"),
+            "{zero}"
+        );
+        let nan = with(Highlight {
+            color: Color([f32::NAN, 0.0, 0.0, 1.0]),
+            ..Highlight::default()
+        });
+        assert!(nan.contains("outline colour"), "{nan}");
+        assert!(InstanceStyle::default()
+            .highlighted(&Highlight::default(), &style)
+            .validate(0)
+            .is_ok());
+    }
 
     #[test]
     fn objects_meet_where_their_placed_bounds_do() {

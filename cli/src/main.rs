@@ -99,7 +99,7 @@ struct SceneArgs {
     #[arg(long, default_value = "on", value_parser = parse_switch, action = clap::ArgAction::Set)]
     silhouettes: bool,
     /// Fade lines from full strength at view depth START to nothing at END (world units).
-    #[arg(long, value_name = "START:END", value_parser = parse_fade)]
+    #[arg(long, allow_hyphen_values = true, value_name = "START:END", value_parser = parse_fade)]
     depth_fade: Option<DepthFade>,
     /// Hidden lines (the parts of the drawn lines that surfaces hide): off, solid,
     /// dashed[:DASH,GAP] or dotted[:SPACING], lengths in pixels. Only deferred and raycast
@@ -119,13 +119,18 @@ struct SceneArgs {
     /// Draw object N (its place in the scene: a scene file's objects in order, a glTF
     /// scene's nodes) selected: its outline in orange, 3 px, dashed where other surfaces
     /// hide it, its fill tinted; repeat it, or give a list (0,2), for several.
-    #[arg(long, value_name = "N", value_delimiter = ',')]
+    #[arg(
+        long,
+        allow_hyphen_values = true,
+        value_name = "N",
+        value_delimiter = ','
+    )]
     highlight: Vec<usize>,
     /// A section plane through point (px, py, pz) with normal (nx, ny, nz), world
     /// coordinates: what lies behind it is cut away, back faces seen through the cut drawn
     /// as the section face; repeat it for up to 6 (a scene file's `sections` come first).
     /// Only deferred and raycast cut.
-    #[arg(long, value_name = "PX,PY,PZ,NX,NY,NZ", value_parser = parse_section)]
+    #[arg(long, allow_hyphen_values = true, value_name = "PX,PY,PZ,NX,NY,NZ", value_parser = parse_section)]
     section: Vec<wirepass::SectionPlane>,
     /// Colour of the section face (back faces seen through a cut), #rrggbb (sRGB).
     #[arg(long, default_value = "#d9a38c")]
@@ -437,7 +442,7 @@ struct PickArgs {
     #[arg(long, value_parser = parse_pixel)]
     at: (u32, u32),
     /// Snapping radius for the nearest drawn edge and vertex, in pixels.
-    #[arg(long, default_value = "8")]
+    #[arg(long, allow_hyphen_values = true, default_value = "8")]
     snap: f64,
 }
 
@@ -691,10 +696,10 @@ struct DiffArgs {
     /// Image to test against it (PNG).
     b: PathBuf,
     /// Largest accepted mean FLIP error (0..1).
-    #[arg(long, default_value_t = 0.001)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 0.001)]
     threshold_mean: f32,
     /// Largest accepted 99th-percentile FLIP error (0..1).
-    #[arg(long, default_value_t = 0.05)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 0.05)]
     threshold_p99: f32,
     /// Write the FLIP heat map (magma: black = same) to this PNG.
     #[arg(long)]

@@ -240,6 +240,29 @@ fn bad_settings_give_one_clear_line() {
     }
 }
 
+/// Every option that takes numbers takes negative ones, not only --eye.
+#[test]
+fn numbers_may_start_with_a_minus() {
+    let out = temp("minus.png");
+    let o = out.to_str().unwrap();
+    let (ok, err) = wirepass(&[
+        "render",
+        "--size",
+        "64x48",
+        "--section",
+        "-0.02,0.1,0,1,0,0",
+        "--eye",
+        "-2,1.5,3",
+        "--target",
+        "0,0,0",
+        "-o",
+        o,
+    ]);
+    assert!(ok, "{err}");
+    let (ok, err) = wirepass(&["render", "--highlight", "-1", "-o", o]);
+    assert!(!ok && err.contains("--highlight"), "{err}");
+}
+
 /// Runs `wirepass bench ARGS --out OUT` and returns its bench.json.
 fn bench_json(args: &[&str], out: &std::path::Path) -> serde_json::Value {
     let mut all = vec!["bench"];
