@@ -1,5 +1,5 @@
 //! The edge pass (compute, `shaders/edge_pass.wgsl`): per pixel, the exact distance to the
-//! visible lines and the composited colour. Six dispatches (README, "How it works"): classify
+//! visible lines and the composited colour. Six dispatches (docs/how-it-works.md): classify
 //! lists the 8×8 tiles with foreground and the background pixels next to it; border adds
 //! the guard band's; the background is cleared or written; then the outlined tiles, the
 //! listed tiles and the refine list write the output.

@@ -702,7 +702,7 @@ async fn the_viewer_page_draws_turns_and_shows_a_dropped_glb() {
     assert_eq!(changed(&hidden, uncut), 0.0, "the cut is not gone");
 }
 
-/// A frame's time in the page (the README quotes it beside the native one): not a test of
+/// A frame's time in the page (docs/browser.md quotes it beside the native one): not a test of
 /// speed, which no test asserts, but a reported figure must be measured, so it runs here.
 #[wasm_bindgen_test]
 async fn frame_time_of_the_builtin_scene() {

@@ -38,7 +38,7 @@ fn native_frames_match_the_references_and_the_ground_truth() {
 }
 
 /// A frame's time on the native adapter, measured as the browser test measures it (the
-/// README quotes both); printed, never asserted.
+/// browser docs, docs/browser.md, quote both); printed, never asserted.
 #[test]
 fn frame_time_of_the_builtin_scene() {
     let ctx = GpuContext::new().unwrap_or_else(|e| panic!("a native adapter: {e}"));
