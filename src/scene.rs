@@ -6,7 +6,6 @@
 
 use crate::camera::{Orbit, View};
 use crate::error::{Error, Result};
-use crate::gpu::MeshId;
 use crate::style::{Color, HiddenLines, LinePattern, MAX_LINE_WIDTH};
 use glam::{DMat4, DVec3};
 
@@ -14,6 +13,30 @@ use glam::{DMat4, DVec3};
 /// per-pixel owner word, whose next two say whether the line is an outline, a section's cut
 /// line or an edge.
 pub const MAX_INSTANCES: u32 = 1 << 18;
+
+/// A mesh in a [`MeshStore`](crate::gpu::MeshStore). Copy it into as many [`Instance`]s as
+/// you like: instances of one mesh share its storage and are drawn instanced. (Defined here,
+/// below the pass, so that a scene names meshes without depending on the store.)
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct MeshId {
+    /// The store that holds it (`MeshStore`'s own id).
+    pub(crate) store: u32,
+    pub(crate) slot: u32,
+    /// The slot's generation when the mesh went in: an id outlives its removal harmlessly.
+    pub(crate) generation: u32,
+}
+
+#[cfg(test)]
+impl MeshId {
+    /// An id of slot `slot` in no store.
+    pub(crate) fn unstored(slot: u32) -> MeshId {
+        MeshId {
+            store: 0,
+            slot,
+            generation: 0,
+        }
+    }
+}
 
 /// Per-instance departures from the frame's [`Style`](crate::Style); `None` keeps the
 /// style's setting.

@@ -256,6 +256,25 @@ impl LinePattern {
     }
 }
 
+/// The class of a line: what colours a pixel (`world::Rendering::line_class` with the
+/// `truth` feature, `--dump`'s `line_class.npy`), and the numbering the shaders use.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u8)]
+pub enum LineClass {
+    /// No line colours the pixel.
+    None = 0,
+    /// A drawn edge (the edges the selection draws).
+    Edge = 1,
+    /// An outline: a silhouette or a boundary.
+    Outline = 2,
+    /// A hidden line ([`Style::hidden`]).
+    Hidden = 3,
+    /// A section's cut line ([`SectionPlane`](crate::SectionPlane)).
+    Cut = 4,
+    /// An intersection line ([`Style::intersection_lines`]).
+    Intersection = 5,
+}
+
 /// Longest dash, gap or dot spacing a pattern may ask for, in pixels.
 pub const MAX_PATTERN_LENGTH: f32 = 4096.0;
 

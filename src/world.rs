@@ -260,20 +260,4 @@ pub struct Rendering {
     pub line_class: Vec<u8>,
 }
 
-/// The class of a pixel's line in [`Rendering::line_class`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[repr(u8)]
-pub enum LineClass {
-    /// No line colours the pixel.
-    None = 0,
-    /// A drawn edge (the edges the selection draws).
-    Edge = 1,
-    /// An outline: a silhouette or a boundary.
-    Outline = 2,
-    /// A hidden line ([`Style::hidden`](crate::Style::hidden)).
-    Hidden = 3,
-    /// A section's cut line ([`SectionPlane`]).
-    Cut = 4,
-    /// An intersection line ([`Style::intersection_lines`](crate::Style::intersection_lines)).
-    Intersection = 5,
-}
+pub use crate::style::LineClass;

@@ -5,12 +5,14 @@
 //! 1. `camera`, `style`, `mesh` (without its loaders)
 //! 2. `edge_math`
 //! 3. `mesh::formats`, the loaders
-//! 4. the pass: `gpu`, `scene`
-//! 5. `world`
-//! 6. `truth`, the ray-cast ground truth
-//! 7. `tools`
+//! 4. `scene`: what a frame draws
+//! 5. the pass: `gpu`
+//! 6. `world`
+//! 7. `truth`, the ray-cast ground truth
+//! 8. `tools`
 //!
-//! (`lib.rs` declares them all and is not checked.)
+//! (`lib.rs` declares them all and is not checked.) And no two files of a layer name each
+//! other, directly or round a longer circle: see `no_file_is_in_an_import_circle`.
 
 use std::path::{Path, PathBuf};
 
@@ -23,10 +25,11 @@ fn layer(path: &[&str]) -> Option<u32> {
         ["mesh", "formats", ..] => 3,
         ["mesh", ..] => 1,
         ["edge_math", ..] => 2,
-        ["gpu", ..] | ["scene", ..] => 4,
-        ["world", ..] => 5,
-        ["truth", ..] => 6,
-        ["tools", ..] => 7,
+        ["scene", ..] => 4,
+        ["gpu", ..] => 5,
+        ["world", ..] => 6,
+        ["truth", ..] => 7,
+        ["tools", ..] => 8,
         // The crate-level re-exports of the core types: `crate::Error`, `crate::Mesh`, ….
         [name, ..] if name.starts_with(char::is_uppercase) => 0,
         _ => return None,
@@ -160,4 +163,241 @@ fn the_scan_finds_paths_and_groups_but_not_comments() {
                   let x = crate::truth::draw(a); my_crate::other();\n";
     let found: Vec<String> = crate_paths(source).iter().map(|p| p.join("::")).collect();
     assert_eq!(found, ["gpu", "error::Result", "mesh::Mesh", "truth::draw"]);
+}
+
+/// The items a file declares (`pub`, `pub(crate)` or private: structs, enums, traits,
+/// types, functions, constants and statics at any indentation).
+fn declared_items(source: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    for line in source.lines() {
+        let mut t = line.trim_start();
+        for prefix in ["pub(crate) ", "pub(super) ", "pub "] {
+            t = t.strip_prefix(prefix).unwrap_or(t);
+        }
+        for keyword in [
+            "struct ", "enum ", "trait ", "type ", "fn ", "const ", "static ",
+        ] {
+            if let Some(rest) = t.strip_prefix(keyword) {
+                let name: String = rest
+                    .chars()
+                    .take_while(|c| c.is_alphanumeric() || *c == '_')
+                    .collect();
+                if !name.is_empty() {
+                    out.push(name);
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Every module path a file's code names, made absolute (below `crate`): `crate::a::b::C`,
+/// `super::x::Y` and `self::z`, with `use` groups spread out, each as its segments.
+fn named_paths(source: &str, module: &[String], is_mod_file: bool) -> Vec<Vec<String>> {
+    // The module `super` names: a `mod.rs` is its folder's module, other files are one below.
+    let here: Vec<String> = module.to_vec();
+    let parent: Vec<String> = if is_mod_file {
+        module[..module.len().saturating_sub(1)].to_vec()
+    } else {
+        here[..here.len().saturating_sub(1)].to_vec()
+    };
+    let this: Vec<String> = if is_mod_file {
+        here.clone()
+    } else {
+        parent.clone()
+    };
+    let mut out = Vec::new();
+    for line in source.lines() {
+        let code = line.split("//").next().unwrap_or("");
+        for (prefix, base) in [
+            ("crate::", Vec::new()),
+            ("super::", parent.clone()),
+            ("self::", this.clone()),
+        ] {
+            let mut rest = code;
+            while let Some(at) = rest.find(prefix) {
+                let preceded = rest[..at]
+                    .chars()
+                    .last()
+                    .is_some_and(|c| c.is_alphanumeric() || c == '_' || c == ':');
+                let after = &rest[at + prefix.len()..];
+                rest = after;
+                if preceded {
+                    continue;
+                }
+                let raw: String = after
+                    .chars()
+                    .take_while(|c| c.is_alphanumeric() || *c == '_' || *c == ':')
+                    .collect();
+                let stem: Vec<String> = raw
+                    .split("::")
+                    .filter(|s| !s.is_empty())
+                    .map(str::to_owned)
+                    .collect();
+                let group = after[raw.len()..].strip_prefix('{');
+                let mut push = |tail: Vec<String>| {
+                    let mut path = base.clone();
+                    path.extend(stem.iter().cloned());
+                    path.extend(tail);
+                    out.push(path);
+                };
+                match group {
+                    Some(group) => {
+                        for item in group.split('}').next().unwrap_or("").split(',') {
+                            let tail: Vec<String> = item
+                                .split(" as ")
+                                .next()
+                                .unwrap_or("")
+                                .trim()
+                                .split("::")
+                                .filter(|s| !s.is_empty() && *s != "self" && *s != "*")
+                                .map(str::to_owned)
+                                .collect();
+                            push(tail);
+                        }
+                    }
+                    None => push(Vec::new()),
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The files of `src/` name one another only downwards: no file reaches itself through the
+/// files it names. A path is taken to the file of its longest module prefix, and a name
+/// through a folder's `mod.rs` (a re-export) to the file of that folder that declares it;
+/// `mod.rs` files themselves only declare and re-export, so edges from them are left out.
+#[test]
+fn no_file_is_in_an_import_circle() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut files = Vec::new();
+    rust_files(&src, &mut files);
+    files.sort();
+    let modules: Vec<Vec<String>> = files.iter().map(|f| module_of(&src, f)).collect();
+    // The code a file builds into the library: its unit tests (a `#[cfg(test)]` module, at
+    // the end) may name what they like.
+    let sources: Vec<String> = files
+        .iter()
+        .map(|f| {
+            let s = std::fs::read_to_string(f).unwrap();
+            match s.find("#[cfg(test)]\nmod tests") {
+                Some(at) => s[..at].to_owned(),
+                None => s,
+            }
+        })
+        .collect();
+    let items: Vec<Vec<String>> = sources.iter().map(|s| declared_items(s)).collect();
+    let is_hub = |i: usize| {
+        files[i]
+            .file_name()
+            .is_some_and(|n| n == "mod.rs" || n == "lib.rs")
+    };
+    let index_of = |path: &[String]| modules.iter().position(|m| m.as_slice() == path);
+    // The file a path names.
+    let resolve = |path: &[String]| -> Option<usize> {
+        let (len, file) = (0..=path.len())
+            .rev()
+            .find_map(|k| index_of(&path[..k]).map(|i| (k, i)))?;
+        if !is_hub(file) || len == path.len() {
+            return Some(file);
+        }
+        // A name re-exported by a folder's mod.rs: the one file of the folder declaring it.
+        let name = &path[len];
+        let folder = &modules[file];
+        let declaring: Vec<usize> = (0..files.len())
+            .filter(|&j| j != file && modules[j].starts_with(folder) && items[j].contains(name))
+            .collect();
+        match declaring.as_slice() {
+            [one] => Some(*one),
+            _ => Some(file),
+        }
+    };
+    let lib = index_of(&["lib".to_owned()]);
+    let mut edges: Vec<Vec<usize>> = vec![Vec::new(); files.len()];
+    for i in 0..files.len() {
+        if is_hub(i) {
+            continue;
+        }
+        let is_mod = false;
+        for path in named_paths(&sources[i], &modules[i], is_mod) {
+            if let Some(j) = resolve(&path) {
+                if j != i && Some(j) != lib && !edges[i].contains(&j) {
+                    edges[i].push(j);
+                }
+            }
+        }
+    }
+    let linked: usize = edges.iter().map(Vec::len).sum();
+    assert!(
+        linked > 150,
+        "only {linked} links between files: is the scan broken?"
+    );
+    // Depth-first search for a back edge; the circle is the stack from its target.
+    let name = |i: usize| files[i].strip_prefix(&src).unwrap().display().to_string();
+    let mut state = vec![0u8; files.len()]; // 0 new, 1 on the stack, 2 done
+    let mut circles = Vec::new();
+    fn visit(
+        i: usize,
+        edges: &[Vec<usize>],
+        state: &mut [u8],
+        stack: &mut Vec<usize>,
+        circles: &mut Vec<Vec<usize>>,
+    ) {
+        state[i] = 1;
+        stack.push(i);
+        for &j in &edges[i] {
+            if state[j] == 1 {
+                let from = stack.iter().position(|&k| k == j).unwrap();
+                circles.push(stack[from..].to_vec());
+            } else if state[j] == 0 {
+                visit(j, edges, state, stack, circles);
+            }
+        }
+        stack.pop();
+        state[i] = 2;
+    }
+    for i in 0..files.len() {
+        if state[i] == 0 {
+            visit(i, &edges, &mut state, &mut Vec::new(), &mut circles);
+        }
+    }
+    let described: Vec<String> = circles
+        .iter()
+        .map(|c| {
+            let mut names: Vec<String> = c.iter().map(|&i| name(i)).collect();
+            names.push(name(c[0]));
+            names.join(" → ")
+        })
+        .collect();
+    assert!(
+        described.is_empty(),
+        "import circles:\n{}",
+        described.join("\n")
+    );
+}
+
+#[test]
+fn paths_are_made_absolute_and_groups_spread() {
+    let module = ["gpu".to_owned(), "frame".to_owned()];
+    let source = "use super::{canvas::Region, mesh_store::MeshStore as S};\n\
+                  use crate::scene::Scene;\n\
+                  let x = self::helper(); // super::ignored\n";
+    let found: Vec<String> = named_paths(source, &module, false)
+        .iter()
+        .map(|p| p.join("::"))
+        .collect();
+    assert_eq!(
+        found,
+        [
+            "gpu::canvas::Region",
+            "gpu::mesh_store::MeshStore",
+            "scene::Scene",
+            "gpu::helper"
+        ]
+    );
+    assert_eq!(
+        declared_items("pub(crate) fn f() {}\n    const K: u32 = 1;"),
+        ["f", "K"]
+    );
 }

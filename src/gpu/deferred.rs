@@ -9,6 +9,7 @@ use super::composite::{Composite, CompositePipeline, FrameComposite, HostSamples
 use super::edge_pass::{round_to_half, EdgePass};
 use super::frame::{FrameData, FrameRecords};
 use super::host_depth::{HostFrame, HostImport};
+use super::instance_crossings::PairCache;
 use super::mesh_store::MeshStore;
 use super::options::{OutputTarget, PassOptions, TriangleIds};
 use super::outline_pass::{piece_size_at, OutlinePass};
@@ -297,6 +298,9 @@ pub struct DeferredPass {
     piece_room: Option<u64>,
     targets: Option<Targets>,
     cull: Option<wgpu::Buffer>,
+    /// The intersection lines of instance pairs found for recent frames
+    /// (`instance_crossings.rs`), kept while the pairs' placements stay.
+    pairs: PairCache,
 }
 
 /// What [`DeferredPass::warm_up`] did: the pipelines it built and the time it took. A
@@ -364,6 +368,7 @@ impl DeferredPass {
             piece_room: None,
             targets: None,
             cull: None,
+            pairs: PairCache::default(),
         })
     }
 
@@ -422,7 +427,15 @@ impl DeferredPass {
         } else {
             style
         };
-        let records = FrameRecords::new(device, store, scene, style, region, true)?;
+        let records = FrameRecords::new(
+            device,
+            store,
+            scene,
+            style,
+            region,
+            true,
+            Some(&mut self.pairs),
+        )?;
         let mut data = FrameData::new(device, store, records);
         // The diagnostic map names the class of each pixel's line, which the outline pass's
         // owner words tell apart (the image is the same with them; the outline buffer takes

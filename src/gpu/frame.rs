@@ -4,6 +4,7 @@
 //! same scene the same way.
 
 use super::canvas::Region;
+use super::instance_crossings::PairCache;
 use super::mesh_store::{MeshRecord, MeshStore, StoreBuffers};
 use crate::camera::View;
 use crate::error::{Error, Result};
@@ -281,6 +282,8 @@ pub(crate) struct ChainWork {
 impl FrameRecords {
     /// Validates the scene, style and region against the device and the store, and builds
     /// the frame's records; with `guarded`, the targets have a guard band ([`guard_band`]).
+    /// The intersection lines of instance pairs are kept in `pairs` from frame to frame,
+    /// where the caller keeps one (the deferred pass does).
     pub fn new(
         device: &wgpu::Device,
         store: &MeshStore,
@@ -288,6 +291,7 @@ impl FrameRecords {
         style: &Style,
         region: Region,
         guarded: bool,
+        pairs: Option<&mut PairCache>,
     ) -> Result<FrameRecords> {
         region.validate()?;
         scene.validate()?;
@@ -485,7 +489,8 @@ impl FrameRecords {
             for (slot, &i) in order.iter().enumerate() {
                 slot_of[i as usize] = slot as u32;
             }
-            let mut cache = store.pair_cache();
+            let mut fresh = PairCache::default();
+            let cache = pairs.unwrap_or(&mut fresh);
             cache.begin_frame();
             for (i, j) in crate::scene::crossing_pairs(&placed) {
                 let (a, b) = (&scene.instances[i], &scene.instances[j]);

@@ -7,12 +7,50 @@
 // `!(a > b)` is deliberate throughout: NaN must take the rejecting branch.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-use super::mesh_store::UploadReport;
 use crate::mesh::par::join;
 use crate::mesh::{adjacency::NO_NEIGHBOUR, patches::Patches, EdgeSelection, Mesh, ALL_EDGES};
 use glam::{DVec3, Vec2, Vec3};
 use std::sync::Arc;
+use std::time::Duration;
 use web_time::Instant;
+
+/// What inserting a mesh into a [`MeshStore`](super::MeshStore) took, step by step
+/// ([`MeshStore::upload_report`](super::MeshStore::upload_report)). A step the mesh had already done (its adjacency, say,
+/// asked for before) takes no time here. The crossings are found beside the adjacency,
+/// hints and clusters (on another core, with the `parallel` feature), so the steps' times
+/// may add up to more than the insert's.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct UploadReport {
+    /// Edge adjacency: the triangle across each edge, vertices welded by position.
+    pub adjacency: Duration,
+    /// The outline hints: how far each triangle's edges fold.
+    pub outline_hints: Duration,
+    /// The clusters of 64 triangles and their bounds.
+    pub clusters: Duration,
+    /// The triangles that cross others of the mesh, and their intersection lines.
+    pub crossings: Duration,
+    /// The edge selection's patches, chains and per-triangle edge data.
+    pub edges: Duration,
+    /// The store's records: packed vertices, triangles in cluster order, neighbour words.
+    pub records: Duration,
+    /// Writing the records into the store's buffers (queued, not yet on the GPU).
+    pub upload: Duration,
+    /// Bytes written to the GPU.
+    pub gpu_bytes: u64,
+}
+
+impl UploadReport {
+    /// The steps' times added up.
+    pub fn total(&self) -> Duration {
+        self.adjacency
+            + self.outline_hints
+            + self.clusters
+            + self.crossings
+            + self.edges
+            + self.records
+            + self.upload
+    }
+}
 
 /// The packed normal of a vertex without one (a zero normal, next to degenerate triangles
 /// only): both components at the snorm code that unpacking clamps, which no unit vector

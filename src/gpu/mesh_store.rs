@@ -18,16 +18,15 @@
 // `!(a > b)` is deliberate throughout: NaN must take the rejecting branch.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-use super::instance_crossings::PairCache;
 use super::mesh_records::{
-    cluster_records, EdgeData, MeshData, MeshLines, StoredCrossing, MAX_MESH_TRIANGLES,
+    cluster_records, EdgeData, MeshData, MeshLines, StoredCrossing, UploadReport,
+    MAX_MESH_TRIANGLES,
 };
 use crate::error::{Error, Result};
 use crate::mesh::{EdgeSelection, Mesh};
 use glam::{DMat4, DVec3, Vec3};
 use std::sync::atomic::{AtomicU32, Ordering};
-use std::sync::{Arc, Mutex};
-use std::time::Duration;
+use std::sync::Arc;
 use web_time::Instant;
 
 /// Bytes per stored vertex: position (3 × f32) and packed normal.
@@ -43,64 +42,7 @@ pub(crate) const CHAIN_BYTES: u64 = 16;
 /// naming the binding limit).
 pub(crate) const SPLIT_STORAGE_BUFFERS: u32 = 11;
 
-/// What inserting a mesh into a [`MeshStore`] took, step by step
-/// ([`MeshStore::upload_report`]). A step the mesh had already done (its adjacency, say,
-/// asked for before) takes no time here. The crossings are found beside the adjacency,
-/// hints and clusters (on another core, with the `parallel` feature), so the steps' times
-/// may add up to more than the insert's.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct UploadReport {
-    /// Edge adjacency: the triangle across each edge, vertices welded by position.
-    pub adjacency: Duration,
-    /// The outline hints: how far each triangle's edges fold.
-    pub outline_hints: Duration,
-    /// The clusters of 64 triangles and their bounds.
-    pub clusters: Duration,
-    /// The triangles that cross others of the mesh, and their intersection lines.
-    pub crossings: Duration,
-    /// The edge selection's patches, chains and per-triangle edge data.
-    pub edges: Duration,
-    /// The store's records: packed vertices, triangles in cluster order, neighbour words.
-    pub records: Duration,
-    /// Writing the records into the store's buffers (queued, not yet on the GPU).
-    pub upload: Duration,
-    /// Bytes written to the GPU.
-    pub gpu_bytes: u64,
-}
-
-impl UploadReport {
-    /// The steps' times added up.
-    pub fn total(&self) -> Duration {
-        self.adjacency
-            + self.outline_hints
-            + self.clusters
-            + self.crossings
-            + self.edges
-            + self.records
-            + self.upload
-    }
-}
-
-/// A mesh in a [`MeshStore`]. Copy it into as many [`Instance`](crate::Instance)s as you
-/// like: instances of one mesh share its storage and are drawn instanced.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct MeshId {
-    store: u32,
-    slot: u32,
-    generation: u32,
-}
-
-#[cfg(test)]
-impl MeshId {
-    /// An id of slot `slot` in no store.
-    pub(crate) fn unstored(slot: u32) -> MeshId {
-        MeshId {
-            store: 0,
-            slot,
-            generation: 0,
-        }
-    }
-}
+pub use crate::scene::MeshId;
 
 /// Where one mesh lives in the arena, and how its stored coordinates map to its own.
 #[derive(Clone, Debug)]
@@ -301,8 +243,6 @@ pub struct MeshStore {
     free_slots: Vec<u32>,
     /// Bumped whenever stored data may be overwritten under frames prepared earlier.
     version: u64,
-    /// The intersection lines of instance pairs found for recent frames.
-    pairs: Mutex<PairCache>,
 }
 
 impl MeshStore {
@@ -371,7 +311,6 @@ impl MeshStore {
             slots: Vec::new(),
             free_slots: Vec::new(),
             version: 0,
-            pairs: Mutex::default(),
         }
     }
 
@@ -569,12 +508,6 @@ impl MeshStore {
             Some((generation, Some(record))) if *generation == id.generation => Ok(record),
             _ => Err(Error::Misuse("the mesh was removed from the store".into())),
         }
-    }
-
-    /// The intersection lines of instance pairs found for recent frames.
-    pub(crate) fn pair_cache(&self) -> std::sync::MutexGuard<'_, PairCache> {
-        // The cache only ever holds whole entries, so one left by a panicking thread is sound.
-        self.pairs.lock().unwrap_or_else(|e| e.into_inner())
     }
 
     pub(crate) fn version(&self) -> u64 {

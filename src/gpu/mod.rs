@@ -55,7 +55,8 @@ pub use diagnostics::EncodeOptions;
 pub(crate) use frame::light_world_dir;
 #[cfg(feature = "truth")]
 pub(crate) use host_depth::depth_quantum;
-pub use mesh_store::{MeshId, MeshStore, UploadReport};
+pub use mesh_records::UploadReport;
+pub use mesh_store::{MeshId, MeshStore};
 // For the tools' OpenGL baseline, which draws the same store and records.
 pub use options::{OutputTarget, PassOptions, TriangleIds, Tuning};
 pub use pick::{

@@ -41,16 +41,6 @@ struct Intersections {
     list: Compute,
 }
 
-/// The shader flags of variant `v`'s outline module, with pieces of 1 px for a GPU
-/// (`short_pieces`, [`Tuning`](super::Tuning)).
-pub(crate) fn outline_flags(v: Variant, short_pieces: bool) -> Vec<&'static str> {
-    let mut flags = v.flags();
-    if short_pieces {
-        flags.push("SHORT_PIECES");
-    }
-    flags
-}
-
 /// Where the piece dispatch's size lies in a frame's cluster list buffer: after the cluster
 /// list (header, then two words per cluster).
 pub(crate) fn piece_size_at(data: &FrameData) -> u64 {
@@ -137,7 +127,7 @@ impl OutlinePass {
             return Ok(p.clone());
         }
         let scope = crate::gpu::validation::Validation::begin(device);
-        let source = shaders::outline_source(&outline_flags(v, self.short_pieces));
+        let source = shaders::outline_source(&v.outline_flags(self.short_pieces));
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("wirepass outline pass"),
             source: wgpu::ShaderSource::Wgsl(source.into()),

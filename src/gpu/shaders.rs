@@ -118,7 +118,7 @@ pub fn constants() -> String {
     use super::frame as fr;
     use super::mesh_records as mr;
     use crate::edge_math as em;
-    use crate::world::LineClass;
+    use crate::style::LineClass;
     let u32s: &[(&str, u32)] = &[
         ("BACKGROUND_ID", super::BACKGROUND_ID),
         ("HOST_ID", super::HOST_ID),

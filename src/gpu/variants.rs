@@ -160,6 +160,16 @@ impl Variant {
         .filter_map(|(on, flag)| on.then_some(flag))
         .collect()
     }
+
+    /// The WGSL flags of this variant's outline module, with pieces of 1 px for a GPU
+    /// (`short_pieces`, [`Tuning`](super::Tuning)).
+    pub(crate) fn outline_flags(self, short_pieces: bool) -> Vec<&'static str> {
+        let mut flags = self.flags();
+        if short_pieces {
+            flags.push("SHORT_PIECES");
+        }
+        flags
+    }
 }
 
 /// Every module the crate builds, named by its settings: each pass in each of its
@@ -213,7 +223,7 @@ pub fn shader_modules() -> Vec<(String, String)> {
     for v in variants.iter().filter(|v| v.outlines) {
         // Both tunings (`Tuning`).
         for short in [false, true] {
-            let flags = super::outline_pass::outline_flags(*v, short);
+            let flags = v.outline_flags(short);
             out.push((format!("outline {flags:?}"), outline_source(&flags)));
         }
     }

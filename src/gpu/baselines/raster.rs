@@ -149,7 +149,15 @@ impl RasterFrame {
         style: &Style,
         size: (u32, u32),
     ) -> Result<RasterFrame> {
-        let records = FrameRecords::new(device, store, scene, style, Region::whole(size), false)?;
+        let records = FrameRecords::new(
+            device,
+            store,
+            scene,
+            style,
+            Region::whole(size),
+            false,
+            None,
+        )?;
         let data = FrameData::new(device, store, records);
         let make = |label, format, usage| texture_2d(device, label, size, format, usage);
         use wgpu::TextureUsages as U;

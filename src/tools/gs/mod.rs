@@ -226,7 +226,15 @@ impl GsPass {
         style: &Style,
         (size, maps): ((u32, u32), bool),
     ) -> Result<GsFrame> {
-        let records = FrameRecords::new(device, store, scene, style, Region::whole(size), false)?;
+        let records = FrameRecords::new(
+            device,
+            store,
+            scene,
+            style,
+            Region::whole(size),
+            false,
+            None,
+        )?;
         let version = (store.store_id(), store.version());
         if self.store.as_ref().map(|s| s.version) != Some(version) {
             if let Some(old) = self.store.take() {
