@@ -104,6 +104,7 @@ fn encoded(world: World, canvas: Option<&wgpu::Texture>) -> Frame {
         view: PickView {
             view,
             image: SIZE,
+            vertices: wirepass::gpu::SnapVertices::Any,
             sections: Vec::new(),
         },
     }
@@ -315,6 +316,40 @@ f 1 2 3 4\nf 2 5 3\nf 5 6 7 8 9\n";
     // None within a radius of zero.
     let at = locate(&hit, px, 0.0);
     assert_eq!((at.vertex, at.edge), (None, None));
+}
+
+/// A CAD host snaps to the ends of drawn edges only (`SnapVertices::OnDrawnEdges`): on a flat
+/// grid whose feature edges are its boundary, an interior vertex under the cursor snaps with
+/// `Any` and not with `OnDrawnEdges`, and a boundary corner snaps with either.
+#[test]
+fn vertices_on_no_drawn_edge_can_be_left_out_of_snapping() {
+    use wirepass::gpu::SnapVertices;
+    let ctx = common::gpu();
+    // 4 × 4 cells over [-1, 1]²: vertex 12 is the centre, vertex 0 the corner (-1, -1).
+    let grid = wirepass::mesh::grid(32).unwrap();
+    let edges = EdgeSelection::Feature(30.0);
+    let f = encoded(World::single(grid, edges), None);
+    let mesh = &f.world.meshes[0].mesh;
+    let snapped = |v: usize, offset: (f64, f64), vertices: SnapVertices| {
+        let ((sx, sy), _) = on_screen(&f.view, mesh.positions()[v].as_dvec3());
+        let px = ((sx + offset.0) as u32, (sy + offset.1) as u32);
+        let Picked::Instance(hit) = f
+            .frame
+            .pick(&ctx.device, &ctx.queue, &f.up.store, &f.scene, px)
+            .unwrap()
+        else {
+            panic!("no triangle next to vertex {v}");
+        };
+        let view = f.view.clone().snapping_to(vertices);
+        let at = hit
+            .locate(mesh, edges, DMat4::IDENTITY, &view, px, 3.0)
+            .unwrap();
+        at.vertex.map(|s| s.vertex)
+    };
+    assert_eq!(mesh.positions()[12], wirepass::glam::Vec3::ZERO);
+    assert_eq!(snapped(12, (1.0, 1.0), SnapVertices::Any), Some(12));
+    assert_eq!(snapped(12, (1.0, 1.0), SnapVertices::OnDrawnEdges), None);
+    assert_eq!(snapped(0, (1.0, -1.0), SnapVertices::OnDrawnEdges), Some(0));
 }
 
 #[test]

@@ -60,7 +60,8 @@ pub use mesh_store::{MeshId, MeshStore};
 // For the tools' OpenGL baseline, which draws the same store and records.
 pub use options::{OutputTarget, PassOptions, TriangleIds, Tuning};
 pub use pick::{
-    EdgeSnap, InstanceHit, Location, PickView, Picked, PickedIds, RectPick, VertexSnap,
+    EdgeSnap, InstanceHit, Location, PickView, Picked, PickedIds, RectPick, SnapVertices,
+    VertexSnap,
 };
 #[cfg(not(target_arch = "wasm32"))]
 pub use readback::read_texture;

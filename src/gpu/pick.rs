@@ -281,9 +281,38 @@ pub struct PickView {
     /// The scene's section planes ([`Scene::sections`](crate::Scene::sections)): what they
     /// cut away is neither located nor snapped to.
     pub sections: Vec<crate::SectionPlane>,
+    /// Which vertices [`Location::vertex`] snaps to.
+    pub vertices: SnapVertices,
+}
+
+/// Which vertices a pick snaps to ([`PickView::vertices`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum SnapVertices {
+    /// Any vertex of the surface round the picked triangle.
+    #[default]
+    Any,
+    /// Only the ends of drawn edges (the edge selection the mesh was inserted with), as a
+    /// CAD host snaps to the corners of the lines it shows.
+    OnDrawnEdges,
 }
 
 impl PickView {
+    /// How `scene` is seen in an image of `image` pixels: its view and its section planes,
+    /// snapping to any vertex.
+    pub fn new(scene: &Scene<'_>, image: (u32, u32)) -> PickView {
+        PickView {
+            view: scene.view,
+            image,
+            sections: scene.sections.clone(),
+            vertices: SnapVertices::Any,
+        }
+    }
+
+    /// This view, snapping to `vertices`.
+    pub fn snapping_to(self, vertices: SnapVertices) -> PickView {
+        PickView { vertices, ..self }
+    }
+
     /// The pixel position, in image pixels, of world point `p` (x right, y down), or `None`
     /// behind the eye.
     fn screen(&self, p: DVec3) -> Option<(DVec2, f64)> {
@@ -419,7 +448,13 @@ impl InstanceHit {
             let mask = mesh.triangle_edge_mask(u, edges);
             for i in 0..3 {
                 let (p, q) = (tri[i], tri[(i + 1) % 3]);
-                if let Some((sp, _)) = view.screen(world(p)).filter(|_| kept(world(p))) {
+                // Corner i ends edges i and i + 2.
+                let on_drawn = mask & (1 << i | 1 << ((i + 2) % 3)) != 0;
+                let snappable = on_drawn || view.vertices == SnapVertices::Any;
+                if let Some((sp, _)) = view
+                    .screen(world(p))
+                    .filter(|_| snappable && kept(world(p)))
+                {
                     let d = sp.distance(centre);
                     if d <= snap_radius && vertex.is_none_or(|v| d < v.distance_px) {
                         vertex = Some(VertexSnap {

@@ -105,6 +105,7 @@ pub fn pick(ctx: &GpuContext, shot: &Shot<'_>, at: (u32, u32), snap: f64) -> Res
     let pick_view = PickView {
         view: shot.view,
         image: shot.size,
+        vertices: crate::gpu::SnapVertices::Any,
         sections: shot.world.sections.clone(),
     };
     let at = hit.locate(

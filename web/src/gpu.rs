@@ -314,6 +314,7 @@ impl Gpu {
         let view = PickView {
             view: scene.view,
             image: frame.output_size(),
+            vertices: wirepass::gpu::SnapVertices::Any,
             sections: scene.sections.clone(),
         };
         let l = hit

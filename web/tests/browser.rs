@@ -260,6 +260,7 @@ async fn picking_works_in_the_page() {
     let pick_view = PickView {
         view: case.view,
         image: cases::SIZE,
+        vertices: wirepass::gpu::SnapVertices::Any,
         sections: Vec::new(),
     };
     let (mut foreground, mut agree, mut raster_agree, mut worst_depth) =
