@@ -501,6 +501,7 @@ impl Viewer {
         let view = PickView {
             view: scene.view,
             image: frame.output_size(),
+            vertices: wirepass::gpu::SnapVertices::Any,
             sections: scene.sections.clone(),
         };
         let edges = EDGES[self.edges].1;
