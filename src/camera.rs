@@ -54,6 +54,7 @@ pub struct View {
     pub depth: DepthRange,
 }
 
+#[cfg_attr(not(feature = "truth"), doc(hidden))]
 /// A view's clip transform in the form the passes use, for one model matrix: the rows
 /// giving clip x, y and w, a row that is ≥ 0 exactly in front of the near plane, and a
 /// reverse depth row that is ≥ 0 exactly before the far plane, with (reverse depth)/w equal
@@ -261,7 +262,20 @@ fn null_vector(p: DMat4) -> DVec4 {
 }
 
 /// A perspective look-at camera: the convenience the tools and the CLI use. Angles in
-/// degrees; `near`/`far` are view-space distances, and `far` may be infinite.
+/// degrees; `near`/`far` are view-space distances, and `far` may be infinite. A host with
+/// its own camera passes its matrices as a [`View`] instead.
+///
+/// ```
+/// use wirepass::glam::DVec3;
+/// use wirepass::{Camera, DepthRange};
+/// // Frame a box at a 16:9 aspect; the view is standard depth (0 near, 1 far).
+/// let camera = Camera::framing(DVec3::splat(-1.0), DVec3::ONE, 16.0 / 9.0);
+/// let view = camera.to_view(16.0 / 9.0);
+/// assert_eq!(view.depth, DepthRange::Standard);
+/// // The box's centre lies in front of the eye, in the middle of the image.
+/// let c = view.view_projection() * DVec3::ZERO.extend(1.0);
+/// assert!(c.w > 0.0 && (c.x / c.w).abs() < 1e-9 && (c.y / c.w).abs() < 1e-9);
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
     /// Eye position in world space.

@@ -73,14 +73,19 @@
 //! ## Layers
 //!
 //! Each depends only on those before it (a test checks every file): [`error`]; the frame's
-//! terms ([`camera`], [`style`]) and [`mesh`]; [`edge_math`]; the loaders
+//! terms ([`camera`], [`style`]) and [`mesh`]; `edge_math`; the loaders
 //! (`mesh::formats`); the pass ([`scene`], [`gpu`]); the world of meshes tools draw
 //! (`world`); the ground truth (`truth`); the tools (`tools`).
 
 #![warn(missing_docs)]
 
 pub mod camera;
+// The f64 twins of the shaders' edge math: public for the ground truth and the tests.
+#[cfg(feature = "truth")]
 pub mod edge_math;
+#[cfg(not(feature = "truth"))]
+#[allow(dead_code, unused_imports)]
+pub(crate) mod edge_math;
 pub mod error;
 pub mod gpu;
 pub mod mesh;

@@ -40,6 +40,21 @@ impl MeshId {
 
 /// Per-instance departures from the frame's [`Style`](crate::Style); `None` keeps the
 /// style's setting.
+///
+/// ```
+/// use wirepass::{Color, InstanceStyle, Style};
+/// // This part in red with wider lines and no outline; everything else as the frame's.
+/// let part = InstanceStyle {
+///     wire_color: Some(Color::from_hex("#c02020")?),
+///     line_width: Some(2.5),
+///     outlines: Some(false),
+///     ..InstanceStyle::default()
+/// };
+/// let style = Style::default();
+/// assert_eq!(part.outline_width_in(&style), 2.5);
+/// assert!(part.validate(0).is_ok());
+/// # Ok::<(), wirepass::Error>(())
+/// ```
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct InstanceStyle {
     /// Colour of this instance's lines (its edges and its outline).
@@ -267,6 +282,7 @@ impl InstanceStyle {
     }
 }
 
+#[cfg_attr(not(feature = "truth"), doc(hidden))]
 /// Checks a model transform: finite, affine (last row 0, 0, 0, 1) and not singular.
 /// `index` names the instance in errors.
 pub fn check_transform(t: &DMat4, index: usize) -> Result<()> {
@@ -286,6 +302,7 @@ pub fn check_transform(t: &DMat4, index: usize) -> Result<()> {
     Ok(())
 }
 
+#[cfg_attr(not(feature = "truth"), doc(hidden))]
 /// Per placed object (its model-space bounds and model → world transform), whether its
 /// world-space bounds meet another's: the objects that may pass through each other, whose
 /// drawn edges both passes then draw only where they are visible (a surface crossing a
@@ -303,6 +320,7 @@ pub fn overlapping(placed: &[((DVec3, DVec3), DMat4)]) -> Vec<bool> {
     meets
 }
 
+#[cfg_attr(not(feature = "truth"), doc(hidden))]
 /// The world-space bounds of model-space bounds `(lo, hi)` placed by `transform`: the box
 /// round its eight transformed corners.
 pub fn world_box((lo, hi): (DVec3, DVec3), transform: DMat4) -> (DVec3, DVec3) {
@@ -313,9 +331,10 @@ pub fn world_box((lo, hi): (DVec3, DVec3), transform: DMat4) -> (DVec3, DVec3) {
     })
 }
 
+#[cfg_attr(not(feature = "truth"), doc(hidden))]
 /// The pairs `(a, b)`, `a < b`, of placed objects (model-space bounds and model → world
 /// transform) whose surfaces may cross: their world bounds, each grown by its share of the
-/// pair's crossing tolerance ([`pair_tolerance`](crate::mesh::crossings::pair_tolerance)),
+/// pair's crossing tolerance (`mesh::crossings::pair_tolerance`),
 /// meet. Sorted.
 pub fn crossing_pairs(placed: &[((DVec3, DVec3), DMat4)]) -> Vec<(usize, usize)> {
     let grown: Vec<(DVec3, DVec3)> = placed
@@ -329,6 +348,7 @@ pub fn crossing_pairs(placed: &[((DVec3, DVec3), DMat4)]) -> Vec<(usize, usize)>
     meeting_pairs(&grown)
 }
 
+#[cfg_attr(not(feature = "truth"), doc(hidden))]
 /// The pairs `(a, b)`, `a < b`, of boxes that meet (touching counts), sorted.
 pub fn meeting_pairs(boxes: &[(DVec3, DVec3)]) -> Vec<(usize, usize)> {
     // Sweep along x.
@@ -498,6 +518,7 @@ impl<'a> Scene<'a> {
     }
 }
 
+#[cfg_attr(not(feature = "truth"), doc(hidden))]
 /// Checks a list of section planes: at most [`MAX_SECTIONS`], each valid.
 pub fn validate_sections(sections: &[SectionPlane]) -> Result<()> {
     if sections.len() > MAX_SECTIONS {

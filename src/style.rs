@@ -5,6 +5,15 @@ use crate::error::{Error, Result};
 use glam::Vec3;
 
 /// A linear-light RGBA colour.
+///
+/// ```
+/// use wirepass::Color;
+/// // #rrggbb[aa] is sRGB, as colour pickers and CSS write it; it is kept linear.
+/// let c = Color::from_hex("#808080cc")?;
+/// assert!((c.0[0] - 0.2158).abs() < 1e-3 && (c.0[3] - 0.8).abs() < 1e-6);
+/// assert!(Color::from_hex("grey").is_err());
+/// # Ok::<(), wirepass::Error>(())
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Color(pub [f32; 4]);
 
@@ -53,6 +62,25 @@ impl Color {
 }
 
 /// Appearance settings shared by every method, so images differ only by method.
+///
+/// ```
+/// use wirepass::{Color, HiddenLines, LinePattern, Style};
+/// // CAD-style: 1 px lines, dashed hidden lines, outlines 2 px and darker.
+/// let style = Style {
+///     line_width: 1.0,
+///     outline_width: Some(2.0),
+///     outline_color: Some(Color::from_hex("#101820")?),
+///     hidden: Some(HiddenLines {
+///         pattern: LinePattern::Dashed { dash: 6.0, gap: 4.0 },
+///         ..HiddenLines::default()
+///     }),
+///     ..Style::default()
+/// };
+/// style.validate()?;
+/// // What cannot make an image is an error, never a panic.
+/// assert!(Style { line_width: f32::NAN, ..Style::default() }.validate().is_err());
+/// # Ok::<(), wirepass::Error>(())
+/// ```
 #[derive(Clone, Debug, PartialEq)]
 pub struct Style {
     /// Line width in pixels, constant at any distance and resolution.
@@ -361,6 +389,7 @@ impl LinePattern {
     }
 }
 
+#[cfg_attr(not(feature = "truth"), doc(hidden))]
 /// Twin of `dash_nearest` in common.wgsl: of the points of the pattern's dashes (cores
 /// `[j·period, j·period + dash]` for every integer j; `period` 0 for a solid line) that lie
 /// in `[lo, hi]`, the one nearest `s` (positions along the line, pixels); `None` where the
@@ -405,6 +434,7 @@ pub struct DepthFade {
 /// and the outline pass look around a pixel.
 pub const MAX_LINE_WIDTH: f32 = 256.0;
 
+#[cfg_attr(not(feature = "truth"), doc(hidden))]
 /// The line width of [`Style::default`], in pixels.
 pub const DEFAULT_LINE_WIDTH: f32 = 1.5;
 
@@ -508,6 +538,7 @@ impl Style {
     }
 }
 
+#[cfg_attr(not(feature = "truth"), doc(hidden))]
 /// Twin of `line_intensity` in common.wgsl: intensity of a `width`-pixel line at distance `d`
 /// pixels from its centre. A core of `width − 2` px at full intensity, then the Gaussian
 /// falloff `exp2(−2 t²)` of NVIDIA's "Solid Wireframe" over the next 2 px; lines narrower
@@ -520,6 +551,7 @@ pub fn line_intensity(d: f64, width: f64) -> f64 {
     (0.5 * width).min(1.0) * (-2.0 * t * t).exp2()
 }
 
+#[cfg_attr(not(feature = "truth"), doc(hidden))]
 /// Twin of `depth_fade` in common.wgsl: the strength of a line at view depth `depth` (the
 /// distance in front of the eye along the view axis), for the fade `fade` = (start, end); 1
 /// where `end <= start` (no fade).
@@ -539,6 +571,7 @@ impl Style {
     }
 }
 
+#[cfg_attr(not(feature = "truth"), doc(hidden))]
 /// Twin of `line_key` in common.wgsl: the rank of a line at a pixel, by its intensity in
 /// 1/4095 steps and then by nearness (distance in 1/4096 px steps): the pixel takes the line
 /// with the greatest key, the one that colours it most.
@@ -553,11 +586,13 @@ pub(crate) const KEY_DISTANCE_MAX: u32 = 0xf_ffff;
 /// Steps of a line key's distance per pixel.
 pub(crate) const KEY_DISTANCE_STEPS: f64 = 4096.0;
 
+#[cfg_attr(not(feature = "truth"), doc(hidden))]
 /// How far from an edge its line can colour a pixel, in pixels.
 pub fn line_reach(width: f64) -> f64 {
     (0.5 * width - 1.0).max(0.0) + 2.0
 }
 
+#[cfg_attr(not(feature = "truth"), doc(hidden))]
 /// Twin of `shade` in common.wgsl: diffuse key light plus ambient, with the normal turned
 /// towards the viewer (`facing` is the normal dotted with the direction to the eye).
 pub fn shade(
@@ -572,6 +607,7 @@ pub fn shade(
     base.map(|c| c * k)
 }
 
+#[cfg_attr(not(feature = "truth"), doc(hidden))]
 /// sRGB transfer function, linear → encoded.
 pub fn linear_to_srgb(x: f32) -> f32 {
     let x = x.clamp(0.0, 1.0);
@@ -582,6 +618,7 @@ pub fn linear_to_srgb(x: f32) -> f32 {
     }
 }
 
+#[cfg_attr(not(feature = "truth"), doc(hidden))]
 /// sRGB transfer function, encoded → linear.
 pub fn srgb_to_linear(x: f32) -> f32 {
     if x <= 0.040_45 {

@@ -1,15 +1,20 @@
 //! The pass on the GPU: the mesh store, a frame's scene data and targets, and the passes.
 //! [`DeferredPass`] orchestrates a frame's sub-passes, each in a file of its own
 //! (`visibility`, `host_depth`, the outline and edge dispatches, `composite`); the
-//! forward methods it is measured against are in [`baselines`]. It uses the frame's terms
+//! forward methods it is measured against are in `baselines` (feature `diagnostics`). It uses the frame's terms
 //! (camera, scene, style, edge math) and the meshes, nothing of the loaders, the ground truth
 //! or the tools.
 
+// The forward methods the pass is measured against: public for the tools that measure.
+#[cfg(feature = "diagnostics")]
 pub mod baselines;
+#[cfg(not(feature = "diagnostics"))]
+#[allow(dead_code, unused_imports)]
+mod baselines;
 mod bindings;
 mod canvas;
 mod composite;
-#[cfg(not(target_arch = "wasm32"))]
+#[cfg(all(feature = "tools", not(target_arch = "wasm32")))]
 mod context;
 mod deferred;
 #[cfg(feature = "diagnostics")]
@@ -40,10 +45,12 @@ mod visibility;
 pub use crate::scene::MAX_INSTANCES;
 #[cfg(feature = "diagnostics")]
 pub use baselines::MAPS_DIAGNOSTIC_FORMAT;
+#[cfg(feature = "diagnostics")]
 pub use baselines::{drawn_edges, EdgeLines, ForwardPass, RasterFrame, TwoPass};
 pub use canvas::{Canvas, HostDepth, Region};
 pub use composite::{Composite, RenderTarget};
-#[cfg(not(target_arch = "wasm32"))]
+// An adapter and device for the command line, the tools and the tests.
+#[cfg(all(feature = "tools", not(target_arch = "wasm32")))]
 pub use context::GpuContext;
 #[cfg(feature = "diagnostics")]
 pub use deferred::EdgeWork;
@@ -77,8 +84,8 @@ use timing::GpuTimer;
 pub use variants::shader_modules;
 #[cfg(all(feature = "tools", not(target_arch = "wasm32")))]
 pub(crate) use {
-    baselines::NO_EDGE,
     frame::{FrameRecords, INSTANCE_BYTES, UNIFORM_INSTANCE_CAPACITY},
     mesh_store::VERTEX_BYTES,
     readback::read_buffer,
+    shaders::NO_EDGE,
 };

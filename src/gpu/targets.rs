@@ -30,6 +30,7 @@ pub fn texture_2d(
     })
 }
 
+#[cfg_attr(not(feature = "truth"), doc(hidden))]
 /// Checks an image size against the device: non-zero and within `max_texture_dimension_2d`.
 pub fn check_size(device: &wgpu::Device, (width, height): (u32, u32)) -> Result<()> {
     if width == 0 || height == 0 {

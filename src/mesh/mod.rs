@@ -3,14 +3,33 @@
 //! what is computed from them once (adjacency, patches, outline clusters). The loaders are
 //! in `formats` (feature `formats`). It uses only the crate's error type.
 
-pub mod adjacency;
 pub(crate) mod chains;
-pub mod clusters;
-pub mod crossings;
 #[cfg(feature = "formats")]
 pub mod formats;
 pub(crate) mod par;
+
+// What is computed from a mesh once, for the pass: public for the ground truth and the
+// tests, which check it against its definitions.
+#[cfg(feature = "truth")]
+pub mod adjacency;
+#[cfg(not(feature = "truth"))]
+#[allow(dead_code, unused_imports)]
+pub(crate) mod adjacency;
+#[cfg(feature = "truth")]
+pub mod clusters;
+#[cfg(not(feature = "truth"))]
+#[allow(dead_code, unused_imports)]
+pub(crate) mod clusters;
+#[cfg(feature = "truth")]
+pub mod crossings;
+#[cfg(not(feature = "truth"))]
+#[allow(dead_code, unused_imports)]
+pub(crate) mod crossings;
+#[cfg(feature = "truth")]
 pub mod patches;
+#[cfg(not(feature = "truth"))]
+#[allow(dead_code, unused_imports)]
+pub(crate) mod patches;
 #[cfg(feature = "formats")]
 pub(crate) mod polygon;
 mod procedural;
@@ -27,10 +46,23 @@ pub use procedural::{
 use crate::error::{Error, Result};
 use glam::Vec3;
 
+#[cfg_attr(not(feature = "truth"), doc(hidden))]
 /// All three edges of a triangle. Edge `i` runs from corner `i` to corner `(i + 1) % 3`.
 pub const ALL_EDGES: u8 = 0b111;
 
 /// Which triangle edges are drawn.
+///
+/// ```
+/// use wirepass::{EdgeSelection, Mesh};
+/// // A unit square as two triangles: a quad whose diagonal is masked out.
+/// let mesh = wirepass::mesh::grid(2)?;
+/// assert_eq!(mesh.triangle_count(), 2);
+/// let drawn = |s| mesh.edge_mask(s).iter().map(|m: &u8| m.count_ones()).sum::<u32>();
+/// assert_eq!(drawn(EdgeSelection::All), 6);
+/// assert_eq!(drawn(EdgeSelection::Polygon), 4); // the square, not its diagonal
+/// assert_eq!(drawn(EdgeSelection::Feature(30.0)), 4); // flat: the boundary only
+/// # Ok::<(), wirepass::Error>(())
+/// ```
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub enum EdgeSelection {
     /// Every triangle edge, diagonals of triangulated polygons included.
@@ -51,6 +83,7 @@ pub enum EdgeSelection {
     Authored,
 }
 
+#[cfg_attr(not(feature = "truth"), doc(hidden))]
 /// Default threshold of [`EdgeSelection::Feature`], in degrees.
 pub const DEFAULT_FEATURE_ANGLE: f32 = 1.0;
 
@@ -342,42 +375,52 @@ impl Mesh {
         }
     }
 
+    // What the pass computes from the mesh: for the ground truth and the tests.
+    #[cfg_attr(not(feature = "truth"), doc(hidden))]
     /// The triangle across each triangle edge (edge `i` runs from corner `i` to `i + 1`),
-    /// with vertices welded by position, or [`adjacency::NO_NEIGHBOUR`] on boundary and
+    /// with vertices welded by position, or `adjacency::NO_NEIGHBOUR` on boundary and
     /// non-manifold edges. Computed once, on first use.
     pub fn edge_neighbours(&self) -> &[[u32; 3]] {
         self.neighbours
             .get_or_init(|| adjacency::welded_neighbours(self.welded(), &self.triangles))
     }
 
+    // What the pass computes from the mesh: for the ground truth and the tests.
+    #[cfg_attr(not(feature = "truth"), doc(hidden))]
     /// Each vertex's first vertex of bit-identical position
-    /// ([`adjacency::weld_by_position`]), which the adjacency and the chains of drawn edges
+    /// (`adjacency::weld_by_position`), which the adjacency and the chains of drawn edges
     /// join vertices by. Computed once, on first use.
     pub fn welded(&self) -> &[u32] {
         self.weld
             .get_or_init(|| adjacency::weld_by_position(&self.positions))
     }
 
+    // What the pass computes from the mesh: for the ground truth and the tests.
+    #[cfg_attr(not(feature = "truth"), doc(hidden))]
     /// Per triangle, 5 bits that let the GPU outline pass skip triangles that cannot have an
     /// outline edge: bit 0 set when an edge has no neighbour (a boundary, always an outline),
     /// bits 1–4 a code q bounding how far the surface folds at its edges: a neighboured edge
     /// can be a silhouette only while the eye sees the triangle within
-    /// asin([`adjacency::fold_bound`]\(q\)) of edge-on.
-    /// See [`adjacency::outline_hints`]. Computed once, on first use.
+    /// asin(`adjacency::fold_bound`\(q\)) of edge-on.
+    /// See `adjacency::outline_hints`. Computed once, on first use.
     pub fn outline_hints(&self) -> &[u8] {
         self.outline_hints.get_or_init(|| {
             adjacency::outline_hints(&self.positions, &self.triangles, self.edge_neighbours())
         })
     }
 
+    // What the pass computes from the mesh: for the ground truth and the tests.
+    #[cfg_attr(not(feature = "truth"), doc(hidden))]
     /// Per triangle, whether it crosses another triangle of the mesh (the mesh passes through
-    /// itself there): see [`crossings::crossing_triangles`]. Computed once, on first use.
+    /// itself there): see `crossings::crossing_triangles`. Computed once, on first use.
     pub fn crossings(&self) -> &[bool] {
         &self.crossing_pairs().1
     }
 
+    // What the pass computes from the mesh: for the ground truth and the tests.
+    #[cfg_attr(not(feature = "truth"), doc(hidden))]
     /// The pairs of triangles that cross, and the segments along which they meet: the
-    /// mesh's intersection lines ([`crossings::crossings`]). Computed once, on first use.
+    /// mesh's intersection lines (`crossings::crossings`). Computed once, on first use.
     pub fn intersections(&self) -> &[crossings::Crossing] {
         &self.crossing_pairs().0
     }
@@ -390,9 +433,11 @@ impl Mesh {
         })
     }
 
-    /// The triangles in clusters of [`clusters::CLUSTER_TRIANGLES`] nearby ones, with bounds
+    // What the pass computes from the mesh: for the ground truth and the tests.
+    #[cfg_attr(not(feature = "truth"), doc(hidden))]
+    /// The triangles in clusters of `clusters::CLUSTER_TRIANGLES` nearby ones, with bounds
     /// that let the GPU outline pass skip a cluster when, from the current eye, none of its
-    /// triangles can have an outline edge. See [`clusters::clusters`]. Computed once, on
+    /// triangles can have an outline edge. See `clusters::clusters`. Computed once, on
     /// first use.
     pub fn outline_clusters(&self) -> &clusters::Clusters {
         self.outline_clusters.get_or_init(|| {
@@ -405,7 +450,9 @@ impl Mesh {
         })
     }
 
-    /// Per triangle, the other triangle of its quad, or [`adjacency::NO_NEIGHBOUR`]: two
+    // What the pass computes from the mesh: for the ground truth and the tests.
+    #[cfg_attr(not(feature = "truth"), doc(hidden))]
+    /// Per triangle, the other triangle of its quad, or `adjacency::NO_NEIGHBOUR`: two
     /// triangles whose only edges that are not polygon edges are the one they share, the
     /// two halves of a source polygon of four corners.
     pub fn quad_partners(&self) -> Vec<u32> {

@@ -16,6 +16,7 @@ const MAX_TRIANGLES: usize = 200_000_000;
 const MAJOR_RADIUS: f64 = 1.0;
 const MINOR_RADIUS: f64 = 0.35;
 
+#[cfg_attr(not(feature = "truth"), doc(hidden))]
 /// A procedural mesh named on the command line as `sphere:N`, `grid:N`, `torus:N` or `cube:N`, where
 /// `N` is the approximate triangle count.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -32,6 +33,7 @@ pub enum Procedural {
     Cube(usize),
 }
 
+#[cfg_attr(not(feature = "truth"), doc(hidden))]
 /// Triangles in each grid of [`layers`] (8 × 8 quads).
 pub const LAYER_TRIANGLES: usize = 128;
 
@@ -222,6 +224,7 @@ pub fn cube(n: usize) -> Result<Mesh> {
     parts.into_mesh()
 }
 
+#[cfg_attr(not(feature = "truth"), doc(hidden))]
 /// `k` square 8 × 8-quad grids over [-1, 1]² parallel to the XY plane, one behind the other
 /// between z = 0 and z = −1: every pixel that sees the stack has depth complexity up to `k`,
 /// for measuring how methods cope with overdraw.
@@ -260,6 +263,7 @@ pub fn torus(n: usize) -> Result<Mesh> {
     torus_parts(major, minor).into_mesh()
 }
 
+#[cfg_attr(not(feature = "truth"), doc(hidden))]
 /// The scene drawn when no mesh is given: a torus of 3 072 triangles, tilted towards the
 /// default camera, whose quads show polygon mode, beside a small UV sphere whose pole caps
 /// are fans of thin triangles.
@@ -284,6 +288,7 @@ pub fn default_scene() -> Mesh {
     }
 }
 
+#[cfg_attr(not(feature = "truth"), doc(hidden))]
 /// The built-in scene's two meshes with their placements: the torus of [`default_scene`],
 /// tilted 40° about X, and its unit sphere, tilted, halved and moved 2 along X.
 pub fn default_parts() -> Result<[(Mesh, glam::DMat4); 2]> {

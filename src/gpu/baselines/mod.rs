@@ -10,8 +10,6 @@ mod two_pass;
 
 pub(crate) use forward::forward_source;
 pub use forward::ForwardPass;
-#[cfg(all(feature = "tools", not(target_arch = "wasm32")))]
-pub(crate) use raster::NO_EDGE;
 pub use raster::{RasterFrame, MAPS_DIAGNOSTIC_FORMAT};
 pub(crate) use two_pass::two_pass_source;
 pub use two_pass::{drawn_edges, EdgeLines, TwoPass};

@@ -13,7 +13,7 @@ use crate::gpu::targets::{clear_color, cleared, BACKGROUND_ID, DEPTH_FORMAT, ID_
 use crate::scene::Scene;
 use crate::style::Style;
 
-pub(crate) use crate::gpu::shaders::NO_EDGE;
+use crate::gpu::shaders::NO_EDGE;
 
 /// Format of the forward passes' diagnostic map: the **bit patterns** of `f32` values
 /// (red = distance in pixels, green = reverse depth), because float render targets are not
