@@ -39,7 +39,7 @@ export WGPU_BACKEND="${WGPU_BACKEND:-vulkan}"
 mkdir -p "$out"
 # shellcheck disable=SC2086 # the scenes are separate arguments
 "${CARGO_TARGET_DIR:-target}/release/wirepass" bench $scenes --size "$sizes" --frames "$frames" \
-    --silhouettes on,off --out "$out" >"$out/bench.log"
+    --outlines on,off --out "$out" >"$out/bench.log"
 
 # The adapter, the GL renderer gs ran on, and the summary: bench.md up to its second table.
 awk '/^\| scene /{tables++} tables < 2 {print}' "$out/bench.md"

@@ -32,7 +32,7 @@ trap 'rm -rf "$out"' EXIT
 # and depth complexity without triangles (layers:16); every method, outlines on and off.
 scenes="sphere:20000 sphere:200000 sphere:2000000 tests/data/meshes/stanford-bunny.obj layers:16"
 # shellcheck disable=SC2086 # the scenes are separate arguments
-"$bin" bench $scenes --size 1280x720 --frames "$frames" --warmup 3 --silhouettes on,off \
+"$bin" bench $scenes --size 1280x720 --frames "$frames" --warmup 3 --outlines on,off \
     --out "$out" --record bench/baseline.json --commit "$commit" --date "$date" \
     >"$out/report.md"
 cp "$out/time_vs_triangles.png" docs/bench-triangles.png

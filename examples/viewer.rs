@@ -298,7 +298,7 @@ impl Viewer {
              (E, O, H, S, [, ], Backspace, M, +/-)",
             self.method,
             EDGES[self.edges].0,
-            if self.style.silhouettes { "on" } else { "off" },
+            if self.style.outlines { "on" } else { "off" },
             HIDDEN[self.hidden].0,
             self.sections.len(),
             self.style.line_width
@@ -324,7 +324,7 @@ impl Viewer {
     fn key(&mut self, key: &Key) {
         match key.as_ref() {
             Key::Character("e" | "E") => self.edges = (self.edges + 1) % EDGES.len(),
-            Key::Character("o" | "O") => self.style.silhouettes = !self.style.silhouettes,
+            Key::Character("o" | "O") => self.style.outlines = !self.style.outlines,
             Key::Character("h" | "H") => {
                 self.hidden = (self.hidden + 1) % HIDDEN.len();
                 self.style = with_hidden(&self.style, self.hidden);

@@ -68,7 +68,7 @@ pub struct InstanceStyle {
     /// its outline unless `outlines` is `Some(false)` too.
     pub edges: Option<bool>,
     /// Whether this instance's outline (silhouettes and boundaries) is drawn; the style's
-    /// [`silhouettes`](crate::Style::silhouettes) otherwise.
+    /// [`outlines`](crate::Style::outlines) otherwise.
     pub outlines: Option<bool>,
     /// Colour of this instance's outline; otherwise the style's
     /// [`outline_color`](crate::Style::outline_color), else this instance's line colour.

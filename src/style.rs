@@ -144,7 +144,7 @@ pub struct Style {
     /// and farther surfaces too, and always, whatever the edge selection. Only the deferred
     /// pass and the ground truth can; the forward baselines draw each edge inside its own
     /// triangles, so their outlines are half as wide. See `shaders/outline.wgsl`.
-    pub silhouettes: bool,
+    pub outlines: bool,
     /// Fade lines with their distance from the eye; `None` draws every line at full strength.
     pub depth_fade: Option<DepthFade>,
     /// Draw the parts of the drawn lines (the selected edges and the outlines) that surfaces
@@ -461,7 +461,7 @@ impl Default for Style {
             outline_width: None,
             edge_pattern: LinePattern::Solid,
             outline_pattern: LinePattern::Solid,
-            silhouettes: true,
+            outlines: true,
             depth_fade: None,
             hidden: None,
         }

@@ -20,7 +20,7 @@ use wirepass::{
 /// tests/outline.rs).
 fn draw(mesh: &Mesh, camera: Camera, size: (u32, u32), edges: EdgeSelection) -> Rendering {
     let style = Style {
-        silhouettes: false,
+        outlines: false,
         ..Style::default()
     };
     draw_styled(mesh, camera, size, edges, style)
@@ -86,7 +86,7 @@ fn suzanne_draws_no_quad_diagonal() {
     // 3 px lines: full line colour within 0.5 px of an edge.
     let style = Style {
         line_width: 3.0,
-        silhouettes: false,
+        outlines: false,
         ..Style::default()
     };
     let polygon = draw_styled(&mesh, cam, size, EdgeSelection::Polygon, style.clone());
@@ -587,9 +587,9 @@ fn warm_up_builds_what_the_first_encode_would() {
         pass.encode(d, &mut encoder, &store, frame, target).unwrap();
         ctx.queue.submit([encoder.finish()]);
     };
-    for silhouettes in [true, false] {
+    for outlines in [true, false] {
         let style = Style {
-            silhouettes,
+            outlines,
             ..Style::default()
         };
         let mut pass = DeferredPass::new(d, PassOptions::default()).unwrap();
@@ -607,17 +607,17 @@ fn warm_up_builds_what_the_first_encode_would() {
 
         pass.warm_up(d, &frame, &shaded).unwrap();
         let built = pass.pipelines_built();
-        assert!(built >= 1, "silhouettes {silhouettes}");
+        assert!(built >= 1, "outlines {outlines}");
         encode(&pass, &frame, shaded);
-        assert_eq!(pass.pipelines_built(), built, "silhouettes {silhouettes}");
+        assert_eq!(pass.pipelines_built(), built, "outlines {outlines}");
 
         // Another output kind, not warmed up: its first encode builds its pipelines.
         encode(&pass, &frame, overlay());
         let after = pass.pipelines_built();
-        assert!(after > built, "silhouettes {silhouettes}");
+        assert!(after > built, "outlines {outlines}");
         pass.warm_up(d, &frame, &overlay()).unwrap();
         encode(&pass, &frame, overlay());
-        assert_eq!(pass.pipelines_built(), after, "silhouettes {silhouettes}");
+        assert_eq!(pass.pipelines_built(), after, "outlines {outlines}");
     }
     ctx.finish().unwrap();
 }

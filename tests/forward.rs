@@ -48,7 +48,7 @@ fn load(name: &str) -> Mesh {
 /// half-width outlines are their error against the ground truth: tests/outline.rs.)
 fn per_triangle() -> Style {
     Style {
-        silhouettes: false,
+        outlines: false,
         ..Style::default()
     }
 }

@@ -261,7 +261,7 @@ fn suzanne_as_gltf_matches_her_obj_twin() {
     let gltf_world = World::from_gltf(doc, None);
     let obj_world = World::single(obj.clone(), EdgeSelection::Polygon);
     let style = Style {
-        silhouettes: false,
+        outlines: false,
         ..Style::default()
     };
     let view = camera(Vec3::new(1.5, 1.0, 3.5)).to_view(aspect());

@@ -83,7 +83,7 @@ fn outlines_off_keep_lines_inside_their_triangles() {
     let mesh = load("fandisk.obj");
     let style = Style {
         line_width: 3.0,
-        silhouettes: false,
+        outlines: false,
         ..Style::default()
     };
     let scene = TestScene::new(
@@ -113,7 +113,7 @@ fn lines_fade_with_depth_in_every_method() {
     let mesh = load("suzanne.obj");
     let base = Style {
         line_width: 2.0,
-        silhouettes: false,
+        outlines: false,
         ..Style::default()
     };
     let plain = scene(&mesh, base.clone());

@@ -138,7 +138,7 @@ fn edge_dashes_run_on_along_chains() {
             dash: 6.0,
             gap: 6.0,
         },
-        silhouettes: false,
+        outlines: false,
         ..Style::default()
     };
     check("cylinder", &world, view, &dashed);

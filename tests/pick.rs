@@ -58,7 +58,7 @@ fn world() -> World {
 /// Without outlines, so the ground truth's nearest line is a drawn edge.
 fn style() -> Style {
     Style {
-        silhouettes: false,
+        outlines: false,
         ..Style::default()
     }
 }

@@ -96,8 +96,8 @@ struct SceneArgs {
     edges: Option<EdgeSelection>,
     /// Outlines (silhouettes and boundaries) at full width over the background and farther
     /// surfaces, whatever --edges selects: on or off. Only deferred and raycast draw them.
-    #[arg(long, default_value = "on", value_parser = parse_switch, action = clap::ArgAction::Set)]
-    silhouettes: bool,
+    #[arg(long, alias = "silhouettes", default_value = "on", value_parser = parse_switch, action = clap::ArgAction::Set)]
+    outlines: bool,
     /// Fade lines from full strength at view depth START to nothing at END (world units).
     #[arg(long, allow_hyphen_values = true, value_name = "START:END", value_parser = parse_fade)]
     depth_fade: Option<DepthFade>,
@@ -240,7 +240,7 @@ impl SceneArgs {
             intersection_lines: self.intersections,
             intersection_line_color: Color::from_hex(&self.intersection_color)?,
             intersection_line_width: self.intersection_width,
-            silhouettes: self.silhouettes,
+            outlines: self.outlines,
             depth_fade: self.depth_fade,
             ..Style::default()
         };
@@ -535,8 +535,8 @@ struct BenchArgs {
     /// Time the deferred method with its outline pass (on), without (off, the same lines
     /// the forward baselines draw), or both (`on,off`); the methods that draw no outline
     /// (forward, two-pass, gs) are timed with the first setting only.
-    #[arg(long, default_value = "on", value_delimiter = ',', value_parser = parse_switch)]
-    silhouettes: Vec<bool>,
+    #[arg(long, alias = "silhouettes", default_value = "on", value_delimiter = ',', value_parser = parse_switch)]
+    outlines: Vec<bool>,
     /// Also time the deferred method drawing these edge selections, comma separated
     /// (`polygon,feature:30`), each on its own upload, beside --edges in the same run.
     #[arg(long, value_delimiter = ',', value_parser = parse_edges)]
@@ -591,7 +591,7 @@ fn bench_command(args: &BenchArgs) -> Result<()> {
         args.scenes.iter().map(|s| Some(s.as_str())).collect()
     };
     let ctx = GpuContext::new()?;
-    let settings = specs.len() * sizes.len() * args.silhouettes.len();
+    let settings = specs.len() * sizes.len() * args.outlines.len();
     let progress = indicatif::ProgressBar::new(settings as u64);
     if !std::io::IsTerminal::is_terminal(&std::io::stderr()) {
         progress.set_draw_target(indicatif::ProgressDrawTarget::hidden());
@@ -609,14 +609,14 @@ fn bench_command(args: &BenchArgs) -> Result<()> {
         print_notes(&loaded.notes);
         let (world, selected) = (loaded.world, loaded.highlight);
         for &size in &sizes {
-            for (k, &silhouettes) in args.silhouettes.iter().enumerate() {
-                let switch = if silhouettes { "on" } else { "off" };
+            for (k, &outlines) in args.outlines.iter().enumerate() {
+                let switch = if outlines { "on" } else { "off" };
                 progress.set_message(format!(
                     "{name} at {}x{}, outlines {switch}",
                     size.0, size.1
                 ));
                 let style = Style {
-                    silhouettes,
+                    outlines,
                     line_width: args.line_width.unwrap_or(DEFAULT_LINE_WIDTH),
                     hidden: LinePattern::parse(&args.hidden)?.map(|pattern| HiddenLines {
                         pattern,

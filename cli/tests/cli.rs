@@ -183,7 +183,7 @@ fn bad_settings_give_one_clear_line() {
             "/no/such/mesh.obj",
         ),
         (&["render", "--method", "magic", "-o", o], "method"),
-        (&["render", "--silhouettes", "maybe", "-o", o], "on or off"),
+        (&["render", "--outlines", "maybe", "-o", o], "on or off"),
         (&["render", "--depth-fade", "5", "-o", o], "START:END"),
         (&["render", "--depth-fade", "5:1", "-o", o], "depth fade"),
         (&["render", "--line-width", "1000", "-o", o], "line width"),
@@ -641,7 +641,7 @@ fn gs_is_skipped_with_its_reason_where_opengl_is_missing() {
     assert!(report["methods"]["forward"]["id_agreement"].is_number());
 }
 
-/// `--silhouettes on,off` times the deferred method and the floor both ways, the methods
+/// `--outlines on,off` times the deferred method and the floor both ways, the methods
 /// that draw no outline once; the summary puts the two deferred totals side by side.
 #[test]
 fn bench_times_outlines_on_and_off_in_one_run() {
@@ -649,7 +649,7 @@ fn bench_times_outlines_on_and_off_in_one_run() {
     let json = bench_json(
         &[
             &TINY_BENCH[..],
-            &["--silhouettes", "on,off", "--methods", "deferred,gs"],
+            &["--outlines", "on,off", "--methods", "deferred,gs"],
         ]
         .concat(),
         &out,

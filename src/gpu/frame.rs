@@ -312,7 +312,7 @@ impl FrameRecords {
         let crossed: Vec<bool> = crate::scene::overlapping(&placed)
             .into_iter()
             .zip(scene.instances.iter())
-            .map(|(meets, i)| meets && i.style.outlines.unwrap_or(style.silhouettes))
+            .map(|(meets, i)| meets && i.style.outlines.unwrap_or(style.outlines))
             .collect();
         crossing |= crossed.contains(&true);
         let guard = if guarded {
@@ -351,7 +351,7 @@ impl FrameRecords {
             let instance = &scene.instances[i as usize];
             let mesh = store.record(instance.mesh)?;
             let s = &instance.style;
-            let draws_outline = s.outlines.unwrap_or(style.silhouettes);
+            let draws_outline = s.outlines.unwrap_or(style.outlines);
             let draws_edges = s.edges.unwrap_or(true);
             // The outline pass also draws the edges of large patches.
             outlines |= draws_outline || (draws_edges && mesh.lines.splat);

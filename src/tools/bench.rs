@@ -549,7 +549,7 @@ pub fn bench_scene(
             triangles: shot.world.triangle_count(),
             size: [size.0, size.1],
             method: subject.name(),
-            outlines: shot.style.silhouettes,
+            outlines: shot.style.outlines,
             passes: gpu[i]
                 .iter()
                 .map(|(name, v)| (name.clone(), Stats::of(v)))
@@ -576,7 +576,7 @@ pub fn bench_scene(
             triangles: shot.world.triangle_count(),
             size: [size.0, size.1],
             method: method.to_owned(),
-            outlines: shot.style.silhouettes,
+            outlines: shot.style.outlines,
             passes: BTreeMap::new(),
             total_median_ms: f64::NAN,
             cpu: Stats {

@@ -376,7 +376,7 @@ impl ObjectStyle {
                 outline_width: f64::from(o.style.outline_width_in(style)),
                 width: f64::from(o.style.line_width.unwrap_or(style.line_width)),
                 edges: o.style.edges.unwrap_or(true),
-                outlines: o.style.outlines.unwrap_or(style.silhouettes),
+                outlines: o.style.outlines.unwrap_or(style.outlines),
                 edge_pattern: o.style.edge_pattern_in(style).dash_period().map(f64::from),
                 outline_pattern: o
                     .style
@@ -384,10 +384,10 @@ impl ObjectStyle {
                     .dash_period()
                     .map(f64::from),
                 sectioned: !world.sections.is_empty(),
-                crossed: crossed && o.style.outlines.unwrap_or(style.silhouettes),
+                crossed: crossed && o.style.outlines.unwrap_or(style.outlines),
                 section_width: f64::from(style.section_width()),
                 hidden: o.style.hidden_in(style).filter(|_| {
-                    o.style.edges.unwrap_or(true) || o.style.outlines.unwrap_or(style.silhouettes)
+                    o.style.edges.unwrap_or(true) || o.style.outlines.unwrap_or(style.outlines)
                 }),
                 normal: DMat3::from_mat4(o.transform).inverse().transpose(),
             })

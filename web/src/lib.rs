@@ -279,7 +279,7 @@ impl App {
             self.model.name,
             self.model.triangles(),
             EDGES[self.edges].0,
-            if self.style.silhouettes { "on" } else { "off" },
+            if self.style.outlines { "on" } else { "off" },
             HIDDEN[self.hidden].0,
             self.sections.len(),
             self.style.line_width,
@@ -674,7 +674,7 @@ fn wire_events(app: &Shared, root: &HtmlElement) -> Result<(), JsValue> {
         |app, e: web_sys::Event| {
             let input: Option<HtmlInputElement> = e.target().and_then(|t| t.dyn_into().ok());
             if let Some(input) = input {
-                app.borrow_mut().style.silhouettes = input.checked();
+                app.borrow_mut().style.outlines = input.checked();
                 schedule(app);
             }
         },
@@ -727,8 +727,8 @@ fn wire_events(app: &Shared, root: &HtmlElement) -> Result<(), JsValue> {
                         select("hidden", a.hidden);
                     }
                     "o" | "O" => {
-                        a.style.silhouettes = !a.style.silhouettes;
-                        let on = a.style.silhouettes;
+                        a.style.outlines = !a.style.outlines;
+                        let on = a.style.outlines;
                         sync("outlines", &|el| {
                             el.unchecked_ref::<HtmlInputElement>().set_checked(on)
                         });
