@@ -108,7 +108,9 @@ pub use gpu::{
     PreparedFrame, RenderTarget, TriangleIds, Tuning,
 };
 pub use mesh::{EdgeSelection, Mesh};
-pub use scene::{Highlight, Instance, InstanceStyle, Scene, SectionPlane, MAX_SECTIONS};
+pub use scene::{
+    HiddenOverride, Highlight, Instance, InstanceStyle, Scene, SectionPlane, MAX_SECTIONS,
+};
 pub use style::{Color, HiddenLines, LinePattern, Style};
 
 /// The wgpu this crate is built against: use it (`wirepass::wgpu`) so the host's types match.

@@ -82,10 +82,23 @@ pub struct InstanceStyle {
     /// The pattern of this instance's outline; otherwise the style's
     /// [`outline_pattern`](crate::Style::outline_pattern).
     pub outline_pattern: Option<LinePattern>,
-    /// This instance's hidden lines: `Some(Some(h))` draws them in `h` (also in a frame whose
-    /// style draws none, as for a selected part), `Some(None)` draws none of them; otherwise
-    /// the style's [`hidden`](crate::Style::hidden).
-    pub hidden: Option<Option<HiddenLines>>,
+    /// This instance's hidden lines: the style's [`hidden`](crate::Style::hidden), none, or
+    /// its own.
+    pub hidden: HiddenOverride,
+}
+
+/// An instance's hidden lines ([`InstanceStyle::hidden`]) against the frame's
+/// [`Style::hidden`](crate::Style::hidden).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum HiddenOverride {
+    /// As the frame's style draws them (or not).
+    #[default]
+    Style,
+    /// None, whatever the style says.
+    Off,
+    /// These, also in a frame whose style draws none (a selected part seen through what
+    /// hides it).
+    Lines(HiddenLines),
 }
 
 /// A selection highlight: the instance's outline as an object (its silhouettes and
@@ -191,7 +204,11 @@ impl InstanceStyle {
 
     /// The instance's hidden lines in `style`: its own, or the style's.
     pub fn hidden_in(&self, style: &crate::Style) -> Option<HiddenLines> {
-        self.hidden.unwrap_or(style.hidden)
+        match self.hidden {
+            HiddenOverride::Style => style.hidden,
+            HiddenOverride::Off => None,
+            HiddenOverride::Lines(h) => Some(h),
+        }
     }
 
     /// This style with the highlight `h` (in the frame's `style`): its outline drawn in the
@@ -201,13 +218,13 @@ impl InstanceStyle {
     pub fn highlighted(self, h: &Highlight, style: &crate::Style) -> InstanceStyle {
         let hidden = match h.hidden {
             None => self.hidden,
-            Some(pattern) => Some(Some(HiddenLines {
+            Some(pattern) => HiddenOverride::Lines(HiddenLines {
                 pattern,
                 color: h.color,
                 width: (0.5 * h.width).max(1.0),
                 behind_host: false,
                 edges: self.hidden_in(style).is_some_and(|l| l.edges),
-            })),
+            }),
         };
         let fill_color = match h.fill_tint {
             None => self.fill_color,
@@ -251,7 +268,7 @@ impl InstanceStyle {
                     .into(),
             );
         }
-        if let Some(Some(h)) = self.hidden {
+        if let HiddenOverride::Lines(h) = self.hidden {
             if let Err(e) = h.validate() {
                 return bad(e.to_string());
             }

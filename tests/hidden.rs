@@ -11,6 +11,7 @@ use common::{
 use glam::{DMat4, DVec3};
 use std::sync::Arc;
 use wirepass::mesh::Procedural;
+use wirepass::scene::HiddenOverride;
 use wirepass::tools::offline::Method;
 use wirepass::world::{Object, World, WorldMesh};
 use wirepass::{Color, EdgeSelection, HiddenLines, LinePattern, Style, View};
@@ -311,29 +312,29 @@ fn hidden_line_styles_per_instance() {
         (
             "own and the frame's",
             &dashed,
-            None,
-            Some(Some(dotted)),
+            HiddenOverride::Style,
+            HiddenOverride::Lines(dotted),
             None,
         ),
         (
             "own and none",
             &dashed,
-            Some(Some(dotted)),
-            Some(None),
+            HiddenOverride::Lines(dotted),
+            HiddenOverride::Off,
             None,
         ),
         (
             "one instance only",
             &Style::default(),
-            None,
-            Some(Some(dotted)),
+            HiddenOverride::Style,
+            HiddenOverride::Lines(dotted),
             None,
         ),
         (
             "own and none, its edges dashed",
             &Style::default(),
-            Some(Some(dotted)),
-            Some(None),
+            HiddenOverride::Lines(dotted),
+            HiddenOverride::Off,
             Some(pattern),
         ),
     ] {

@@ -53,6 +53,7 @@
 use crate::camera::{Camera, DepthRange, View};
 use crate::error::{Error, Result};
 use crate::mesh::EdgeSelection;
+use crate::scene::HiddenOverride;
 use crate::scene::InstanceStyle;
 use crate::style::{Color, LinePattern};
 use crate::world::{Object, World, WorldMesh};
@@ -290,8 +291,8 @@ pub fn load(
             let pattern = pattern
                 .or(file_style.hidden)
                 .unwrap_or(Some(crate::style::HiddenLines::default().pattern));
-            style.hidden = Some(pattern.map(|pattern| {
-                crate::style::HiddenLines {
+            style.hidden = pattern.map_or(HiddenOverride::Off, |pattern| {
+                HiddenOverride::Lines(crate::style::HiddenLines {
                     pattern,
                     color: hidden_color
                         .or(file_style.hidden_color)
@@ -301,8 +302,8 @@ pub fn load(
                         .unwrap_or(crate::style::HiddenLines::default().width),
                     behind_host: false,
                     edges: true,
-                }
-            }));
+                })
+            });
         }
         style
             .validate(i)
@@ -693,17 +694,17 @@ mod tests {
         // Its own pattern and width, the colour a default, as the file's style gives none.
         assert_eq!(
             world.objects[3].style.hidden,
-            Some(Some(crate::HiddenLines {
+            HiddenOverride::Lines(crate::HiddenLines {
                 pattern: LinePattern::Dashed {
                     dash: 5.0,
                     gap: 2.0
                 },
                 width: 2.0,
                 ..crate::HiddenLines::default()
-            }))
+            })
         );
-        assert_eq!(world.objects[4].style.hidden, Some(None));
-        assert_eq!(world.objects[0].style.hidden, None);
+        assert_eq!(world.objects[4].style.hidden, HiddenOverride::Off);
+        assert_eq!(world.objects[0].style.hidden, HiddenOverride::Style);
         assert_eq!(world.objects[3].style.outline_width, Some(4.0));
         assert_eq!(
             world.objects[3].style.outline_color,
