@@ -108,7 +108,7 @@ pub(crate) const NO_EDGE: f32 = 3.0e38;
 /// outline pass's line at a pixel.
 const OWNER_CLASS_SHIFT: u32 = crate::scene::MAX_INSTANCES.trailing_zeros();
 const _: () = assert!(crate::scene::MAX_INSTANCES.is_power_of_two());
-// The owner word shares a line key's low 20 bits with nothing: slot and class fit below.
+// An owner word keeps a line key's top 12 bits over the owner: slot and class take 20.
 const _: () = assert!(OWNER_CLASS_SHIFT + 2 <= 20);
 
 /// Every constant the shaders share with the Rust side, declared in WGSL from its Rust
