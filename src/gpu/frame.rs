@@ -441,74 +441,12 @@ impl FrameRecords {
         let clusters = u32::try_from(clusters)
             .map_err(|_| Error::InvalidScene(format!("{clusters} clusters over all instances")))?;
         let hidden_color = hidden_styles.iter().flatten().map(|h| h.color).next();
-        // A pattern runs along chains of drawn edges: each instance drawing its edges, or
-        // their hidden parts, in a dashed or dotted pattern gets a phase table in the
-        // outline buffer, if its mesh has chains.
-        let mut chain_work = Vec::new();
-        let (mut phase_words, mut chains) = (0u64, 0u64);
-        for (slot, record) in records.iter_mut().enumerate() {
-            let mesh = store.record(scene.instances[order[slot] as usize].mesh)?;
-            let wanted = INSTANCE_EDGES | INSTANCE_HIDDEN | INSTANCE_HIDDEN_EDGES;
-            let hidden = record.hidden_period > 0.0 && record.flags & wanted == wanted;
-            let visible = record.flags & INSTANCE_LISTED_EDGES != 0 && record.edge_pattern[1] > 0.0;
-            if !(hidden || visible) || mesh.chains == 0 {
-                continue;
-            }
-            record.flags |= INSTANCE_PHASES;
-            record.phase_table = u32::try_from(phase_words).map_err(|_| too_many_chains())?;
-            chain_work.push(ChainWork {
-                slot: slot as u32,
-                chain_base: mesh.chain_base,
-                chains: mesh.chains,
-                before: u32::try_from(chains).map_err(|_| too_many_chains())?,
-            });
-            phase_words += u64::from(PHASE_ENTRY_WORDS) << mesh.table_log2;
-            chains += u64::from(mesh.chains);
-        }
-        let phase_words = u32::try_from(phase_words.next_power_of_two())
-            .ok()
-            .filter(|_| u32::try_from(chains).is_ok())
-            .ok_or_else(too_many_chains)?;
-        // Intersection lines: every crossing pair of every instance's mesh, and of every
-        // two instances that pass through each other (`instance_crossings.rs`).
-        let mut intersections = Vec::new();
-        if style.intersection_lines {
-            for (slot, &i) in order.iter().enumerate() {
-                let mesh = store.record(scene.instances[i as usize].mesh)?;
-                intersections.extend(mesh.intersections.iter().map(|c| IntersectionRecord {
-                    a: c.ends[0],
-                    slot: slot as u32,
-                    b: c.ends[1],
-                    t: c.t,
-                    u: c.u,
-                    other: slot as u32,
-                    _pad: [0; 2],
-                }));
-            }
-            let mut slot_of = vec![0u32; order.len()];
-            for (slot, &i) in order.iter().enumerate() {
-                slot_of[i as usize] = slot as u32;
-            }
-            let mut fresh = PairCache::default();
-            let cache = pairs.unwrap_or(&mut fresh);
-            cache.begin_frame();
-            for (i, j) in crate::scene::crossing_pairs(&placed) {
-                let (a, b) = (&scene.instances[i], &scene.instances[j]);
-                let records = (store.record(a.mesh)?, store.record(b.mesh)?);
-                let pair = ((a.mesh, a.transform), (b.mesh, b.transform));
-                let (slot, other) = (slot_of[i], slot_of[j]);
-                let found = cache.between(pair, records);
-                intersections.extend(found.iter().map(|c| IntersectionRecord {
-                    a: c.ends[0],
-                    slot,
-                    b: c.ends[1],
-                    t: c.t,
-                    u: c.u,
-                    other,
-                    _pad: [0; 2],
-                }));
-            }
-        }
+        let (chain_work, phase_words, chains) = phase_tables(store, scene, &order, &mut records)?;
+        let intersections = if style.intersection_lines {
+            intersection_records(store, scene, &order, &placed, pairs)?
+        } else {
+            Vec::new()
+        };
         let intersections_count = u32::try_from(intersections.len()).map_err(|_| {
             Error::InvalidScene(format!(
                 "{} intersection segments over all instances",
@@ -574,7 +512,7 @@ impl FrameRecords {
                 } else {
                     phase_words
                 },
-                chains as u32,
+                chains,
                 chain_work.len() as u32,
                 0,
             ],
@@ -639,6 +577,96 @@ fn section_planes(
 /// Words of a phase table entry: the edge's key, the hidden-line pattern's position and the
 /// edge pattern's (`chain_phases`).
 pub(crate) const PHASE_ENTRY_WORDS: u32 = 3;
+
+/// The phase tables of a frame's patterns: a pattern runs along chains of drawn edges, so
+/// each instance drawing its edges, or their hidden parts, in a dashed or dotted pattern
+/// gets a phase table in the outline buffer, if its mesh has chains (its record is marked
+/// `INSTANCE_PHASES` and given the table's place). Returns the tables' work, their words in
+/// all (a power of two) and the chains in all.
+fn phase_tables(
+    store: &MeshStore,
+    scene: &Scene<'_>,
+    order: &[u32],
+    records: &mut [InstanceRecord],
+) -> Result<(Vec<ChainWork>, u32, u32)> {
+    let mut chain_work = Vec::new();
+    let (mut phase_words, mut chains) = (0u64, 0u64);
+    for (slot, record) in records.iter_mut().enumerate() {
+        let mesh = store.record(scene.instances[order[slot] as usize].mesh)?;
+        let wanted = INSTANCE_EDGES | INSTANCE_HIDDEN | INSTANCE_HIDDEN_EDGES;
+        let hidden = record.hidden_period > 0.0 && record.flags & wanted == wanted;
+        let visible = record.flags & INSTANCE_LISTED_EDGES != 0 && record.edge_pattern[1] > 0.0;
+        if !(hidden || visible) || mesh.chains == 0 {
+            continue;
+        }
+        record.flags |= INSTANCE_PHASES;
+        record.phase_table = u32::try_from(phase_words).map_err(|_| too_many_chains())?;
+        chain_work.push(ChainWork {
+            slot: slot as u32,
+            chain_base: mesh.chain_base,
+            chains: mesh.chains,
+            before: u32::try_from(chains).map_err(|_| too_many_chains())?,
+        });
+        phase_words += u64::from(PHASE_ENTRY_WORDS) << mesh.table_log2;
+        chains += u64::from(mesh.chains);
+    }
+    let phase_words = u32::try_from(phase_words.next_power_of_two())
+        .ok()
+        .filter(|_| u32::try_from(chains).is_ok())
+        .ok_or_else(too_many_chains)?;
+    let chains = u32::try_from(chains).map_err(|_| too_many_chains())?;
+    Ok((chain_work, phase_words, chains))
+}
+
+/// A frame's intersection lines: every crossing pair of every instance's mesh, and of every
+/// two instances that pass through each other (`instance_crossings.rs`), found or kept in
+/// `pairs` where the caller keeps one. `order` maps slots to the scene's instances;
+/// `placed`, each instance's bounds and transform.
+fn intersection_records(
+    store: &MeshStore,
+    scene: &Scene<'_>,
+    order: &[u32],
+    placed: &[((DVec3, DVec3), DMat4)],
+    pairs: Option<&mut PairCache>,
+) -> Result<Vec<IntersectionRecord>> {
+    let mut intersections = Vec::new();
+    for (slot, &i) in order.iter().enumerate() {
+        let mesh = store.record(scene.instances[i as usize].mesh)?;
+        intersections.extend(mesh.intersections.iter().map(|c| IntersectionRecord {
+            a: c.ends[0],
+            slot: slot as u32,
+            b: c.ends[1],
+            t: c.t,
+            u: c.u,
+            other: slot as u32,
+            _pad: [0; 2],
+        }));
+    }
+    let mut slot_of = vec![0u32; order.len()];
+    for (slot, &i) in order.iter().enumerate() {
+        slot_of[i as usize] = slot as u32;
+    }
+    let mut fresh = PairCache::default();
+    let cache = pairs.unwrap_or(&mut fresh);
+    cache.begin_frame();
+    for (i, j) in crate::scene::crossing_pairs(placed) {
+        let (a, b) = (&scene.instances[i], &scene.instances[j]);
+        let records = (store.record(a.mesh)?, store.record(b.mesh)?);
+        let pair = ((a.mesh, a.transform), (b.mesh, b.transform));
+        let (slot, other) = (slot_of[i], slot_of[j]);
+        let found = cache.between(pair, records);
+        intersections.extend(found.iter().map(|c| IntersectionRecord {
+            a: c.ends[0],
+            slot,
+            b: c.ends[1],
+            t: c.t,
+            u: c.u,
+            other,
+            _pad: [0; 2],
+        }));
+    }
+    Ok(intersections)
+}
 
 fn too_many_chains() -> Error {
     Error::InvalidScene(
