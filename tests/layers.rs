@@ -62,55 +62,6 @@ fn module_of(src: &Path, file: &Path) -> Vec<String> {
     parts
 }
 
-/// Every `crate::a::b` path the code (not the comments) names, and the `crate::{a, b}`
-/// groups, as the first two segments.
-fn crate_paths(source: &str) -> Vec<Vec<String>> {
-    let mut paths = Vec::new();
-    for line in source.lines() {
-        let code = line.split("//").next().unwrap_or("");
-        let mut rest = code;
-        while let Some(at) = rest.find("crate::") {
-            let after = &rest[at + "crate::".len()..];
-            let preceded = rest[..at]
-                .chars()
-                .last()
-                .is_some_and(|c| c.is_alphanumeric() || c == '_');
-            rest = after;
-            if preceded {
-                continue;
-            }
-            if let Some(group) = after.strip_prefix('{') {
-                let inner = group.split('}').next().unwrap_or("");
-                for item in inner.split(',') {
-                    let segments: Vec<String> = item
-                        .trim()
-                        .split("::")
-                        .take(2)
-                        .map(|s| s.trim().to_owned())
-                        .collect();
-                    if !segments[0].is_empty() {
-                        paths.push(segments);
-                    }
-                }
-                continue;
-            }
-            let segments: Vec<String> = after
-                .split(|c: char| !(c.is_alphanumeric() || c == '_' || c == ':'))
-                .next()
-                .unwrap_or("")
-                .split("::")
-                .filter(|s| !s.is_empty())
-                .take(2)
-                .map(str::to_owned)
-                .collect();
-            if !segments.is_empty() {
-                paths.push(segments);
-            }
-        }
-    }
-    paths
-}
-
 #[test]
 fn every_file_names_only_its_own_layer_and_the_ones_below() {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
@@ -128,11 +79,11 @@ fn every_file_names_only_its_own_layer_and_the_ones_below() {
         let own =
             layer(&names).unwrap_or_else(|| panic!("{}: a module no layer holds", file.display()));
         let source = std::fs::read_to_string(file).unwrap();
-        for path in crate_paths(&source) {
+        for path in named_paths(&source, &module) {
             let segments: Vec<&str> = path.iter().map(String::as_str).collect();
             let Some(theirs) = layer(&segments) else {
                 wrong.push(format!(
-                    "{}: crate::{} is in no layer",
+                    "{}: {} is in no layer",
                     file.display(),
                     path.join("::")
                 ));
@@ -141,7 +92,7 @@ fn every_file_names_only_its_own_layer_and_the_ones_below() {
             checked += 1;
             if theirs > own {
                 wrong.push(format!(
-                    "{} (layer {own}) names crate::{} (layer {theirs})",
+                    "{} (layer {own}) names {} (layer {theirs})",
                     file.strip_prefix(&src).unwrap().display(),
                     path.join("::")
                 ));
@@ -153,16 +104,6 @@ fn every_file_names_only_its_own_layer_and_the_ones_below() {
         "only {checked} references found: is the scan broken?"
     );
     assert!(wrong.is_empty(), "upward references:\n{}", wrong.join("\n"));
-}
-
-#[test]
-fn the_scan_finds_paths_and_groups_but_not_comments() {
-    let source = "use crate::gpu::{frame, targets};\n\
-                  use crate::{error::Result, mesh::Mesh};\n\
-                  // crate::tools in a comment\n\
-                  let x = crate::truth::draw(a); my_crate::other();\n";
-    let found: Vec<String> = crate_paths(source).iter().map(|p| p.join("::")).collect();
-    assert_eq!(found, ["gpu", "error::Result", "mesh::Mesh", "truth::draw"]);
 }
 
 /// The items a file declares (`pub`, `pub(crate)` or private: structs, enums, traits,
@@ -193,19 +134,10 @@ fn declared_items(source: &str) -> Vec<String> {
 
 /// Every module path a file's code names, made absolute (below `crate`): `crate::a::b::C`,
 /// `super::x::Y` and `self::z`, with `use` groups spread out, each as its segments.
-fn named_paths(source: &str, module: &[String], is_mod_file: bool) -> Vec<Vec<String>> {
-    // The module `super` names: a `mod.rs` is its folder's module, other files are one below.
-    let here: Vec<String> = module.to_vec();
-    let parent: Vec<String> = if is_mod_file {
-        module[..module.len().saturating_sub(1)].to_vec()
-    } else {
-        here[..here.len().saturating_sub(1)].to_vec()
-    };
-    let this: Vec<String> = if is_mod_file {
-        here.clone()
-    } else {
-        parent.clone()
-    };
+fn named_paths(source: &str, module: &[String]) -> Vec<Vec<String>> {
+    // `self` is the file's own module (a `mod.rs` is its folder's), `super` the one above.
+    let this: Vec<String> = module.to_vec();
+    let parent: Vec<String> = module[..module.len().saturating_sub(1)].to_vec();
     let mut out = Vec::new();
     for line in source.lines() {
         let code = line.split("//").next().unwrap_or("");
@@ -239,7 +171,10 @@ fn named_paths(source: &str, module: &[String], is_mod_file: bool) -> Vec<Vec<St
                     let mut path = base.clone();
                     path.extend(stem.iter().cloned());
                     path.extend(tail);
-                    out.push(path);
+                    // `super::*` at the top names the crate root, which is no module here.
+                    if !path.is_empty() {
+                        out.push(path);
+                    }
                 };
                 match group {
                     Some(group) => {
@@ -319,8 +254,7 @@ fn no_file_is_in_an_import_circle() {
         if is_hub(i) {
             continue;
         }
-        let is_mod = false;
-        for path in named_paths(&sources[i], &modules[i], is_mod) {
+        for path in named_paths(&sources[i], &modules[i]) {
             if let Some(j) = resolve(&path) {
                 if j != i && Some(j) != lib && !edges[i].contains(&j) {
                     edges[i].push(j);
@@ -381,9 +315,10 @@ fn no_file_is_in_an_import_circle() {
 fn paths_are_made_absolute_and_groups_spread() {
     let module = ["gpu".to_owned(), "frame".to_owned()];
     let source = "use super::{canvas::Region, mesh_store::MeshStore as S};\n\
-                  use crate::scene::Scene;\n\
-                  let x = self::helper(); // super::ignored\n";
-    let found: Vec<String> = named_paths(source, &module, false)
+                  use crate::{error::Result, scene::Scene};\n\
+                  // crate::tools in a comment\n\
+                  let x = self::helper(); my_crate::other(); // super::ignored\n";
+    let found: Vec<String> = named_paths(source, &module)
         .iter()
         .map(|p| p.join("::"))
         .collect();
@@ -392,8 +327,9 @@ fn paths_are_made_absolute_and_groups_spread() {
         [
             "gpu::canvas::Region",
             "gpu::mesh_store::MeshStore",
+            "error::Result",
             "scene::Scene",
-            "gpu::helper"
+            "gpu::frame::helper"
         ]
     );
     assert_eq!(
