@@ -277,6 +277,11 @@ pub(crate) const INFO_QUAD: u32 = 1 << 15;
 /// is the diagonal's start (one bit) and its drawn edges (three bits): `quad_of` in
 /// edge_pass.wgsl reads the other triangle from these, its id and one corner's position.
 pub(crate) const QUAD_SHIFT: u32 = 16;
+/// The quad's fields after [`QUAD_SHIFT`]: the other triangle's corner, whether its next
+/// corner is the diagonal's start (a bit, `QUAD_SAME`), its drawn edges.
+pub(crate) const QUAD_CORNER_SHIFT: u32 = QUAD_SHIFT + 2;
+pub(crate) const QUAD_SAME: u32 = 1 << (QUAD_SHIFT + 4);
+pub(crate) const QUAD_MASK_SHIFT: u32 = QUAD_SHIFT + 5;
 
 /// Bits of [`EdgeData::info`] of a quad: its other triangle is stored right after this one
 /// ([`QUAD_NEXT`]) or right before it ([`QUAD_PREVIOUS`]), as the cluster order keeps the
@@ -322,9 +327,9 @@ fn quad_bits(mesh: &Mesh, mask: &[u8], stored: &[u32], t: usize) -> u32 {
     INFO_QUAD
         | place
         | (e as u32) << QUAD_SHIFT
-        | (k as u32) << (QUAD_SHIFT + 2)
-        | u32::from(same) << (QUAD_SHIFT + 4)
-        | u32::from(mask[n] & ALL_EDGES) << (QUAD_SHIFT + 5)
+        | (k as u32) << QUAD_CORNER_SHIFT
+        | if same { QUAD_SAME } else { 0 }
+        | u32::from(mask[n] & ALL_EDGES) << QUAD_MASK_SHIFT
 }
 
 /// First of the three bits of [`EdgeData::info`] that mark the drawn edges in a chain of more

@@ -161,9 +161,9 @@ pub fn constants() -> String {
         ("INFO_CHAINED_SHIFT", mr::INFO_CHAINED_SHIFT),
         ("INFO_CROSSED", mr::INFO_CROSSED),
         ("QUAD_EDGE_SHIFT", mr::QUAD_SHIFT),
-        ("QUAD_CORNER_SHIFT", mr::QUAD_SHIFT + 2),
-        ("QUAD_SAME", 1 << (mr::QUAD_SHIFT + 4)),
-        ("QUAD_MASK_SHIFT", mr::QUAD_SHIFT + 5),
+        ("QUAD_CORNER_SHIFT", mr::QUAD_CORNER_SHIFT),
+        ("QUAD_SAME", mr::QUAD_SAME),
+        ("QUAD_MASK_SHIFT", mr::QUAD_MASK_SHIFT),
         ("QUAD_NEXT", mr::QUAD_NEXT),
         ("QUAD_PREVIOUS", mr::QUAD_PREVIOUS),
     ];
