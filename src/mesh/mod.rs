@@ -154,6 +154,24 @@ pub struct Mesh {
     crossings: std::sync::OnceLock<(Vec<crossings::Crossing>, Vec<bool>)>,
 }
 
+/// The value in `cell`, computed by `compute` if no thread has stored one yet.
+///
+/// Unlike `OnceLock::get_or_init`, no thread waits while another computes: the computations
+/// run on rayon's workers, and a worker that blocked on a cell another worker fills could
+/// hold, queued beneath it, the very job that computation waits for (two threads inserting
+/// one mesh deadlocked so). Threads that race compute the same value; the first one stored
+/// is kept.
+fn computed_once<T>(cell: &std::sync::OnceLock<T>, compute: impl FnOnce() -> T) -> &T {
+    if let Some(value) = cell.get() {
+        return value;
+    }
+    let value = compute();
+    // Storing moves a finished value: the wait, if another thread stores at that moment,
+    // is for a move, never for a computation.
+    let _ = cell.set(value);
+    cell.get().expect("the cell was just filled")
+}
+
 impl Mesh {
     /// Builds a mesh, checking that every coordinate is finite and every index in range.
     ///
@@ -381,8 +399,10 @@ impl Mesh {
     /// with vertices welded by position, or `adjacency::NO_NEIGHBOUR` on boundary and
     /// non-manifold edges. Computed once, on first use.
     pub fn edge_neighbours(&self) -> &[[u32; 3]] {
-        self.neighbours
-            .get_or_init(|| adjacency::welded_neighbours(self.welded(), &self.triangles))
+        computed_once(&self.neighbours, || {
+            adjacency::welded_neighbours(self.welded(), &self.triangles)
+        })
+        .as_slice()
     }
 
     // What the pass computes from the mesh: for the ground truth and the tests.
@@ -391,8 +411,7 @@ impl Mesh {
     /// (`adjacency::weld_by_position`), which the adjacency and the chains of drawn edges
     /// join vertices by. Computed once, on first use.
     pub fn welded(&self) -> &[u32] {
-        self.weld
-            .get_or_init(|| adjacency::weld_by_position(&self.positions))
+        computed_once(&self.weld, || adjacency::weld_by_position(&self.positions)).as_slice()
     }
 
     // What the pass computes from the mesh: for the ground truth and the tests.
@@ -404,9 +423,10 @@ impl Mesh {
     /// asin(`adjacency::fold_bound`\(q\)) of edge-on.
     /// See `adjacency::outline_hints`. Computed once, on first use.
     pub fn outline_hints(&self) -> &[u8] {
-        self.outline_hints.get_or_init(|| {
+        computed_once(&self.outline_hints, || {
             adjacency::outline_hints(&self.positions, &self.triangles, self.edge_neighbours())
         })
+        .as_slice()
     }
 
     // What the pass computes from the mesh: for the ground truth and the tests.
@@ -426,7 +446,7 @@ impl Mesh {
     }
 
     fn crossing_pairs(&self) -> &(Vec<crossings::Crossing>, Vec<bool>) {
-        self.crossings.get_or_init(|| {
+        computed_once(&self.crossings, || {
             let pairs = crossings::crossings(&self.positions, &self.triangles);
             let flags = crossings::flag_crossing(self.triangles.len(), &pairs);
             (pairs, flags)
@@ -440,7 +460,7 @@ impl Mesh {
     /// triangles can have an outline edge. See `clusters::clusters`. Computed once, on
     /// first use.
     pub fn outline_clusters(&self) -> &clusters::Clusters {
-        self.outline_clusters.get_or_init(|| {
+        computed_once(&self.outline_clusters, || {
             clusters::clusters(
                 &self.positions,
                 &self.triangles,
@@ -609,6 +629,44 @@ mod tests {
             Some(vec![0b011, 0b110]),
         )
         .unwrap()
+    }
+
+    /// Threads that prepare one mesh at once, each as an upload does (the crossings beside
+    /// the adjacency, hints and clusters, on rayon's workers), all finish with the same
+    /// records: none waits on a cache another fills while holding work that filling needs.
+    #[test]
+    fn threads_preparing_one_mesh_at_once_all_finish() {
+        use std::sync::{mpsc, Arc};
+        use std::time::Duration;
+        for round in 0..8 {
+            let mesh = Arc::new(procedural::sphere(20_000).unwrap());
+            let (done, finished) = mpsc::channel();
+            for _ in 0..3 {
+                let (mesh, done) = (mesh.clone(), done.clone());
+                std::thread::spawn(move || {
+                    let (clusters, crossings) = par::join(
+                        || {
+                            mesh.edge_neighbours();
+                            mesh.outline_hints();
+                            mesh.outline_clusters().clone()
+                        },
+                        || mesh.intersections().len(),
+                    );
+                    let _ = done.send((clusters, crossings));
+                });
+            }
+            let results: Vec<_> = (0..3)
+                .map(|_| {
+                    finished
+                        .recv_timeout(Duration::from_secs(120))
+                        .unwrap_or_else(|_| panic!("round {round}: a thread never finished"))
+                })
+                .collect();
+            for (clusters, crossings) in &results {
+                assert_eq!(clusters, mesh.outline_clusters());
+                assert_eq!(*crossings, mesh.intersections().len());
+            }
+        }
     }
 
     #[test]
