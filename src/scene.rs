@@ -320,24 +320,6 @@ pub fn check_transform(t: &DMat4, index: usize) -> Result<()> {
 }
 
 #[cfg_attr(not(feature = "truth"), doc(hidden))]
-/// Per placed object (its model-space bounds and model → world transform), whether its
-/// world-space bounds meet another's: the objects that may pass through each other, whose
-/// drawn edges both passes then draw only where they are visible (a surface crossing a
-/// triangle can hide its lines right beside its visible pixels, with no outline between),
-/// where they draw their outlines. With outlines drawn that is the same image where nothing
-/// crosses (a nearer surface's outline lies between a pixel and any of its lines the surface
-/// hides), so boxes that only touch count, and the test errs towards the exact path.
-pub fn overlapping(placed: &[((DVec3, DVec3), DMat4)]) -> Vec<bool> {
-    let boxes: Vec<(DVec3, DVec3)> = placed.iter().map(|&(b, t)| world_box(b, t)).collect();
-    let mut meets = vec![false; boxes.len()];
-    for (a, b) in meeting_pairs(&boxes) {
-        meets[a] = true;
-        meets[b] = true;
-    }
-    meets
-}
-
-#[cfg_attr(not(feature = "truth"), doc(hidden))]
 /// The world-space bounds of model-space bounds `(lo, hi)` placed by `transform`: the box
 /// round its eight transformed corners.
 pub fn world_box((lo, hi): (DVec3, DVec3), transform: DMat4) -> (DVec3, DVec3) {
@@ -589,11 +571,11 @@ mod tests {
         let at = |x: f64| DMat4::from_translation(DVec3::new(x, 0.0, 0.0));
         // Turned by 45°, its corners reach 1.41 from its centre.
         let turned = at(2.3) * DMat4::from_rotation_z(std::f64::consts::FRAC_PI_4);
-        assert_eq!(overlapping(&[(unit, at(0.0)), (unit, at(2.3))]), [false; 2]);
-        assert_eq!(overlapping(&[(unit, at(0.0)), (unit, turned)]), [true; 2]);
+        assert_eq!(crossing_pairs(&[(unit, at(0.0)), (unit, at(2.3))]), []);
+        assert_eq!(crossing_pairs(&[(unit, at(0.0)), (unit, turned)]), [(0, 1)]);
         assert_eq!(
-            overlapping(&[(unit, at(0.0)), (unit, at(5.0)), (unit, at(6.5))]),
-            [false, true, true]
+            crossing_pairs(&[(unit, at(0.0)), (unit, at(5.0)), (unit, at(6.5))]),
+            [(1, 2)]
         );
     }
 

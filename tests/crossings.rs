@@ -273,6 +273,65 @@ fn instances_through_each_other() {
     );
 }
 
+/// Spot, and Suzanne beside it, turned so that their placed bounds reach across each other
+/// while their surfaces stay apart (0.8 to the side) or pass through each other (0.5).
+fn spot_beside_suzanne(shift: f64) -> World {
+    let centred = |m: &Mesh| {
+        let (lo, hi) = m.bounds_f64();
+        DMat4::from_translation(-0.5 * (lo + hi))
+    };
+    let (spot, suzanne) = (load("spot.obj"), load("suzanne.obj"));
+    let objects = vec![
+        Object::new(0, centred(&spot)),
+        Object::new(
+            1,
+            DMat4::from_translation(DVec3::new(shift, 0.1, 0.0))
+                * DMat4::from_rotation_y(0.8)
+                * DMat4::from_scale(DVec3::splat(0.5))
+                * centred(&suzanne),
+        ),
+    ];
+    let mesh = |mesh: Mesh, name: &str| WorldMesh {
+        mesh: Arc::new(mesh),
+        edges: EdgeSelection::Polygon,
+        name: name.into(),
+    };
+    World {
+        meshes: vec![mesh(spot, "spot"), mesh(suzanne, "suzanne")],
+        objects,
+        sections: Vec::new(),
+    }
+}
+
+/// Instances whose bounds meet but whose surfaces do not cross are drawn as any two
+/// instances are (each pixel's own triangle gives its lines; with hidden lines, the wide
+/// way), and match the ground truth as closely as those that do cross, from every camera;
+/// tests/work.rs holds the pieces each way lists.
+#[test]
+fn instances_whose_bounds_meet_but_not_their_surfaces() {
+    let hidden = Style {
+        hidden: Some(wirepass::HiddenLines::default()),
+        ..Style::default()
+    };
+    for (what, shift) in [("apart", 0.8), ("crossed", 0.5)] {
+        let world = spot_beside_suzanne(shift);
+        for (camera, view) in cameras(DVec3::new(0.4, 0.0, 0.0)) {
+            check(
+                &format!("{what}, {camera}"),
+                &world,
+                view,
+                &Style::default(),
+            );
+        }
+        check(
+            &format!("{what}, between them, hidden lines"),
+            &world,
+            perspective(DVec3::new(0.5, 0.9, 2.4), DVec3::new(0.45, 0.0, 0.0)),
+            &hidden,
+        );
+    }
+}
+
 /// The intersection lines of the two boxes through each other (`boxes`, in an edge mode)
 /// from every camera of `cameras`, thin and wide, against the ground truth.
 fn boxes_from_every_camera(what: &str, boxes: impl Fn(EdgeSelection) -> World) {

@@ -13,12 +13,13 @@
 
 mod common;
 
-use common::{framing, gpu, load};
-use glam::DVec3;
+use common::{gpu, load};
+use glam::{DMat4, DVec3};
+use std::sync::Arc;
 use wirepass::gpu::{DeferredPass, EdgeWork, OutputTarget, PassOptions, Tuning};
 use wirepass::tools::offline::Uploaded;
-use wirepass::world::World;
-use wirepass::{EdgeSelection, HiddenLines, Mesh, SectionPlane, Style};
+use wirepass::world::{Object, World, WorldMesh};
+use wirepass::{Camera, EdgeSelection, HiddenLines, Mesh, SectionPlane, Style};
 
 const TABLE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/work.txt");
 
@@ -34,15 +35,46 @@ const COLUMNS: [&str; 8] = [
     "pipelines",
 ];
 
-/// A fixed scene: a mesh framed at a size, drawn in a style, maybe cut by a plane through
+/// A fixed scene: a world framed at a size, drawn in a style, maybe cut by a plane through
 /// its centre.
 struct Case {
     name: &'static str,
-    mesh: Mesh,
-    edges: EdgeSelection,
+    world: World,
     size: (u32, u32),
     style: Style,
     section: bool,
+}
+
+/// Instances of spot and Suzanne: side by side, their placed bounds meeting but not their
+/// surfaces (`apart`), or passing through each other.
+fn spot_and_suzanne(apart: bool) -> World {
+    let (spot, suzanne) = (load("spot.obj"), load("suzanne.obj"));
+    let centred = |m: &Mesh| {
+        let (lo, hi) = m.bounds_f64();
+        DMat4::from_translation(-0.5 * (lo + hi))
+    };
+    let (spot_at, suzanne_at) = (centred(&spot), centred(&suzanne));
+    let shift = if apart { 0.8 } else { 0.5 };
+    let mesh = |mesh: Mesh, name: &str| WorldMesh {
+        mesh: Arc::new(mesh),
+        edges: EdgeSelection::Polygon,
+        name: name.into(),
+    };
+    World {
+        meshes: vec![mesh(spot, "spot"), mesh(suzanne, "suzanne")],
+        objects: vec![
+            Object::new(0, spot_at),
+            // Turned a quarter about the vertical, so its bounds reach across the cow's.
+            Object::new(
+                1,
+                DMat4::from_translation(DVec3::new(shift, 0.1, 0.0))
+                    * DMat4::from_rotation_y(0.8)
+                    * DMat4::from_scale(DVec3::splat(0.5))
+                    * suzanne_at,
+            ),
+        ],
+        sections: Vec::new(),
+    }
 }
 
 fn cases() -> Vec<Case> {
@@ -57,8 +89,7 @@ fn cases() -> Vec<Case> {
     };
     let case = |name, mesh, edges, size, style, section| Case {
         name,
-        mesh,
-        edges,
+        world: World::single(mesh, edges),
         size,
         style,
         section,
@@ -115,6 +146,22 @@ fn cases() -> Vec<Case> {
             crossing,
             false,
         ),
+        // Instances whose bounds meet but whose surfaces do not cross are drawn as any two
+        // are; those that pass through each other draw every edge where it is visible.
+        Case {
+            name: "instances-apart",
+            world: spot_and_suzanne(true),
+            size: small,
+            style: Style::default(),
+            section: false,
+        },
+        Case {
+            name: "instances-crossed",
+            world: spot_and_suzanne(false),
+            size: small,
+            style: Style::default(),
+            section: false,
+        },
     ]
 }
 
@@ -123,13 +170,13 @@ fn cases() -> Vec<Case> {
 fn measure(case: &Case) -> [u64; 8] {
     let ctx = gpu();
     let (device, queue) = (&ctx.device, &ctx.queue);
-    let world = World::single(case.mesh.clone(), case.edges);
-    let up = Uploaded::new(device, queue, &world).unwrap();
+    let world = &case.world;
+    let up = Uploaded::new(device, queue, world).unwrap();
     let aspect = f64::from(case.size.0) / f64::from(case.size.1);
-    let view = framing(&case.mesh, case.size).to_view(aspect);
-    let mut scene = up.scene(&world, view);
+    let (lo, hi) = world.bounds();
+    let view = Camera::framing(lo, hi, aspect).to_view(aspect);
+    let mut scene = up.scene(world, view);
     if case.section {
-        let (lo, hi) = case.mesh.bounds_f64();
         let plane = SectionPlane::new((lo + hi) / 2.0, DVec3::new(0.3, -1.0, 0.2));
         scene = scene.with_sections(vec![plane]);
     }

@@ -4,13 +4,14 @@
 //! same scene the same way.
 
 use super::canvas::Region;
-use super::instance_crossings::PairCache;
+use super::instance_crossings::{PairCache, PairCrossing};
 use super::mesh_store::{MeshRecord, MeshStore, StoreBuffers};
 use crate::camera::View;
 use crate::error::{Error, Result};
 use crate::scene::{Scene, MAX_SECTIONS};
 use crate::style::Style;
 use glam::{DMat3, DMat4, DVec3, DVec4};
+use std::sync::Arc;
 use wgpu::util::DeviceExt;
 
 /// Mirror of WGSL `struct Frame`; field order and padding match it.
@@ -93,14 +94,14 @@ pub(crate) const INSTANCE_HIDDEN: u32 = 4;
 pub(crate) const INSTANCE_BEHIND_HOST: u32 = 8;
 /// `Instance.flags`: the hidden parts of its drawn edges are drawn, not only its outline's.
 pub(crate) const INSTANCE_HIDDEN_EDGES: u32 = 16;
-/// `Instance.flags`: its drawn edges are patterned, cut by section planes or perhaps crossed
-/// by another instance, so the outline pass draws them (their visible runs) and the edge pass
+/// `Instance.flags`: its drawn edges are patterned, cut by section planes or crossed by
+/// another instance, so the outline pass draws them (their visible runs) and the edge pass
 /// leaves them.
 pub(crate) const INSTANCE_LISTED_EDGES: u32 = 32;
 /// `Instance.flags`: it has a phase table (`chain_phases`).
 pub(crate) const INSTANCE_PHASES: u32 = 64;
-/// `Instance.flags`: another instance may pass through it ([`crate::scene::overlapping`]), so
-/// its lines' visibility is tested over a wider window ([`CROSSING_BAND`]).
+/// `Instance.flags`: another instance passes through it (`instance_pair_crossings`), so its
+/// lines' visibility is tested over a wider window ([`CROSSING_BAND`]).
 pub(crate) const INSTANCE_CROSSED: u32 = 128;
 
 /// Pixels the guard band grows by in a frame where surfaces may cross: the outline pass
@@ -299,7 +300,7 @@ impl FrameRecords {
         super::targets::check_size(device, region.size)?;
         // Where the device's largest texture leaves no room for the whole band, a narrower one.
         let room = device.limits().max_texture_dimension_2d - region.size.0.max(region.size.1);
-        // Instances that may pass through each other draw their edges where visible, where
+        // Instances that pass through each other draw their edges where visible, where
         // they draw outlines (without, a line may reach past the silhouette only so); they and
         // meshes that pass through themselves test their lines' visibility more widely.
         let mut placed = Vec::with_capacity(scene.instances.len());
@@ -309,11 +310,26 @@ impl FrameRecords {
             placed.push((record.bounds, i.transform));
             crossing |= record.lines.crossed;
         }
-        let crossed: Vec<bool> = crate::scene::overlapping(&placed)
-            .into_iter()
-            .zip(scene.instances.iter())
-            .map(|(meets, i)| meets && i.style.outlines.unwrap_or(style.outlines))
-            .collect();
+        let outlines_of =
+            |i: usize| -> bool { scene.instances[i].style.outlines.unwrap_or(style.outlines) };
+        let pair_crossings = instance_pair_crossings(
+            store,
+            scene,
+            &placed,
+            |(a, b)| style.intersection_lines || outlines_of(a) || outlines_of(b),
+            pairs,
+        )?;
+        // Where either draws hidden lines, a pair whose bounds meet is drawn the wide way
+        // whether or not it crosses: the narrow window can miss the first fraction of a pixel
+        // of a hidden run where the other's surface in front of it ends beside it.
+        let hides = |i: usize| scene.instances[i].style.hidden_in(style).is_some();
+        let mut crossed = vec![false; scene.instances.len()];
+        for ((a, b), found) in &pair_crossings {
+            if !found.is_empty() || hides(*a) || hides(*b) {
+                crossed[*a] = outlines_of(*a);
+                crossed[*b] = outlines_of(*b);
+            }
+        }
         crossing |= crossed.contains(&true);
         let guard = if guarded {
             let band = guard_band(scene, style);
@@ -443,7 +459,7 @@ impl FrameRecords {
         let hidden_color = hidden_styles.iter().flatten().map(|h| h.color).next();
         let (chain_work, phase_words, chains) = phase_tables(store, scene, &order, &mut records)?;
         let intersections = if style.intersection_lines {
-            intersection_records(store, scene, &order, &placed, pairs)?
+            intersection_records(store, scene, &order, &pair_crossings)?
         } else {
             Vec::new()
         };
@@ -618,16 +634,45 @@ fn phase_tables(
     Ok((chain_work, phase_words, chains))
 }
 
+/// The pairs of instances whose surfaces may cross (their bounds, grown by the pair's
+/// crossing tolerance, meet) that `wanted` asks for, and where they cross, found or kept in
+/// `pairs` where the caller keeps one: an instance another passes through tests its lines'
+/// visibility more widely, and intersection lines are drawn along the crossings. Pairs whose
+/// bounds meet but whose surfaces do not cross (parts side by side in an assembly, one inside
+/// another) are drawn as any two instances are, unless they draw hidden lines.
+type PairCrossings = Vec<((usize, usize), Arc<[PairCrossing]>)>;
+
+fn instance_pair_crossings(
+    store: &MeshStore,
+    scene: &Scene<'_>,
+    placed: &[((DVec3, DVec3), DMat4)],
+    wanted: impl Fn((usize, usize)) -> bool,
+    pairs: Option<&mut PairCache>,
+) -> Result<PairCrossings> {
+    let mut fresh = PairCache::default();
+    let cache = pairs.unwrap_or(&mut fresh);
+    cache.begin_frame();
+    let mut found = Vec::new();
+    for (i, j) in crate::scene::crossing_pairs(placed) {
+        if !wanted((i, j)) {
+            continue;
+        }
+        let (a, b) = (&scene.instances[i], &scene.instances[j]);
+        let records = (store.record(a.mesh)?, store.record(b.mesh)?);
+        let pair = ((a.mesh, a.transform), (b.mesh, b.transform));
+        found.push(((i, j), cache.between(pair, records)));
+    }
+    Ok(found)
+}
+
 /// A frame's intersection lines: every crossing pair of every instance's mesh, and of every
-/// two instances that pass through each other (`instance_crossings.rs`), found or kept in
-/// `pairs` where the caller keeps one. `order` maps slots to the scene's instances;
-/// `placed`, each instance's bounds and transform.
+/// two instances that pass through each other (`pair_crossings`, by the scene's instance
+/// indices). `order` maps slots to the scene's instances.
 fn intersection_records(
     store: &MeshStore,
     scene: &Scene<'_>,
     order: &[u32],
-    placed: &[((DVec3, DVec3), DMat4)],
-    pairs: Option<&mut PairCache>,
+    pair_crossings: &PairCrossings,
 ) -> Result<Vec<IntersectionRecord>> {
     let mut intersections = Vec::new();
     for (slot, &i) in order.iter().enumerate() {
@@ -646,15 +691,8 @@ fn intersection_records(
     for (slot, &i) in order.iter().enumerate() {
         slot_of[i as usize] = slot as u32;
     }
-    let mut fresh = PairCache::default();
-    let cache = pairs.unwrap_or(&mut fresh);
-    cache.begin_frame();
-    for (i, j) in crate::scene::crossing_pairs(placed) {
-        let (a, b) = (&scene.instances[i], &scene.instances[j]);
-        let records = (store.record(a.mesh)?, store.record(b.mesh)?);
-        let pair = ((a.mesh, a.transform), (b.mesh, b.transform));
-        let (slot, other) = (slot_of[i], slot_of[j]);
-        let found = cache.between(pair, records);
+    for ((i, j), found) in pair_crossings {
+        let (slot, other) = (slot_of[*i], slot_of[*j]);
         intersections.extend(found.iter().map(|c| IntersectionRecord {
             a: c.ends[0],
             slot,

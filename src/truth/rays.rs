@@ -331,8 +331,8 @@ pub(crate) struct ObjectStyle {
     pub outline_pattern: [f64; 2],
     /// The world has section planes.
     pub sectioned: bool,
-    /// Its placed bounds meet another object's ([`crate::scene::overlapping`]), so the two
-    /// may pass through each other, and it draws its outline.
+    /// Another object's surface passes through it ([`crossed_objects`]), and it draws its
+    /// outline.
     pub crossed: bool,
     /// The cut lines' width.
     pub section_width: f64,
@@ -342,9 +342,47 @@ pub(crate) struct ObjectStyle {
     pub normal: DMat3,
 }
 
+/// Per object, whether its lines are drawn as where another's surface passes through it,
+/// as the pass decides: a pair whose bounds, grown by the pair's tolerance, meet
+/// (`scene::crossing_pairs`) and whose triangles cross (`crossings_between`, in world
+/// coordinates), or either of which draws hidden lines.
+fn crossed_objects(
+    world: &World,
+    placed: &[((DVec3, DVec3), DMat4)],
+    style: &style::Style,
+) -> Vec<bool> {
+    let hides = |o: usize| world.objects[o].style.hidden_in(style).is_some();
+    use crate::mesh::crossings::{crossings_between, pair_tolerance};
+    let corners = |o: usize| -> Vec<[DVec3; 3]> {
+        let object = &world.objects[o];
+        let mesh = &world.meshes[object.mesh].mesh;
+        let p = mesh.positions();
+        mesh.triangles()
+            .iter()
+            .map(|t| t.map(|v| object.transform.transform_point3(p[v as usize].as_dvec3())))
+            .collect()
+    };
+    let boxes: Vec<_> = placed
+        .iter()
+        .map(|&(bounds, t)| crate::scene::world_box(bounds, t))
+        .collect();
+    let mut crossed = vec![false; placed.len()];
+    for (a, b) in crate::scene::crossing_pairs(placed) {
+        let tolerance = pair_tolerance(boxes[a], boxes[b]);
+        if hides(a)
+            || hides(b)
+            || !crossings_between(&corners(a), &corners(b), tolerance).is_empty()
+        {
+            crossed[a] = true;
+            crossed[b] = true;
+        }
+    }
+    crossed
+}
+
 impl ObjectStyle {
     /// Whether the object's drawn edges are in the outline map (dashed or dotted, cut by
-    /// section planes, or perhaps crossed by another object), not measured from each pixel's
+    /// section planes, or crossed by another object), not measured from each pixel's
     /// own triangle.
     pub fn listed_edges(&self) -> bool {
         self.edges && (self.edge_pattern[1] > 0.0 || self.sectioned || self.crossed)
@@ -356,7 +394,7 @@ impl ObjectStyle {
             .iter()
             .map(|o| (world.meshes[o.mesh].mesh.bounds_f64(), o.transform))
             .collect();
-        let crossed = crate::scene::overlapping(&placed);
+        let crossed = crossed_objects(world, &placed, style);
         world
             .objects
             .iter()
