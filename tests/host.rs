@@ -1498,13 +1498,20 @@ fn soak_memory_stays_flat_over_changing_frames() {
         let view = f
             .scene
             .view(f64::from(size.0) / f64::from(size.1), DepthRange::Standard);
-        // 1 to 12 instances, the cow and the monkey in turn, each a little apart.
+        // 1 to 12 instances, the cow and the monkey in turn: the first three a little apart
+        // (through each other, so the frames' intersection tests and wide windows come and
+        // go), the rest in a row further off.
         let count = 1 + (i / 10 * 5) % 12;
         let instances: Vec<Instance> = (0..count)
             .map(|k| {
                 let mut inst = base.instances[k % 2];
+                let x = if k < 3 {
+                    0.3 * k as f64
+                } else {
+                    1.5 * k as f64
+                };
                 inst.transform = wirepass::glam::DMat4::from_translation(
-                    wirepass::glam::DVec3::new(0.3 * k as f64, 0.0, -0.4 * k as f64),
+                    wirepass::glam::DVec3::new(x, 0.0, -0.4 * k as f64),
                 ) * inst.transform;
                 inst
             })
