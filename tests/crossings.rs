@@ -110,12 +110,12 @@ fn cameras(target: DVec3) -> Vec<(&'static str, View)> {
 #[test]
 fn the_crossing_triangles_are_found() {
     let boxes = two_boxes();
-    let crossing = boxes.crossings();
+    let crossing = boxes.crossed_triangles();
     let count = crossing.iter().filter(|&&c| c).count();
     println!("two boxes: {count} of {} triangles cross", crossing.len());
     assert!(count >= 6 && count < crossing.len(), "{count}");
     let suzanne = load("suzanne.obj");
-    let count = suzanne.crossings().iter().filter(|&&c| c).count();
+    let count = suzanne.crossed_triangles().iter().filter(|&&c| c).count();
     println!(
         "suzanne: {count} of {} triangles cross",
         suzanne.triangle_count()
@@ -123,7 +123,7 @@ fn the_crossing_triangles_are_found() {
     assert!(count > 0, "Suzanne's eyes pass through its head");
     for name in ["fandisk.obj", "spot.obj"] {
         let mesh = load(name);
-        let count = mesh.crossings().iter().filter(|&&c| c).count();
+        let count = mesh.crossed_triangles().iter().filter(|&&c| c).count();
         assert_eq!(
             count, 0,
             "{name}: a closed, embedded surface crosses nothing"

@@ -215,7 +215,7 @@ fn seen_crossing(
 
 #[test]
 fn same_render_twice_is_identical() {
-    let mesh = wirepass::mesh::default_scene();
+    let mesh = wirepass::mesh::builtin_mesh();
     let cam = framing(&mesh, (300, 200));
     let a = draw(&mesh, cam, (300, 200), EdgeSelection::Polygon);
     let b = draw(&mesh, cam, (300, 200), EdgeSelection::Polygon);
@@ -370,7 +370,7 @@ fn overlay_blends_lines_over_the_host_image_and_resizes() {
 fn timer_reports_every_pass() {
     let ctx = gpu();
     let device = &ctx.device;
-    let mesh = wirepass::mesh::default_scene();
+    let mesh = wirepass::mesh::builtin_mesh();
     let mut pass = DeferredPass::new(device, PassOptions::default())
         .unwrap()
         .with_diagnostics();

@@ -65,17 +65,24 @@ impl PairCache {
         let bits = |m: DMat4| m.to_cols_array().map(f64::to_bits);
         let key = (a.0, b.0, bits(a.1), bits(b.1));
         let now = self.frames;
-        let entry = self
-            .entries
-            .entry(key)
-            .or_insert_with(|| (now, crossings(records.0, a.1, records.1, b.1).into()));
+        let entry = self.entries.entry(key).or_insert_with(|| {
+            (
+                now,
+                crossings_of_pair(records.0, a.1, records.1, b.1).into(),
+            )
+        });
         entry.0 = now;
         entry.1.clone()
     }
 }
 
 /// Where mesh `a` placed by `ta` and mesh `b` placed by `tb` cross, sorted by triangle.
-pub(crate) fn crossings(a: &MeshRecord, ta: DMat4, b: &MeshRecord, tb: DMat4) -> Vec<PairCrossing> {
+pub(crate) fn crossings_of_pair(
+    a: &MeshRecord,
+    ta: DMat4,
+    b: &MeshRecord,
+    tb: DMat4,
+) -> Vec<PairCrossing> {
     let (box_a, box_b) = (world_box(a.bounds, ta), world_box(b.bounds, tb));
     let tolerance = pair_tolerance(box_a, box_b);
     let overlap = (
@@ -176,7 +183,7 @@ mod tests {
             DMat4::from_translation(shift),
             DMat4::from_translation(shift) * DMat4::from_scale(DVec3::new(-1.0, 1.0, 1.0)),
         ] {
-            let found = crossings(&cube, DMat4::IDENTITY, &cube, tb);
+            let found = crossings_of_pair(&cube, DMat4::IDENTITY, &cube, tb);
             let mut length = 0.0;
             for c in &found {
                 let [p, q] = world_ends(&cube, DMat4::IDENTITY, c);
@@ -189,7 +196,7 @@ mod tests {
         }
         // Apart: nothing.
         let apart = DMat4::from_translation(DVec3::new(2.5, 0.3, 0.2));
-        assert!(crossings(&cube, DMat4::IDENTITY, &cube, apart).is_empty());
+        assert!(crossings_of_pair(&cube, DMat4::IDENTITY, &cube, apart).is_empty());
     }
 
     /// Passing over the clusters that miss the overlap loses no crossing: dense spheres,
@@ -202,7 +209,7 @@ mod tests {
         let tb = DMat4::from_translation(DVec3::new(0.9, 0.7, 0.1))
             * DMat4::from_rotation_x(1.1)
             * DMat4::from_scale(DVec3::new(-0.8, 0.8, 0.8));
-        let found = crossings(&record, ta, &record, tb);
+        let found = crossings_of_pair(&record, ta, &record, tb);
         let all = |t: DMat4| -> Vec<[DVec3; 3]> {
             record
                 .indices

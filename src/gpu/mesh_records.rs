@@ -362,7 +362,7 @@ impl EdgeData {
         for (s, &t) in order.iter().enumerate() {
             stored[t as usize] = s as u32;
         }
-        let patches = Patches::ordered(neighbours, &mask, mesh.crossings(), |t, u| {
+        let patches = Patches::ordered(neighbours, &mask, mesh.crossed_triangles(), |t, u| {
             stored[t] < stored[u]
         });
         let hints = mesh.outline_hints();

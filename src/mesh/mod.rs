@@ -40,7 +40,7 @@ pub use formats::{
     FORMATS,
 };
 pub use procedural::{
-    cube, default_parts, default_scene, grid, layers, sphere, torus, Procedural, LAYER_TRIANGLES,
+    builtin_mesh, cube, default_parts, grid, layers, sphere, torus, Procedural, LAYER_TRIANGLES,
 };
 
 use crate::error::{Error, Result};
@@ -150,7 +150,7 @@ pub struct Mesh {
     /// [`Mesh::outline_clusters`].
     outline_clusters: std::sync::OnceLock<clusters::Clusters>,
     /// The crossing pairs, and per triangle whether it crosses another: see
-    /// [`Mesh::crossings`].
+    /// [`Mesh::crossed_triangles`].
     crossings: std::sync::OnceLock<(Vec<crossings::Crossing>, Vec<bool>)>,
 }
 
@@ -433,7 +433,7 @@ impl Mesh {
     #[cfg_attr(not(feature = "truth"), doc(hidden))]
     /// Per triangle, whether it crosses another triangle of the mesh (the mesh passes through
     /// itself there): see `crossings::crossing_triangles`. Computed once, on first use.
-    pub fn crossings(&self) -> &[bool] {
+    pub fn crossed_triangles(&self) -> &[bool] {
         &self.crossing_pairs().1
     }
 
@@ -689,7 +689,7 @@ mod tests {
     #[test]
     fn one_triangle_s_mask_is_the_whole_mesh_s() {
         let sphere = procedural::sphere(500).unwrap();
-        let scene = procedural::default_scene();
+        let scene = procedural::builtin_mesh();
         let authored = quad().with_authored_edges(vec![0b001, 0b110]).unwrap();
         for mesh in [&sphere, &scene, &authored] {
             for selection in [

@@ -264,15 +264,15 @@ pub fn torus(n: usize) -> Result<Mesh> {
 }
 
 #[cfg_attr(not(feature = "truth"), doc(hidden))]
-/// The scene drawn when no mesh is given: a torus of 3 072 triangles, tilted towards the
-/// default camera, whose quads show polygon mode, beside a small UV sphere whose pole caps
-/// are fans of thin triangles.
-pub fn default_scene() -> Mesh {
+/// The built-in scene, drawn when no mesh is given, as one mesh: a torus of 3 072
+/// triangles, tilted towards the default camera, whose quads show polygon mode, beside a
+/// small UV sphere whose pole caps are fans of thin triangles.
+pub fn builtin_mesh() -> Mesh {
     let tilt = Quat::from_rotation_x(40f32.to_radians());
     let mut scene = torus_parts(64, 24).transformed(tilt, 1.0, Vec3::ZERO);
     scene.append(uv_sphere(10, 20).transformed(tilt, 0.5, Vec3::new(2.0, 0.0, 0.0)));
     // Built directly rather than through `Mesh::new`, which cannot fail on these constant
-    // inputs (the test `default_scene_is_a_valid_mesh` checks it) but returns a Result.
+    // inputs (the test `builtin_mesh_is_a_valid_mesh` checks it) but returns a Result.
     Mesh {
         positions: scene.positions,
         normals: scene.normals,
@@ -289,7 +289,7 @@ pub fn default_scene() -> Mesh {
 }
 
 #[cfg_attr(not(feature = "truth"), doc(hidden))]
-/// The built-in scene's two meshes with their placements: the torus of [`default_scene`],
+/// The built-in scene's two meshes with their placements: the torus of [`builtin_mesh`],
 /// tilted 40° about X, and its unit sphere, tilted, halved and moved 2 along X.
 pub fn default_parts() -> Result<[(Mesh, glam::DMat4); 2]> {
     use glam::{DMat4, DQuat, DVec3};
@@ -513,8 +513,8 @@ mod tests {
     }
 
     #[test]
-    fn default_scene_is_a_valid_mesh() {
-        let m = default_scene();
+    fn builtin_mesh_is_a_valid_mesh() {
+        let m = builtin_mesh();
         assert_eq!(m.triangle_count(), 2 * 64 * 24 + 2 * 20 * 9);
         check_normals_and_winding(&m);
         let checked = Mesh::new(

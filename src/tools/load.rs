@@ -18,7 +18,7 @@ use std::path::Path;
 /// when `None`, the built-in default scene as one mesh.
 pub fn load_mesh(spec: Option<&str>) -> Result<Mesh> {
     match spec {
-        None => Ok(mesh::default_scene()),
+        None => Ok(mesh::builtin_mesh()),
         Some(s) => mesh_spec(s),
     }
 }
@@ -77,7 +77,7 @@ pub fn load_world(spec: Option<&str>, options: &WorldOptions) -> Result<Loaded> 
             Vec::new(),
         ),
         Some(s) if lower.ends_with(".json") => {
-            let file = crate::tools::scene_file::load(Path::new(s), edges, &mesh_spec)?;
+            let file = crate::tools::scene_file::load_scene(Path::new(s), edges, &mesh_spec)?;
             style = file.style;
             highlight = file.highlight;
             (file.world, file.camera.into_iter().collect(), Vec::new())

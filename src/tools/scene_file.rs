@@ -113,7 +113,7 @@ impl FileCamera {
 /// [`Mesh::resolve_edges`](crate::Mesh::resolve_edges)); meshes named more than once (with
 /// the same edges) are loaded once. `load_mesh` turns a mesh spec (procedural name or path,
 /// already made relative to the scene file's folder) into a mesh.
-pub fn load(
+pub fn load_scene(
     path: &Path,
     edges: Option<EdgeSelection>,
     load_mesh: &dyn Fn(&str) -> Result<crate::Mesh>,
@@ -674,7 +674,7 @@ mod tests {
             camera,
             style,
             highlight,
-        } = load(&path, Some(EdgeSelection::Polygon), &procedural).unwrap();
+        } = load_scene(&path, Some(EdgeSelection::Polygon), &procedural).unwrap();
         assert_eq!(highlight, vec![4]);
         assert_eq!(
             style,
@@ -838,7 +838,7 @@ mod tests {
                     source: std::io::Error::from(std::io::ErrorKind::NotFound),
                 }),
             };
-            let e = load(&path, Some(EdgeSelection::Polygon), &loader)
+            let e = load_scene(&path, Some(EdgeSelection::Polygon), &loader)
                 .err()
                 .unwrap_or_else(|| panic!("{text} loaded"))
                 .to_string();

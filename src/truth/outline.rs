@@ -130,7 +130,7 @@ struct Draw {
 }
 
 /// In a frame with section planes, how the eye's ray reaches a line where no other surface
-/// tells (see [`Visibility::class`]): not asked (no planes, or a cut line), from outside the
+/// tells (see [`RayVisibility::class`]): not asked (no planes, or a cut line), from outside the
 /// solid or from inside it (from behind the section face).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 enum Cap {
@@ -150,7 +150,7 @@ pub(crate) fn outline_map(
     host: Option<&HostMap>,
 ) -> OutlineMap {
     let world = caster.world();
-    let view = Visibility {
+    let view = RayVisibility {
         caster,
         rays,
         fade_row: shot.view.view_depth_row(),
@@ -412,7 +412,7 @@ fn splat(
                 let x1 = ((s.from.x.max(s.to.x) + reach).ceil() as usize).min(width as usize);
                 for (x, out) in row.iter_mut().enumerate().take(x1).skip(x0) {
                     let p = DVec2::new(x as f64 + 0.5, cy);
-                    let (d, at) = segment_distance(p, s.from, s.to);
+                    let (d, at) = nearest_on_segment(p, s.from, s.to);
                     if !(d < reach + edge_math::REACH_SLACK) {
                         continue;
                     }
@@ -464,7 +464,7 @@ fn splat(
 }
 
 /// Distance from `p` to the segment `a → b`, and the parameter of its nearest point.
-pub fn segment_distance(p: DVec2, a: DVec2, b: DVec2) -> (f64, f64) {
+pub fn nearest_on_segment(p: DVec2, a: DVec2, b: DVec2) -> (f64, f64) {
     let seg = b - a;
     let len2 = seg.length_squared();
     let at = if len2 > 0.0 {
@@ -475,8 +475,8 @@ pub fn segment_distance(p: DVec2, a: DVec2, b: DVec2) -> (f64, f64) {
     (p.distance(a + seg * at), at)
 }
 
-/// Visibility of points of outline edges, by ray casts.
-struct Visibility<'a> {
+/// The visibility of points of lines, by ray casts.
+struct RayVisibility<'a> {
     caster: &'a RayCaster<'a>,
     rays: &'a Rays,
     fade_row: DVec4,
@@ -495,7 +495,7 @@ enum Class {
     Neither,
 }
 
-impl Visibility<'_> {
+impl RayVisibility<'_> {
     /// The visible stretches of the intersection lines between objects, `width` wide.
     fn lines_between_objects(&self, width: f64) -> Vec<Stretch> {
         use crate::mesh::crossings::{crossings_between, pair_tolerance};
@@ -830,7 +830,7 @@ impl Visibility<'_> {
 
 /// In a frame with section planes, back faces stand for the section face of a cut solid,
 /// and a line point that the eye's ray reaches from inside the solid lies behind that face
-/// (see [`Visibility::class`]). Where no other surface lies just in front of the point, the
+/// (see [`RayVisibility::class`]). Where no other surface lies just in front of the point, the
 /// line's own triangles tell (twin of `capped` in outline.wgsl): the ray reaches from inside
 /// a line between two back faces (global triangle `t` and its neighbour `n`), a back face's
 /// boundary (`n` is `None`), and a silhouette where the surface folds inwards (concave);
@@ -920,7 +920,7 @@ fn dashes(
     out
 }
 
-/// A projected point of an edge: see [`Visibility::project`].
+/// A projected point of an edge: see [`RayVisibility::project`].
 #[derive(Clone, Copy, Debug)]
 struct Projected {
     xy: DVec2,
@@ -1173,7 +1173,7 @@ mod tests {
         let patches = [Patches::new(
             mesh.edge_neighbours(),
             &masks[0],
-            mesh.crossings(),
+            mesh.crossed_triangles(),
         )];
         outline_map(&caster, &rays, &shot, &styles, (&patches, &masks), None)
     }
@@ -1235,7 +1235,7 @@ mod tests {
         let cam = camera(Vec3::new(0.0, 0.0, 4.0));
         let view = cam.to_view(1.0);
         let rays = Rays::new(&view, (64, 64), &world).unwrap();
-        let vis = Visibility {
+        let vis = RayVisibility {
             caster: &caster,
             rays: &rays,
             fade_row: view.view_depth_row(),

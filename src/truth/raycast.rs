@@ -113,7 +113,7 @@ pub fn draw_raycast_over(shot: &Shot<'_>, host: Option<&HostOccluders<'_>>) -> R
         .meshes
         .iter()
         .zip(&masks)
-        .map(|(m, mask)| Patches::new(m.mesh.edge_neighbours(), mask, m.mesh.crossings()))
+        .map(|(m, mask)| Patches::new(m.mesh.edge_neighbours(), mask, m.mesh.crossed_triangles()))
         .collect();
     let eyes: Vec<DVec4> = world
         .objects

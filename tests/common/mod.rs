@@ -321,9 +321,12 @@ pub fn near_crossed(
     radius: f64,
 ) -> Vec<bool> {
     let masks = mesh.edge_mask(edges);
-    let crossed =
-        wirepass::mesh::patches::Patches::new(mesh.edge_neighbours(), &masks, mesh.crossings())
-            .crossed;
+    let crossed = wirepass::mesh::patches::Patches::new(
+        mesh.edge_neighbours(),
+        &masks,
+        mesh.crossed_triangles(),
+    )
+    .crossed;
     let vp = camera.view_projection(size.0, size.1);
     let extent = DVec2::new(f64::from(size.0), f64::from(size.1));
     let mut near = vec![false; size.0 as usize * size.1 as usize];
