@@ -16,8 +16,6 @@ use super::outline_pass::{piece_size_at, OutlinePass};
 use super::targets::{self, check_sampled, check_storage_output, TargetSpec, Targets, LIST_HEADER};
 use super::variants::{Mode, Variant};
 use super::visibility::Visibility;
-#[cfg(feature = "diagnostics")]
-use super::EncodeOptions;
 use super::{shaders, GpuTimer};
 use crate::error::{Error, Result};
 use crate::scene::Scene;
@@ -41,114 +39,6 @@ pub struct PreparedFrame {
     encoded: AtomicU64,
 }
 
-/// How much of a frame the edge pass's later dispatches took on (see
-/// [`PreparedFrame::edge_work`]).
-#[cfg(feature = "diagnostics")]
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct EdgeWork {
-    /// 8×8 output tiles holding foreground, which the tile dispatch visited.
-    pub tiles: u32,
-    /// Output tiles the outline pass's lines reach, whose background the edge pass's
-    /// outlined dispatch visited (0 where the outline pass did not run).
-    pub outlined_tiles: u32,
-    /// Output tiles in all.
-    pub all_tiles: u32,
-    /// Pixels the refine dispatch decided: centres the exact test could not settle from the
-    /// rasterizer's triangle, and background next to foreground.
-    pub refined: u32,
-    /// Output pixels in all.
-    pub pixels: u32,
-    /// Clusters of 64 triangles the outline pass's cull listed (those that may hold an
-    /// outline edge from the eye, or a drawn edge of a large patch), 0 where it did not run.
-    pub outline_clusters: u32,
-    /// Lines the outline pass listed pieces of (outline and drawn edges, cut and
-    /// intersection lines with a piece within reach of the targets), 0 where it did not run.
-    pub outline_lines: u32,
-    /// Pieces (up to 2 px, or 1 px for [`Tuning::Gpu`](super::Tuning::Gpu)) of those lines
-    /// the outline pass listed or found beyond its list's room, 0 where it did not run.
-    pub outline_pieces: u32,
-    /// How many of them its piece list has room for.
-    pub piece_room: u32,
-    /// Clusters (and groups of 64 intersection segments) whose pieces the list had no room
-    /// for, which the piece dispatch drew 64 lanes each.
-    pub overflowed: u32,
-}
-
-#[cfg(feature = "diagnostics")]
-impl PreparedFrame {
-    /// What the outline pass and the edge pass's tile and refine dispatches took on in the
-    /// last encode of this frame, read back from the GPU (it waits for the work submitted so
-    /// far): for tools, tests and benchmarks. [`edge_work_async`](Self::edge_work_async)
-    /// reads it without blocking.
-    #[cfg(not(target_arch = "wasm32"))]
-    pub fn edge_work(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<EdgeWork> {
-        let mut counts = [0u32; 7];
-        for (count, (buffer, at)) in counts.iter_mut().zip(self.counters()) {
-            if let Some(buffer) = buffer {
-                let bytes = super::readback::read_buffer(device, queue, buffer, at, 4)?;
-                *count = u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]);
-            }
-        }
-        Ok(self.edge_work_of(counts))
-    }
-
-    /// [`edge_work`](Self::edge_work) without blocking, as a browser needs.
-    pub async fn edge_work_async(
-        &self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-    ) -> Result<EdgeWork> {
-        let mut counts = [0u32; 7];
-        for (count, (buffer, at)) in counts.iter_mut().zip(self.counters()) {
-            if let Some(buffer) = buffer {
-                let read = super::readback::read_buffer_async(device, queue, buffer, at, 4);
-                let bytes = read.await?;
-                *count = u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]);
-            }
-        }
-        Ok(self.edge_work_of(counts))
-    }
-
-    /// Where the counts lie (a list's is the last word of its header): the tile list, the
-    /// outlined tiles, the refine list, the cluster list, the lines and the pieces listed,
-    /// and the overflow list (the last five only where the outline pass ran).
-    fn counters(&self) -> [(Option<&wgpu::Buffer>, u64); 7] {
-        let t = &self.targets;
-        let outlines = |b| self.data.outlines.then_some(b);
-        let count = LIST_HEADER - 4;
-        [
-            (Some(&t.tiles), count),
-            (outlines(&t.acc), t.acc_tiles + count),
-            (Some(&t.work), count),
-            (outlines(&self.cull), count),
-            (outlines(&t.acc), t.acc_overflow),
-            (outlines(&t.acc), t.acc_pieces + count),
-            (outlines(&t.acc), t.acc_overflow + count),
-        ]
-    }
-
-    /// The work from the counts at [`counters`](Self::counters).
-    fn edge_work_of(
-        &self,
-        [tiles, outlined_tiles, refined, clusters, lines, pieces, overflowed]: [u32; 7],
-    ) -> EdgeWork {
-        let (w, h) = self.targets.output;
-        let tile = super::edge_pass::TILE;
-        EdgeWork {
-            tiles,
-            outlined_tiles,
-            all_tiles: w.div_ceil(tile) * h.div_ceil(tile),
-            refined,
-            pixels: w * h,
-            outline_clusters: clusters,
-            outline_lines: lines,
-            outline_pieces: pieces,
-            piece_room: self.targets.piece_room(),
-            overflowed,
-        }
-    }
-}
-
 impl PreparedFrame {
     /// The output size.
     pub fn output_size(&self) -> (u32, u32) {
@@ -165,19 +55,6 @@ impl PreparedFrame {
     /// The reverse depth target (`Depth32Float`, 1 = near plane), as the ids.
     pub fn depth_texture(&self) -> &wgpu::Texture {
         &self.targets.depth
-    }
-
-    /// The (instance slot, triangle) each output pixel centre sees after the exact coverage
-    /// test, written by [`OutputTarget::Diagnostic`].
-    #[cfg(feature = "diagnostics")]
-    pub fn resolved_id_texture(&self) -> Option<&wgpu::Texture> {
-        self.targets.diagnostic.as_ref().map(|d| &d.1)
-    }
-
-    /// The diagnostic map written by [`OutputTarget::Diagnostic`].
-    #[cfg(feature = "diagnostics")]
-    pub fn diagnostic_texture(&self) -> Option<&wgpu::Texture> {
-        self.targets.diagnostic.as_ref().map(|d| &d.0)
     }
 
     /// For each instance slot of the id maps, the index of the instance in the scene.
@@ -293,10 +170,10 @@ pub struct DeferredPass {
     results: AtomicU64,
     /// Header every list starts a frame with: no work, one workgroup row.
     reset: wgpu::Buffer,
-    diagnostics: bool,
+    pub(super) diagnostics: bool,
     /// Entries of the outline pass's piece list, where a test sets it.
-    piece_room: Option<u64>,
-    targets: Option<Targets>,
+    pub(super) piece_room: Option<u64>,
+    pub(super) targets: Option<Targets>,
     cull: Option<wgpu::Buffer>,
     /// The intersection lines of instance pairs found for recent frames
     /// (`instance_crossings.rs`), kept while the pairs' placements stay.
@@ -370,26 +247,6 @@ impl DeferredPass {
             cull: None,
             pairs: PairCache::default(),
         })
-    }
-
-    /// Enables [`OutputTarget::Diagnostic`], which needs 24 more bytes of targets per pixel
-    /// (and, where the outline pass runs, a second word per pixel in its buffer, which tells
-    /// outlines from edges for the line-class map); tools and tests use it, a renderer does
-    /// not need it.
-    #[cfg(feature = "diagnostics")]
-    pub fn with_diagnostics(mut self) -> Self {
-        self.diagnostics = true;
-        self.targets = None;
-        self
-    }
-
-    /// Gives the outline pass's piece list room for `pieces` entries instead of one per 8
-    /// target pixels, so that a test can draw a frame whose pieces overflow it.
-    #[cfg(feature = "diagnostics")]
-    pub fn with_piece_room(mut self, pieces: u64) -> Self {
-        self.piece_room = Some(pieces);
-        self.targets = None;
-        self
     }
 
     /// The format [`OutputTarget::Shaded`] and [`OutputTarget::Overlay`] write.
@@ -620,33 +477,8 @@ impl DeferredPass {
         self.encode_inner(device, encoder, store, frame, target, None, true)
     }
 
-    /// [`encode`](Self::encode) with what tools add (see [`EncodeOptions`]): timestamps
-    /// around each pass, or a second output over the ids the last encode of this frame
-    /// rasterized.
-    #[cfg(feature = "diagnostics")]
-    pub fn encode_with(
-        &self,
-        device: &wgpu::Device,
-        encoder: &mut wgpu::CommandEncoder,
-        store: &MeshStore,
-        frame: &PreparedFrame,
-        target: OutputTarget<'_>,
-        options: EncodeOptions<'_>,
-    ) -> Result<()> {
-        let visibility = !options.reuse_ids;
-        self.encode_inner(
-            device,
-            encoder,
-            store,
-            frame,
-            target,
-            options.timer,
-            visibility,
-        )
-    }
-
     #[allow(clippy::too_many_arguments)]
-    fn encode_inner(
+    pub(super) fn encode_inner(
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,

@@ -1,7 +1,7 @@
 //! What tools and tests add to an encode (feature `diagnostics`): GPU timestamps around each
 //! pass, a second output of an already rasterized frame, and the baselines' id and distance
 //! maps. A renderer needs none of it; every pass's plain `encode` is `encode_with` and the
-//! default options.
+//! default options. What the deferred pass adds is in `deferred_diagnostics.rs`.
 
 use super::GpuTimer;
 

@@ -18,6 +18,8 @@ mod composite;
 mod context;
 mod deferred;
 #[cfg(feature = "diagnostics")]
+mod deferred_diagnostics;
+#[cfg(feature = "diagnostics")]
 mod diagnostics;
 mod edge_pass;
 mod frame;
@@ -52,9 +54,9 @@ pub use composite::{Composite, RenderTarget};
 // An adapter and device for the command line, the tools and the tests.
 #[cfg(all(feature = "tools", not(target_arch = "wasm32")))]
 pub use context::GpuContext;
-#[cfg(feature = "diagnostics")]
-pub use deferred::EdgeWork;
 pub use deferred::{DeferredPass, PreparedFrame, WarmUp};
+#[cfg(feature = "diagnostics")]
+pub use deferred_diagnostics::EdgeWork;
 #[cfg(feature = "diagnostics")]
 pub use diagnostics::EncodeOptions;
 // For the ground truth, which shades and reads host depth as the pass does.
