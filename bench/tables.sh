@@ -29,8 +29,10 @@ out="$(mktemp -d)"
 trap 'rm -rf "$out"' EXIT
 
 # The scenes of the docs: UV spheres from few to many triangles per pixel, a scanned mesh,
-# and depth complexity without triangles (layers:16); every method, outlines on and off.
-scenes="sphere:20000 sphere:200000 sphere:2000000 tests/data/meshes/stanford-bunny.obj layers:16"
+# depth complexity without triangles (layers:16), and two instances whose bounds meet, side
+# by side and passing through each other (bench/scenes); every method, outlines on and off.
+scenes="sphere:20000 sphere:200000 sphere:2000000 tests/data/meshes/stanford-bunny.obj layers:16
+    bench/scenes/side-by-side.json bench/scenes/through-each-other.json"
 # shellcheck disable=SC2086 # the scenes are separate arguments
 "$bin" bench $scenes --size 1280x720 --frames "$frames" --warmup 3 --outlines on,off \
     --out "$out" --record bench/baseline.json --commit "$commit" --date "$date" \
@@ -57,6 +59,9 @@ run's ratios against it and flags those that worsened by more than 15 %.
   geometry-shader method itself on the machine's OpenGL, timed from issuing the frame to
   \`glFinish\` on a software renderer (its GL timestamps miss the vertex and geometry
   stages there), by its timestamps on a GPU.
+- \`bench/scenes/side-by-side.json\`: Spot, and Suzanne beside it, their bounds meeting but
+  not their surfaces; \`through-each-other.json\`: Suzanne passing through Spot, whose
+  lines the outline pass draws where visible, in one-pixel pieces tested over 9×9 windows.
 - Ratios: \`deferred ÷ gs\` and \`÷ forward\`, the whole frame; \`edge ÷ floor\`, the edge
   pass's dispatches against the floor's one compute pass; \`edge ÷ edge at sphere:20000\`,
   the edge pass against its time on the sphere of fewest triangles (flat is 1).
