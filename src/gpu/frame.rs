@@ -634,14 +634,15 @@ fn phase_tables(
     Ok((chain_work, phase_words, chains))
 }
 
+/// Pairs of instances (by their index in the scene) and where their surfaces cross.
+type PairCrossings = Vec<((usize, usize), Arc<[PairCrossing]>)>;
+
 /// The pairs of instances whose surfaces may cross (their bounds, grown by the pair's
 /// crossing tolerance, meet) that `wanted` asks for, and where they cross, found or kept in
 /// `pairs` where the caller keeps one: an instance another passes through tests its lines'
 /// visibility more widely, and intersection lines are drawn along the crossings. Pairs whose
 /// bounds meet but whose surfaces do not cross (parts side by side in an assembly, one inside
 /// another) are drawn as any two instances are, unless they draw hidden lines.
-type PairCrossings = Vec<((usize, usize), Arc<[PairCrossing]>)>;
-
 fn instance_pair_crossings(
     store: &MeshStore,
     scene: &Scene<'_>,

@@ -159,7 +159,7 @@ pub struct Mesh {
 /// Unlike `OnceLock::get_or_init`, no thread waits while another computes: the computations
 /// run on rayon's workers, and a worker that blocked on a cell another worker fills could
 /// hold, queued beneath it, the very job that computation waits for (two threads inserting
-/// one mesh deadlocked so). Threads that race compute the same value; the first one stored
+/// one mesh can deadlock so). Threads that race compute the same value; the first one stored
 /// is kept.
 fn computed_once<T>(cell: &std::sync::OnceLock<T>, compute: impl FnOnce() -> T) -> &T {
     if let Some(value) = cell.get() {
