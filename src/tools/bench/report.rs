@@ -162,7 +162,9 @@ pub fn summary_markdown(runs: &[Run]) -> String {
                 parts.join(" / ")
             }
         };
-        let edge_floor = ratios(&|d| Some(edge(d)? / edge(floor?)?));
+        // Against the floor timed beside the same setting, as the ratios table takes it.
+        let floor_of = |d: &Run| find("floor", Some(d.outlines)).or(floor);
+        let edge_floor = ratios(&|d| Some(edge(d)? / edge(floor_of(d)?)?));
         let deferred_gs = ratios(&|d| Some(d.total_median_ms / gs?.total_median_ms));
         out += &format!(
             "| {} | {} | {}x{} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
