@@ -460,8 +460,9 @@ fn intersection_lines_between_instances() {
 /// the boxes cross, gone when one moves clear, back to the same bits when it returns.
 #[test]
 fn intersection_lines_follow_moving_instances() {
+    use wirepass::gpu::Canvas;
     use wirepass::gpu::{DeferredPass, PassOptions};
-    use wirepass::tools::offline::draw_deferred_with;
+    use wirepass::tools::offline::draw_deferred_on;
     use wirepass::world::offscreen::Uploaded;
     use wirepass::world::Shot;
     let ctx = common::gpu();
@@ -482,7 +483,14 @@ fn intersection_lines_follow_moving_instances() {
             size: SIZE,
         };
         let pass = DeferredPass::new(&ctx.device, PassOptions::default()).unwrap();
-        draw_deferred_with(ctx, &shot, &up, pass.with_diagnostics()).unwrap()
+        draw_deferred_on(
+            ctx,
+            &shot,
+            &up,
+            pass.with_diagnostics(),
+            Canvas::new(shot.size),
+        )
+        .unwrap()
     };
     let class = LineClass::Intersection as u8;
     let lines =
@@ -538,8 +546,9 @@ fn intersection_lines_are_drawn_where_visible() {
 /// along the box's -x face, through which the mirrored Suzanne passes, and through it.
 #[test]
 fn crossed_instances_draw_the_same_frame_every_time() {
+    use wirepass::gpu::Canvas;
     use wirepass::gpu::{DeferredPass, PassOptions};
-    use wirepass::tools::offline::draw_deferred_with;
+    use wirepass::tools::offline::draw_deferred_on;
     use wirepass::world::offscreen::Uploaded;
     use wirepass::world::Shot;
     let world = crossed_instances();
@@ -570,7 +579,14 @@ fn crossed_instances_draw_the_same_frame_every_time() {
         };
         let draw = || {
             let pass = DeferredPass::new(&ctx.device, PassOptions::default()).unwrap();
-            draw_deferred_with(ctx, &shot, &up, pass.with_diagnostics()).unwrap()
+            draw_deferred_on(
+                ctx,
+                &shot,
+                &up,
+                pass.with_diagnostics(),
+                Canvas::new(shot.size),
+            )
+            .unwrap()
         };
         let first = draw();
         for round in 1..6 {

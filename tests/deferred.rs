@@ -6,10 +6,11 @@ mod common;
 use common::{camera, cpu_distance, framing, gpu, load, near_crossed, shoot};
 use glam::{DMat4, Vec3};
 use wirepass::gpu::{
-    DeferredPass, EncodeOptions, MeshStore, OutputTarget, PassOptions, PreparedFrame, Tuning,
+    Canvas, DeferredPass, EncodeOptions, MeshStore, OutputTarget, PassOptions, PreparedFrame,
+    Tuning,
 };
 use wirepass::tools::compare::metrics;
-use wirepass::tools::offline::{draw_deferred_with, Method, Uploaded};
+use wirepass::tools::offline::{draw_deferred_on, Method, Uploaded};
 use wirepass::world::{Rendering, BACKGROUND};
 use wirepass::{
     Camera, Color, EdgeSelection, HiddenLines, Instance, LinePattern, Mesh, Scene, Style,
@@ -736,7 +737,7 @@ fn gpu_tuning_draws_what_the_software_tuning_draws() {
             let pass = DeferredPass::new(device, options)
                 .unwrap()
                 .with_diagnostics();
-            let frame = draw_deferred_with(ctx, &shot, &up, pass).unwrap();
+            let frame = draw_deferred_on(ctx, &shot, &up, pass, Canvas::new(shot.size)).unwrap();
             let m = metrics(&truth, &frame).unwrap();
             println!("{name} {tuning:?}: {m:?}");
             assert!(m.id_agreement >= 0.999, "{name} {tuning:?}: {m:?}");

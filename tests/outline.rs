@@ -256,8 +256,8 @@ fn within_bounds(name: &str, scene: &TestScene) -> Rendering {
 /// section plane lists thousands of pieces; Suzanne's eyes add intersection lines.
 #[test]
 fn pieces_beyond_the_lists_room_are_drawn_all_the_same() {
-    use wirepass::gpu::{DeferredPass, PassOptions};
-    use wirepass::tools::offline::draw_deferred_with;
+    use wirepass::gpu::{Canvas, DeferredPass, PassOptions};
+    use wirepass::tools::offline::draw_deferred_on;
     use wirepass::world::offscreen::Uploaded;
     let ctx = common::gpu();
     let hidden = Style {
@@ -278,7 +278,7 @@ fn pieces_beyond_the_lists_room_are_drawn_all_the_same() {
             if let Some(room) = room {
                 pass = pass.with_piece_room(room);
             }
-            draw_deferred_with(ctx, &scene.shot(), &up, pass).unwrap()
+            draw_deferred_on(ctx, &scene.shot(), &up, pass, Canvas::new(scene.size)).unwrap()
         };
         let listed = draw(None);
         let overflowed = draw(Some(64));

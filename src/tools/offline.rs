@@ -83,7 +83,7 @@ pub fn draw(ctx: &GpuContext, shot: &Shot<'_>, method: Method) -> Result<Renderi
 pub fn draw_deferred(ctx: &GpuContext, shot: &Shot<'_>) -> Result<Rendering> {
     let up = Uploaded::new(&ctx.device, &ctx.queue, shot.world)?;
     let pass = DeferredPass::new(&ctx.device, PassOptions::default())?.with_diagnostics();
-    draw_deferred_with(ctx, shot, &up, pass)
+    draw_deferred_on(ctx, shot, &up, pass, Canvas::new(shot.size))
 }
 
 /// Where the time to a first deferred image goes ([`draw_deferred_timed`]; `wirepass
@@ -182,20 +182,11 @@ fn first_image(ctx: &GpuContext, shot: &Shot<'_>, maps: bool) -> Result<(Drawn, 
     Ok((drawn, timings))
 }
 
-/// [`draw_deferred`] with a pass and upload of the caller's (a pass with lowered limits,
-/// or vertex pulling, say).
-pub fn draw_deferred_with(
-    ctx: &GpuContext,
-    shot: &Shot<'_>,
-    up: &Uploaded,
-    pass: DeferredPass,
-) -> Result<Rendering> {
-    draw_deferred_on(ctx, shot, up, pass, Canvas::new(shot.size))
-}
-
-/// [`draw_deferred_with`] onto a canvas of the caller's: over the host's depth buffer, say
-/// (its pixels where the host is in front get the id [`HOST`](crate::world::HOST)), or a region of the shot's
-/// image (a tile: the frame is the region's size).
+/// [`draw_deferred`] with a pass and upload of the caller's (a pass with lowered limits, or
+/// vertex pulling, say) onto a canvas of the caller's: the whole image
+/// (`Canvas::new(shot.size)`), the image over the host's depth buffer (its pixels where the
+/// host is in front get the id [`HOST`](crate::world::HOST)), or a region of it (a tile: the
+/// frame is the region's size).
 pub fn draw_deferred_on(
     ctx: &GpuContext,
     shot: &Shot<'_>,
