@@ -351,8 +351,8 @@ fn crossed_objects(
     placed: &[((DVec3, DVec3), DMat4)],
     style: &style::Style,
 ) -> Vec<bool> {
-    let hides = |o: usize| world.objects[o].style.hidden_in(style).is_some();
     use crate::mesh::crossings::{crossings_between, pair_tolerance};
+    let hides = |o: usize| world.objects[o].style.hidden_in(style).is_some();
     let corners = |o: usize| -> Vec<[DVec3; 3]> {
         let object = &world.objects[o];
         let mesh = &world.meshes[object.mesh].mesh;
