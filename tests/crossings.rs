@@ -7,7 +7,7 @@
 
 mod common;
 
-use common::{load, truth_and_frame, within_bounds};
+use common::{load, spot_beside_suzanne, truth_and_frame, within_bounds, SIDE_BY_SIDE, THROUGH};
 use glam::{DMat4, DVec3, Vec3};
 use std::sync::Arc;
 use wirepass::world::{LineClass, Object, World, WorldMesh};
@@ -273,36 +273,6 @@ fn instances_through_each_other() {
     );
 }
 
-/// Spot, and Suzanne beside it, turned so that their placed bounds reach across each other
-/// while their surfaces stay apart (0.8 to the side) or pass through each other (0.5).
-fn spot_beside_suzanne(shift: f64) -> World {
-    let centred = |m: &Mesh| {
-        let (lo, hi) = m.bounds_f64();
-        DMat4::from_translation(-0.5 * (lo + hi))
-    };
-    let (spot, suzanne) = (load("spot.obj"), load("suzanne.obj"));
-    let objects = vec![
-        Object::new(0, centred(&spot)),
-        Object::new(
-            1,
-            DMat4::from_translation(DVec3::new(shift, 0.1, 0.0))
-                * DMat4::from_rotation_y(0.8)
-                * DMat4::from_scale(DVec3::splat(0.5))
-                * centred(&suzanne),
-        ),
-    ];
-    let mesh = |mesh: Mesh, name: &str| WorldMesh {
-        mesh: Arc::new(mesh),
-        edges: EdgeSelection::Polygon,
-        name: name.into(),
-    };
-    World {
-        meshes: vec![mesh(spot, "spot"), mesh(suzanne, "suzanne")],
-        objects,
-        sections: Vec::new(),
-    }
-}
-
 /// Instances whose bounds meet but whose surfaces do not cross are drawn as any two
 /// instances are (each pixel's own triangle gives its lines; with hidden lines, the wide
 /// way), and match the ground truth as closely as those that do cross, from every camera;
@@ -313,7 +283,7 @@ fn instances_whose_bounds_meet_but_not_their_surfaces() {
         hidden: Some(wirepass::HiddenLines::default()),
         ..Style::default()
     };
-    for (what, shift) in [("apart", 0.8), ("crossed", 0.5)] {
+    for (what, shift) in [("apart", SIDE_BY_SIDE), ("crossed", THROUGH)] {
         let world = spot_beside_suzanne(shift);
         for (camera, view) in cameras(DVec3::new(0.4, 0.0, 0.0)) {
             check(

@@ -13,13 +13,12 @@
 
 mod common;
 
-use common::{gpu, load};
-use glam::{DMat4, DVec3};
-use std::sync::Arc;
+use common::{gpu, load, spot_beside_suzanne, SIDE_BY_SIDE, THROUGH};
+use glam::DVec3;
 use wirepass::gpu::{DeferredPass, EdgeWork, OutputTarget, PassOptions, Tuning};
 use wirepass::tools::offline::Uploaded;
-use wirepass::world::{Object, World, WorldMesh};
-use wirepass::{Camera, EdgeSelection, HiddenLines, Mesh, SectionPlane, Style};
+use wirepass::world::World;
+use wirepass::{Camera, EdgeSelection, HiddenLines, SectionPlane, Style};
 
 const TABLE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/work.txt");
 
@@ -43,38 +42,6 @@ struct Case {
     size: (u32, u32),
     style: Style,
     section: bool,
-}
-
-/// Instances of spot and Suzanne: side by side, their placed bounds meeting but not their
-/// surfaces (`apart`), or passing through each other.
-fn spot_and_suzanne(apart: bool) -> World {
-    let (spot, suzanne) = (load("spot.obj"), load("suzanne.obj"));
-    let centred = |m: &Mesh| {
-        let (lo, hi) = m.bounds_f64();
-        DMat4::from_translation(-0.5 * (lo + hi))
-    };
-    let (spot_at, suzanne_at) = (centred(&spot), centred(&suzanne));
-    let shift = if apart { 0.8 } else { 0.5 };
-    let mesh = |mesh: Mesh, name: &str| WorldMesh {
-        mesh: Arc::new(mesh),
-        edges: EdgeSelection::Polygon,
-        name: name.into(),
-    };
-    World {
-        meshes: vec![mesh(spot, "spot"), mesh(suzanne, "suzanne")],
-        objects: vec![
-            Object::new(0, spot_at),
-            // Turned a quarter about the vertical, so its bounds reach across the cow's.
-            Object::new(
-                1,
-                DMat4::from_translation(DVec3::new(shift, 0.1, 0.0))
-                    * DMat4::from_rotation_y(0.8)
-                    * DMat4::from_scale(DVec3::splat(0.5))
-                    * suzanne_at,
-            ),
-        ],
-        sections: Vec::new(),
-    }
 }
 
 fn cases() -> Vec<Case> {
@@ -150,14 +117,14 @@ fn cases() -> Vec<Case> {
         // are; those that pass through each other draw every edge where it is visible.
         Case {
             name: "instances-apart",
-            world: spot_and_suzanne(true),
+            world: spot_beside_suzanne(SIDE_BY_SIDE),
             size: small,
             style: Style::default(),
             section: false,
         },
         Case {
             name: "instances-crossed",
-            world: spot_and_suzanne(false),
+            world: spot_beside_suzanne(THROUGH),
             size: small,
             style: Style::default(),
             section: false,

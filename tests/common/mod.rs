@@ -348,3 +348,41 @@ pub fn near_crossed(
     }
     near
 }
+
+/// Suzanne's offset from Spot in [`spot_beside_suzanne`] where their placed bounds meet but
+/// not their surfaces, and where she passes through the cow.
+pub const SIDE_BY_SIDE: f64 = 0.8;
+pub const THROUGH: f64 = 0.5;
+
+/// Spot, and Suzanne `shift` to its side, halved and turned 0.8 rad about the vertical so
+/// that their placed bounds reach across each other: two instances of two meshes, polygon
+/// edges.
+pub fn spot_beside_suzanne(shift: f64) -> World {
+    use glam::{DMat4, DVec3};
+    use wirepass::world::{Object, WorldMesh};
+    let centred = |m: &Mesh| {
+        let (lo, hi) = m.bounds_f64();
+        DMat4::from_translation(-0.5 * (lo + hi))
+    };
+    let (spot, suzanne) = (load("spot.obj"), load("suzanne.obj"));
+    let objects = vec![
+        Object::new(0, centred(&spot)),
+        Object::new(
+            1,
+            DMat4::from_translation(DVec3::new(shift, 0.1, 0.0))
+                * DMat4::from_rotation_y(0.8)
+                * DMat4::from_scale(DVec3::splat(0.5))
+                * centred(&suzanne),
+        ),
+    ];
+    let mesh = |mesh: Mesh, name: &str| WorldMesh {
+        mesh: std::sync::Arc::new(mesh),
+        edges: EdgeSelection::Polygon,
+        name: name.into(),
+    };
+    World {
+        meshes: vec![mesh(spot, "spot"), mesh(suzanne, "suzanne")],
+        objects,
+        sections: Vec::new(),
+    }
+}
