@@ -67,7 +67,8 @@
 //! mesh loaders (OBJ, STL, PLY, glTF), `parallel` preprocessing on all cores, `regression`
 //! FLIP image comparison, `diagnostics` what tools measure the pass with (the benchmark
 //! floor, diagnostic maps, timestamps: `gpu::EncodeOptions`), `truth` the ray-cast ground
-//! truth, and `tools` all of them with offline frames, compare and bench. The `wirepass`
+//! truth, `drawing` the technical drawings (the exact visible and hidden lines as SVG, PDF
+//! and DXF, on the CPU), and `tools` all of them with offline frames, compare and bench. The `wirepass`
 //! command is the workspace's `wirepass-cli` package.
 //!
 //! ## Layers
@@ -75,7 +76,7 @@
 //! Each depends only on those before it (a test checks every file): [`error`]; the frame's
 //! terms ([`camera`], [`style`]) and [`mesh`]; `edge_math`; the loaders
 //! (`mesh::formats`); the pass ([`scene`], [`gpu`]); the world of meshes tools draw
-//! (`world`); the ground truth (`truth`); the tools (`tools`).
+//! (`world`); the ground truth (`truth`) and the drawings (`drawing`); the tools (`tools`).
 
 #![warn(missing_docs)]
 
@@ -92,11 +93,14 @@ pub mod mesh;
 pub mod scene;
 pub mod style;
 
-#[cfg(feature = "truth")]
+#[cfg(any(feature = "truth", feature = "drawing"))]
 pub mod world;
 
 #[cfg(feature = "truth")]
 pub mod truth;
+
+#[cfg(feature = "drawing")]
+pub mod drawing;
 
 #[cfg(any(feature = "tools", feature = "regression"))]
 pub mod tools;

@@ -8,7 +8,7 @@
 //! 4. `scene`: what a frame draws
 //! 5. the pass: `gpu`
 //! 6. `world`
-//! 7. `truth`, the ray-cast ground truth
+//! 7. `truth`, the ray-cast ground truth; `drawing`, the vector drawings
 //! 8. `tools`
 //!
 //! (`lib.rs` declares them all and is not checked.) And no two files of a layer name each
@@ -28,7 +28,7 @@ fn layer(path: &[&str]) -> Option<u32> {
         ["scene", ..] => 4,
         ["gpu", ..] => 5,
         ["world", ..] => 6,
-        ["truth", ..] => 7,
+        ["truth", ..] | ["drawing", ..] => 7,
         ["tools", ..] => 8,
         // The crate-level re-exports of the core types: `crate::Error`, `crate::Mesh`, ….
         [name, ..] if name.starts_with(char::is_uppercase) => 0,

@@ -40,6 +40,10 @@ enum Command {
     Bench(BenchArgs),
     /// Compare two images with FLIP: print mean, p99 and max; exit non-zero over the threshold.
     Diff(DiffArgs),
+    /// Write the scene's lines as a vector drawing (SVG, PDF or DXF, by -o's extension):
+    /// drawn edges, outlines, hidden lines, cut and intersection lines in render's style,
+    /// their visible and hidden runs found exactly in f64 on the CPU (no GPU needed).
+    Drawing(DrawingArgs),
     /// Print, as JSON, what pixel --at X,Y of the scene's deferred frame shows: the object,
     /// its mesh, the file's triangle and polygon, the exact point and normal, and the drawn
     /// edge and vertex nearest it within --snap pixels.
@@ -476,6 +480,112 @@ fn pick_command(args: &PickArgs) -> Result<()> {
 }
 
 #[derive(clap::Args)]
+struct DrawingArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// An orthographic view of the whole scene instead of the camera: front (from +z),
+    /// back, top (from +y), bottom, right (from +x), left or iso.
+    #[arg(long, value_name = "NAME", conflicts_with_all = ["eye", "target", "up", "fov", "near", "far", "camera"])]
+    view: Option<String>,
+    /// Draw to scale 1:N on a page in millimetres (orthographic views: --view, or a scene
+    /// file's orthographic camera); without it the page is in pixels of --size.
+    #[arg(long, value_name = "1:N")]
+    scale: Option<String>,
+    /// The world's unit for --scale: mm, cm, m or in.
+    #[arg(long, default_value = "mm", value_name = "UNIT")]
+    unit: String,
+    /// Output file: .svg, .pdf or .dxf.
+    #[arg(short, long, default_value = "drawing.svg")]
+    output: PathBuf,
+    /// Print where the time went and how large the drawing is.
+    #[arg(long)]
+    timings: bool,
+}
+
+/// The N of a scale given as `1:N` (or `N`).
+fn parse_scale(s: &str) -> Result<f64> {
+    let n = s.strip_prefix("1:").unwrap_or(s);
+    match n.trim().parse::<f64>() {
+        Ok(v) if v > 0.0 && v.is_finite() => Ok(v),
+        _ => Err(wirepass::Error::InvalidSetting(format!(
+            "--scale {s:?} is not 1:N with N a number > 0"
+        ))),
+    }
+}
+
+fn drawing_command(args: &DrawingArgs) -> Result<()> {
+    use wirepass::drawing::{Drawing, Page};
+    let start = Instant::now();
+    // Checked before the scene is read, so a typo costs nothing.
+    let scale = args.scale.as_deref().map(parse_scale).transpose()?;
+    let unit_mm = match args.unit.as_str() {
+        "mm" => 1.0,
+        "cm" => 10.0,
+        "m" => 1000.0,
+        "in" => 25.4,
+        other => {
+            return Err(wirepass::Error::InvalidSetting(format!(
+                "--unit {other:?} is not mm, cm, m or in"
+            )))
+        }
+    };
+    let ext = args
+        .output
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    if !matches!(ext.as_deref(), Some("svg" | "pdf" | "dxf")) {
+        return Err(wirepass::Error::InvalidSetting(format!(
+            "-o {}: a drawing is written as .svg, .pdf or .dxf",
+            args.output.display()
+        )));
+    }
+    let (world, view, style, size) = args.scene.load()?;
+    let view = match &args.view {
+        Some(name) => wirepass::tools::load::named_view(&world, name, size)?,
+        None => view,
+    };
+    let read = start.elapsed();
+    let shot = Shot {
+        world: &world,
+        view,
+        style: &style,
+        size,
+    };
+    let drawing = Drawing::new(&shot)?;
+    let page = match scale {
+        Some(n) => Page::to_scale(&view, size, unit_mm, n)?,
+        None => Page::pixels(),
+    };
+    let write = Instant::now();
+    drawing.write(&args.output, &page)?;
+    let write = write.elapsed();
+    let bytes = std::fs::metadata(&args.output).map_or(0, |m| m.len());
+    let points: usize = drawing.paths.iter().map(|p| p.points.len()).sum();
+    if args.timings {
+        let ms = |d: Duration| d.as_secs_f64() * 1e3;
+        eprintln!("read the scene       {:9.1} ms", ms(read));
+        eprintln!(
+            "occluders            {:9.1} ms",
+            ms(drawing.timings.occluders)
+        );
+        eprintln!("lines and visibility {:9.1} ms", ms(drawing.timings.lines));
+        eprintln!("write the file       {:9.1} ms", ms(write));
+        eprintln!("total                {:9.1} ms", ms(start.elapsed()));
+    }
+    eprintln!(
+        "wrote {} ({} paths, {} points, {} bytes; {} objects, {} triangles)",
+        args.output.display(),
+        drawing.paths.len(),
+        points,
+        bytes,
+        world.objects.len(),
+        world.triangle_count()
+    );
+    Ok(())
+}
+
+#[derive(clap::Args)]
 struct CompareArgs {
     #[command(flatten)]
     scene: SceneArgs,
@@ -752,6 +862,7 @@ fn main() -> ExitCode {
         Command::Bench(args) => bench_command(args),
         Command::Diff(args) => diff_command(args),
         Command::Pick(args) => pick_command(args),
+        Command::Drawing(args) => drawing_command(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -721,3 +721,76 @@ fn patterns_dash_the_visible_lines() {
     let share = dashed / solid;
     assert!((0.2..0.45).contains(&share), "{dashed} of {solid} pixels");
 }
+
+#[test]
+fn drawing_writes_svg_pdf_and_dxf_and_refuses_what_it_cannot_draw() {
+    let mesh = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../tests/data/meshes/fandisk.obj"
+    );
+    for ext in ["svg", "pdf", "dxf"] {
+        let out = temp(&format!("drawing.{ext}"));
+        let (ok, err) = wirepass(&[
+            "drawing",
+            mesh,
+            "--edges",
+            "feature:30",
+            "--hidden",
+            "dashed",
+            "--view",
+            "iso",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(ok, "{ext}: {err}");
+        let bytes = std::fs::read(&out).unwrap();
+        let head = String::from_utf8_lossy(&bytes[..16.min(bytes.len())]).into_owned();
+        let expected = match ext {
+            "svg" => "<?xml",
+            "pdf" => "%PDF",
+            _ => "  0\nSECTION",
+        };
+        assert!(head.starts_with(expected), "{ext}: {head:?}");
+    }
+    let scaled = temp("scaled.svg");
+    let (ok, err) = wirepass(&[
+        "drawing",
+        mesh,
+        "--view",
+        "front",
+        "--scale",
+        "1:2",
+        "-o",
+        scaled.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(std::fs::read_to_string(&scaled).unwrap().contains("mm\""));
+    for (args, says) in [
+        (vec!["drawing", mesh, "-o", "out.png"], ".svg, .pdf or .dxf"),
+        (
+            vec!["drawing", mesh, "--view", "sideways", "-o", "x.svg"],
+            "view \"sideways\"",
+        ),
+        (
+            vec!["drawing", mesh, "--scale", "1:0", "-o", "x.svg"],
+            "--scale",
+        ),
+        (
+            vec!["drawing", mesh, "--scale", "1:10", "-o", "x.svg"],
+            "orthographic",
+        ),
+        (
+            vec!["drawing", mesh, "--unit", "furlong", "-o", "x.svg"],
+            "--unit",
+        ),
+        (
+            vec!["drawing", mesh, "-o", "/nonexistent/dir/x.svg"],
+            "/nonexistent/dir/x.svg",
+        ),
+    ] {
+        let (ok, err) = wirepass(&args);
+        assert!(!ok, "{args:?} succeeded");
+        assert_eq!(err.trim().lines().count(), 1, "{args:?}: {err}");
+        assert!(err.contains(says), "{args:?}: {err}");
+    }
+}

@@ -232,9 +232,88 @@ impl CameraPlacement {
     }
 }
 
+/// The orthographic views of technical drawings, each named for where it looks from (y is
+/// up): `front` (+z), `back`, `top` (+y, with −z up), `bottom`, `right` (+x), `left`, and
+/// `iso` (from +x, +y, +z).
+pub const NAMED_VIEWS: [&str; 7] = ["front", "back", "top", "bottom", "right", "left", "iso"];
+
+/// The orthographic view `name` (one of [`NAMED_VIEWS`]) of the whole of `world` at `size`:
+/// its bounds' corners fill the image less a 5 % margin.
+pub fn named_view(world: &World, name: &str, size: (u32, u32)) -> Result<View> {
+    let (towards, up) = match name {
+        "front" => (DVec3::Z, DVec3::Y),
+        "back" => (DVec3::NEG_Z, DVec3::Y),
+        "top" => (DVec3::Y, DVec3::NEG_Z),
+        "bottom" => (DVec3::NEG_Y, DVec3::Z),
+        "right" => (DVec3::X, DVec3::Y),
+        "left" => (DVec3::NEG_X, DVec3::Y),
+        "iso" => (DVec3::ONE.normalize(), DVec3::Y),
+        _ => {
+            return Err(Error::InvalidSetting(format!(
+                "view {name:?} is not one of {}",
+                NAMED_VIEWS.join(", ")
+            )))
+        }
+    };
+    let (lo, hi) = world.bounds();
+    let span = (hi - lo).length();
+    if !(span.is_finite() && span > 0.0) {
+        return Err(Error::InvalidScene(format!(
+            "the scene spans {lo} to {hi}: no view frames it"
+        )));
+    }
+    let centre = 0.5 * (lo + hi);
+    let right = up.cross(towards).normalize();
+    let up = towards.cross(right);
+    let corners = (0..8).map(|k| {
+        let pick = |bit: usize, a: f64, b: f64| if k & bit == 0 { a } else { b };
+        DVec3::new(
+            pick(1, lo.x, hi.x),
+            pick(2, lo.y, hi.y),
+            pick(4, lo.z, hi.z),
+        ) - centre
+    });
+    let (half_x, half_y) = corners.fold((0.0f64, 0.0f64), |(x, y), c| {
+        (x.max(c.dot(right).abs()), y.max(c.dot(up).abs()))
+    });
+    let aspect = f64::from(size.0) / f64::from(size.1);
+    let height = 2.0 * half_y.max(half_x / aspect).max(1e-9 * span) * 1.05;
+    let eye = centre + towards * span;
+    let view = View::orthographic((eye, centre, up), height, aspect, (0.0, 2.0 * span));
+    view.validate()?;
+    Ok(view)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_named_view_frames_the_world_from_its_side() {
+        let world = crate::world::default_world(crate::EdgeSelection::All);
+        let (lo, hi) = world.bounds();
+        for name in NAMED_VIEWS {
+            let view = named_view(&world, name, (400, 300)).unwrap();
+            assert!(view.is_orthographic(), "{name}");
+            let m = view.view_projection();
+            for k in 0..8 {
+                let pick = |bit: usize, a: f64, b: f64| if k & bit == 0 { a } else { b };
+                let p = DVec3::new(
+                    pick(1, lo.x, hi.x),
+                    pick(2, lo.y, hi.y),
+                    pick(4, lo.z, hi.z),
+                );
+                let c = m * p.extend(1.0);
+                let ndc = c.truncate() / c.w;
+                assert!(
+                    ndc.x.abs() < 1.0 && ndc.y.abs() < 1.0,
+                    "{name}: {p} at {ndc}"
+                );
+                assert!(ndc.z > 0.0 && ndc.z < 1.0, "{name}: {p} at depth {}", ndc.z);
+            }
+        }
+        assert!(named_view(&world, "sideways", (400, 300)).is_err());
+    }
 
     #[test]
     fn sizes_and_vectors() {

@@ -40,6 +40,7 @@ use crate::mesh::adjacency::NO_NEIGHBOUR;
 use crate::mesh::patches::Patches;
 use crate::style::{depth_fade, line_intensity, line_key, line_reach};
 use crate::truth::rays::{HostMap, Line, ObjectStyle, RayCaster, Rays};
+pub use crate::world::outline_edges;
 use crate::world::Shot;
 use glam::{DVec2, DVec3, DVec4};
 use rayon::prelude::*;
@@ -57,37 +58,6 @@ pub struct OutlineMap {
     pub line: Vec<Option<Line>>,
     /// Pixels, row-major; all `None` without hidden lines.
     pub hidden: Vec<Option<Line>>,
-}
-
-/// The outline edges of `mesh` seen from `eye` (homogeneous, in the mesh's coordinates), as
-/// (triangle, edge) with edge `i` running from corner `i` to corner `i + 1`; an edge shared by
-/// two triangles appears once, under the lower id. Only the edges the mesh allows as outlines
-/// ([`Mesh::outline_mask`](crate::Mesh::outline_mask)) are listed.
-pub fn outline_edges(mesh: &crate::Mesh, eye: DVec4) -> Vec<(u32, u32)> {
-    let p = mesh.positions();
-    let tris = mesh.triangles();
-    let neighbours = mesh.edge_neighbours();
-    let allowed = mesh.outline_mask();
-    let corner = |t: u32, k: usize| p[tris[t as usize][k % 3] as usize].as_dvec3();
-    (0..tris.len() as u32)
-        .into_par_iter()
-        .flat_map_iter(|t| {
-            let allowed = allowed[t as usize];
-            (0..3).filter_map(move |i| {
-                if allowed & (1 << i) == 0 {
-                    return None;
-                }
-                let n = neighbours[t as usize][i];
-                let outline = n == NO_NEIGHBOUR
-                    || (t < n && {
-                        let d = (corner(n, 0) + corner(n, 1) + corner(n, 2)) / 3.0;
-                        let (a, b, c) = (corner(t, i), corner(t, i + 1), corner(t, i + 2));
-                        edge_math::is_silhouette(a, b, c, d, eye)
-                    });
-                outline.then_some((t, i as u32))
-            })
-        })
-        .collect()
 }
 
 /// A stretch of an edge on screen, visible or a dash of a hidden part: pixel coordinates at
