@@ -10,11 +10,13 @@
 //! hidden lines (off, dashed, dotted, solid; deferred only), `S` adds a section plane
 //! through the orbit's centre facing the way the camera looks (what is nearer is cut away;
 //! up to 6), `[`/`]` move the last one along its normal, `Backspace` removes it (deferred
-//! only), `M` switches the method, `+`/`-` change the line width, `Esc` quits.
+//! only), `D` writes the view as a technical drawing (`wirepass-drawing.svg`: its visible
+//! and hidden lines as vectors), `M` switches the method, `+`/`-` change the line width,
+//! `Esc` quits.
 //!
 //! `cargo run --release --example viewer -- [MESH] [--method deferred|forward]
 //! [--edges polygon|all|feature] [--hidden off|dashed|dotted|solid] [--cut] [--frames N]
-//! [--screenshot OUT.png] [--pick X,Y]`
+//! [--screenshot OUT.png] [--pick X,Y] [--drawing OUT.svg]`
 //!
 //! `--cut` presses `S` once before the first frame.
 //!
@@ -22,7 +24,8 @@
 //! `--screenshot` it reads the last frame back from the surface, checks that it shows the
 //! background, the shaded mesh and its lines, and writes it as a PNG (CI runs it so under
 //! Xvfb). With `--pick X,Y` it prints what pixel X,Y of the last frame shows, selecting
-//! the mesh there as a click does, and draws one more frame so.
+//! the mesh there as a click does, and draws one more frame so. With `--drawing` it writes
+//! the last frame's view as a drawing there, as `D` does.
 
 use std::sync::Arc;
 use winit::application::ApplicationHandler;
@@ -70,6 +73,8 @@ struct Options {
     pick: Option<(u32, u32)>,
     /// `--cut`: a section plane from the start.
     cut: bool,
+    /// `--drawing`: the last frame's view as a drawing.
+    drawing: Option<std::path::PathBuf>,
 }
 
 /// The hidden-line styles `H` cycles through.
@@ -107,6 +112,7 @@ fn options() -> Result<Options, AnyError> {
         screenshot: None,
         pick: None,
         cut: false,
+        drawing: None,
     };
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
@@ -138,6 +144,7 @@ fn options() -> Result<Options, AnyError> {
             "--frames" => o.frames = Some(value()?.parse()?),
             "--screenshot" => o.screenshot = Some(value()?.into()),
             "--cut" => o.cut = true,
+            "--drawing" => o.drawing = Some(value()?.into()),
             "--pick" => {
                 let v = value()?;
                 let bad = || format!("--pick {v:?} is not X,Y");
@@ -295,7 +302,7 @@ impl Viewer {
     fn title(&self) {
         self.window.set_title(&format!(
             "wirepass viewer: {:?}, {} edges, outlines {}, hidden {}, sections {}, width {:.1} \
-             (E, O, H, S, [, ], Backspace, M, +/-)",
+             (E, O, H, S, [, ], Backspace, D, M, +/-)",
             self.method,
             EDGES[self.edges].0,
             if self.style.outlines { "on" } else { "off" },
@@ -344,6 +351,16 @@ impl Viewer {
                     Method::Forward => Method::Deferred,
                 }
             }
+            Key::Character("d" | "D") => {
+                let path = std::path::Path::new("wirepass-drawing.svg");
+                let said = match self.write_drawing(path) {
+                    Ok(paths) => format!("wrote {} ({paths} paths)", path.display()),
+                    Err(e) => format!("the drawing failed: {e}"),
+                };
+                println!("{said}");
+                self.window.set_title(&format!("wirepass viewer: {said}"));
+                return;
+            }
             Key::Character("+" | "=") => {
                 self.style.line_width = (self.style.line_width + 0.5).min(16.0)
             }
@@ -352,6 +369,32 @@ impl Viewer {
         }
         self.title();
         self.window.request_redraw();
+    }
+
+    /// Writes the view, as drawn, as a drawing (SVG, PDF or DXF by `path`'s extension);
+    /// returns how many paths it has.
+    fn write_drawing(&self, path: &std::path::Path) -> Result<usize, AnyError> {
+        use wirepass::drawing::{Drawing, Page};
+        use wirepass::world::{Shot, World};
+        let mut world = World::single(self.mesh.clone(), EDGES[self.edges].1);
+        world.sections = self.sections.clone();
+        if self.selected {
+            world.objects[0].style =
+                InstanceStyle::default().highlighted(&Highlight::default(), &self.style);
+        }
+        let size = (self.config.width, self.config.height);
+        let shot = Shot {
+            world: &world,
+            view: self
+                .orbit
+                .camera()
+                .to_view(f64::from(size.0) / f64::from(size.1)),
+            style: &self.style,
+            size,
+        };
+        let drawing = Drawing::new(&shot)?;
+        drawing.write(path, &Page::pixels())?;
+        Ok(drawing.paths.len())
     }
 
     fn mouse_moved(&mut self, x: f64, y: f64) {
@@ -698,6 +741,13 @@ impl App {
             println!("wrote {} ({w}x{h}, {} frames)", path.display(), self.frames);
             let offscreen = viewer.draw_offscreen()?;
             check_frame(&rgba, &offscreen, &viewer.style)?;
+        }
+        if let Some(path) = &self.options.drawing {
+            let paths = viewer.write_drawing(path)?;
+            println!("wrote {} ({paths} paths)", path.display());
+            if paths == 0 {
+                return Err("the drawing of the view has no paths".into());
+            }
         }
         if let Some(at) = self.options.pick {
             println!("pick {},{}: {}", at.0, at.1, viewer.pick(at)?);

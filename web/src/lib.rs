@@ -2,7 +2,9 @@
 //! opened with its picker (`.glb`, `.gltf` with embedded buffers, `.obj`, `.stl`, `.ply`),
 //! drawn by the deferred pass straight into a WebGPU canvas. Mouse and touch: drag orbits,
 //! right or middle drag (or shift-drag, or two fingers) pans, the wheel (or a pinch) zooms,
-//! a click (or tap) picks: the toolbar says what the pixel shows.
+//! a click (or tap) picks: the toolbar says what the pixel shows. "Export SVG" downloads
+//! the view as a technical drawing (`wirepass::drawing`: its visible and hidden lines as
+//! vectors).
 //! Keys: `E` cycles the edges, `O` toggles outlines, `H` cycles the hidden lines (off,
 //! dashed, dotted, solid), `+`/`-` change the line width, `S` adds a section plane through
 //! the orbit's centre that cuts away the half nearer the eye (up to 6), `[`/`]` move the
@@ -150,6 +152,12 @@ impl Viewer {
         self.app.borrow().gpu.adapter.clone()
     }
 
+    /// The current view as an SVG drawing (`wirepass::drawing`), as "Export SVG" downloads
+    /// it.
+    pub fn export_svg(&self) -> Result<String, JsValue> {
+        self.app.borrow().drawing_svg().map_err(JsValue::from)
+    }
+
     /// Shows a mesh file from its bytes, as a dropped file is shown.
     pub async fn load(&self, name: String, bytes: Vec<u8>) -> Result<(), JsValue> {
         show_file(&self.app, &name, &bytes).map_err(JsValue::from)
@@ -287,6 +295,47 @@ impl App {
         )));
     }
 
+    /// The view, its model, style and sections as an SVG drawing: each mesh with the edges
+    /// the page uploaded it with.
+    fn drawing_svg(&self) -> Result<String, String> {
+        use wirepass::drawing::{Drawing, Page};
+        use wirepass::world::{Object, Shot, World, WorldMesh};
+        let edges = EDGES[self.edges].1;
+        let meshes = self
+            .model
+            .meshes
+            .iter()
+            .enumerate()
+            .map(|(k, (mesh, own))| {
+                let (mesh, selection) = mesh.clone().resolve_edges(edges.or(*own));
+                WorldMesh {
+                    mesh: std::sync::Arc::new(mesh),
+                    edges: selection,
+                    name: format!("mesh {k}"),
+                }
+            })
+            .collect();
+        let world = World {
+            meshes,
+            objects: (self.model.instances.iter())
+                .map(|&(m, transform)| Object::new(m, transform))
+                .collect(),
+            sections: self.sections.clone(),
+        };
+        let size = self.gpu.size();
+        let shot = Shot {
+            world: &world,
+            view: self
+                .orbit
+                .camera()
+                .to_view(f64::from(size.0) / f64::from(size.1)),
+            style: &self.style,
+            size,
+        };
+        let drawing = Drawing::new(&shot).map_err(|e| e.to_string())?;
+        Ok(drawing.to_svg(&Page::pixels()))
+    }
+
     fn show_error(&mut self, message: &str) {
         web_sys::console::error_1(&message.into());
         self.status.set_text_content(Some(message));
@@ -403,6 +452,7 @@ fn controls(doc: &web_sys::Document) -> Result<(HtmlElement, HtmlElement), JsVal
          value=\"{}\"></label> \
          <label>Open <input type=\"file\" name=\"file\" \
          accept=\".glb,.gltf,.obj,.stl,.ply\"></label> \
+         <button type=\"button\" name=\"export\">Export SVG</button> \
          <span class=\"wirepass-status\">starting…</span>",
         wirepass::style::DEFAULT_LINE_WIDTH
     ));
@@ -411,6 +461,20 @@ fn controls(doc: &web_sys::Document) -> Result<(HtmlElement, HtmlElement), JsVal
         .ok_or("no status")?
         .unchecked_into();
     Ok((bar, status))
+}
+
+/// Offers `text` to the user as a file `name` of type `mime`.
+fn download(name: &str, text: &str, mime: &str) -> Result<(), JsValue> {
+    let parts = js_sys::Array::of1(&JsValue::from_str(text));
+    let options = web_sys::BlobPropertyBag::new();
+    options.set_type(mime);
+    let blob = web_sys::Blob::new_with_str_sequence_and_options(&parts, &options)?;
+    let url = web_sys::Url::create_object_url_with_blob(&blob)?;
+    let link: web_sys::HtmlAnchorElement = document()?.create_element("a")?.unchecked_into();
+    link.set_href(&url);
+    link.set_download(name);
+    link.click();
+    web_sys::Url::revoke_object_url(&url)
 }
 
 fn document() -> Result<web_sys::Document, JsValue> {
@@ -644,6 +708,21 @@ fn wire_events(app: &Shared, root: &HtmlElement) -> Result<(), JsValue> {
             let input: Option<HtmlInputElement> = e.target().and_then(|t| t.dyn_into().ok());
             if let Some(file) = input.and_then(|i| i.files()).and_then(|f| f.get(0)) {
                 open_file(app, file);
+            }
+        },
+    )?;
+    listen(
+        &find("export")?.into(),
+        "click",
+        app,
+        |app, _: web_sys::Event| {
+            let drawn = app.borrow().drawing_svg();
+            let saved = drawn.and_then(|svg| {
+                download("wirepass-drawing.svg", &svg, "image/svg+xml")
+                    .map_err(|e| format!("the drawing could not be saved: {e:?}"))
+            });
+            if let Err(e) = saved {
+                app.borrow_mut().show_error(&format!("Export SVG: {e}"));
             }
         },
     )?;

@@ -655,6 +655,18 @@ async fn the_viewer_page_draws_turns_and_shows_a_dropped_glb() {
     );
     assert!(shown > 0.005, "the hidden lines are not shown ({shown})");
 
+    // "Export SVG": the view as a drawing of the canvas's size.
+    let svg = viewer.export_svg().unwrap();
+    console_log!("the drawing of the view: {} bytes", svg.len());
+    assert!(
+        svg.starts_with("<?xml") && svg.contains("<path"),
+        "{}",
+        &svg[..svg.len().min(300)]
+    );
+    let view_box = format!("viewBox=\"0 0 {} {}\"", viewer.width(), viewer.height());
+    assert!(svg.contains(&view_box), "{}", &svg[..svg.len().min(300)]);
+    assert!(svg.contains("<g id=\"outlines\""));
+
     // `S` cuts the scene open through the orbit's centre: the section face shows; `]` moves
     // the cut, `Backspace` takes it away again.
     let press = |k: &str| {
