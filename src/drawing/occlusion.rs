@@ -363,28 +363,29 @@ impl<'a> Frame<'a> {
             self.project(a.lerp(b, range.1)),
         );
         self.candidates(pa, pb, scratch);
+        let near = self.rows.clip.row(2);
+        let near_of = |p: DVec3| near.dot(p.extend(1.0));
+        let farthest = near_of(a.lerp(b, range.0)).max(near_of(a.lerp(b, range.1)));
         let mut parts = Vec::new();
         for &id in scratch.iter() {
             if own.contains(&id) {
                 continue;
             }
-            let Some(polygon) = self.polygon(id) else {
+            // A triangle wholly at or beyond the line's farthest point hides none of it.
+            let corners = self.corners(id);
+            if corners.iter().all(|&c| near_of(c) >= farthest) {
+                continue;
+            }
+            let Some(polygon) = clip(corners, &self.keep) else {
                 continue;
             };
-            let outline = self.outline_sides(id);
-            self.hidden_by(
-                &polygon,
-                (self.corners(id), outline),
-                (a, b),
-                range,
-                &mut parts,
-            );
+            self.hidden_by(&polygon, (corners, id), (a, b), range, &mut parts);
         }
         merge(parts)
     }
 
     /// Pushes to `out` the parts of `range` of the segment a → b that `polygon` (a cut part
-    /// of the triangle with corners `triangle`) hides.
+    /// of global triangle `id`, with corners `triangle`) hides.
     ///
     /// With G(P) = eye.xyz − eye.w·P the direction from P towards the eye, the ray P + u·G
     /// meets the triangle's plane n · X = k at u = N / D, N = k − n · P, D = n · G; the near
@@ -394,7 +395,7 @@ impl<'a> Frame<'a> {
     fn hidden_by(
         &self,
         polygon: &Polygon,
-        (triangle, outline): ([DVec3; 3], u8),
+        (triangle, id): ([DVec3; 3], u32),
         (a, b): (DVec3, DVec3),
         range: (f64, f64),
         out: &mut Vec<(f64, f64)>,
@@ -421,26 +422,39 @@ impl<'a> Frame<'a> {
             return;
         }
         let turn = area.signum();
-        let mut sigma = (0.0, 1.0);
-        for k in 0..projected.len() {
-            let (u, v) = (projected[k], projected[(k + 1) % projected.len()]);
-            let side = v - u;
-            let length = side.length();
-            if !(length > 0.0) {
-                continue;
+        // The parameters σ inside, each side pulled in by `margin(its label)`.
+        let inside = |margin: &dyn Fn(u8) -> f64| {
+            let mut sigma = (0.0, 1.0);
+            for k in 0..projected.len() {
+                let (u, v) = (projected[k], projected[(k + 1) % projected.len()]);
+                let side = v - u;
+                let length = side.length();
+                if !(length > 0.0) {
+                    continue;
+                }
+                let m = margin(polygon.sides[k]);
+                let f = |p: DVec2| turn * side.perp_dot(p - u) / length - m;
+                keep_positive(&mut sigma, f(pa), f(pb));
+                if sigma.0 >= sigma.1 || sigma.0.is_nan() {
+                    return None;
+                }
             }
-            let label = polygon.sides[k];
-            let margin = if label < CUT && outline & (1 << label) != 0 {
+            Some(sigma)
+        };
+        // Most candidates miss: the outline sides are only worth finding for those that do.
+        if inside(&|_| 0.0).is_none() {
+            return;
+        }
+        let outline = self.outline_sides(id);
+        let Some(sigma) = inside(&|label| {
+            if label < CUT && outline & (1 << label) != 0 {
                 OUTLINE_MARGIN
             } else {
                 0.0
-            };
-            let inside = |p: DVec2| turn * side.perp_dot(p - u) / length - margin;
-            keep_positive(&mut sigma, inside(pa), inside(pb));
-            if sigma.0 >= sigma.1 || sigma.0.is_nan() {
-                return;
             }
-        }
+        }) else {
+            return;
+        };
         let to_s = |t: f64| range.0 + (range.1 - range.0) * (t * wa / (t * wa + (1.0 - t) * wb));
         let s = (to_s(sigma.0), to_s(sigma.1));
         if !(s.0 < s.1) {
