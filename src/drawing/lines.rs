@@ -5,11 +5,12 @@
 //! outline edges that are not drawn edges (a silhouette loop of a smooth part), so a
 //! pattern runs on along a chain as one path with one phase. A run of one class that
 //! reaches the vertex where the next edge of its chain starts with a run of the same class
-//! goes on in the same path.
+//! goes on in the same path. An outline edge between two triangles seen edge-on is left
+//! out: the edge-on part's own outline covers its projection.
 
 use super::occlusion::{Frame, JOIN};
 use super::{Path, PathClass};
-use crate::edge_math::local_eye;
+use crate::edge_math::{local_eye, towards_eye, EDGE_ON};
 use crate::mesh::adjacency::NO_NEIGHBOUR;
 use crate::mesh::chains::{chains, Chains};
 use crate::mesh::par::*;
@@ -154,8 +155,25 @@ fn list(frame: &Frame<'_>, style: &Style, looks: &[Look]) -> Vec<Chain> {
         let neighbours = mesh.edge_neighbours();
         let first = frame.first(o);
         let positions = frame.positions(o);
+        // Seen edge-on (within the silhouettes' EDGE_ON): such a triangle draws as a line.
+        let edge_on = |t: u32| {
+            let c = tris[t as usize].map(|v| positions[v as usize]);
+            let n = (c[1] - c[0]).cross(c[2] - c[0]);
+            let towards = towards_eye((c[0] + c[1] + c[2]) / 3.0, frame.eye);
+            n.dot(towards).abs() <= EDGE_ON * n.length() * towards.length()
+        };
+        // The outline edges, but those between two triangles seen edge-on: such an edge lies
+        // on the projection of the edge-on part, which the part's own outline covers (a
+        // box's side in a front view is drawn by its edges with the front and back, not
+        // also by every edge of its triangulation).
         let mut outline: Vec<(u32, u32)> = if look.outlines {
-            crate::world::outline_edges(mesh, local_eye(object.transform, frame.eye))
+            let local = local_eye(object.transform, frame.eye);
+            let mut all = crate::world::outline_edges(mesh, local);
+            all.retain(|&(t, i)| {
+                let n = neighbours[t as usize][i as usize];
+                n == NO_NEIGHBOUR || !(edge_on(t) && edge_on(n))
+            });
+            all
         } else {
             Vec::new()
         };
