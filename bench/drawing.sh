@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Times `wirepass drawing` on this machine's CPU and writes docs/drawing.md: for each case
-# the median of RUNS runs (default 5) of each phase, and the size of what it wrote.
+# the median of RUNS runs (default 5) of each phase, and the size of what it wrote; and
+# docs/drawing-fandisk.svg, the drawing the docs show.
 #
 #   bench/drawing.sh               RUNS narrows or widens the run
 #
@@ -60,5 +61,14 @@ for c in "${cases[@]}"; do
         >>"$out/drawing.md"
     echo "$name: done" >&2
 done
+# The picture the docs show: what a drawing looks like.
+"$bin" drawing tests/data/meshes/fandisk.obj --edges feature:30 --hidden dashed --view iso \
+    --size 640x480 -o docs/drawing-fandisk.svg 2>/dev/null
+{
+    echo
+    echo "fandisk, iso view, feature edges and dashed hidden lines (\`docs/drawing-fandisk.svg\`):"
+    echo
+    echo "![fandisk as an SVG drawing](drawing-fandisk.svg)"
+} >>"$out/drawing.md"
 cp "$out/drawing.md" docs/drawing.md
 cat docs/drawing.md
