@@ -692,8 +692,10 @@ fn what_cannot_be_drawn_is_a_clear_error() {
     let away = perspective(camera(Vec3::Z * 3.0, Vec3::Z * 6.0, 0.1, 10.0), size);
     let e = shot(&cube, away, size).unwrap_err().to_string();
     assert!(e.contains("nothing to draw"), "{e}");
-    let e = shot(&cube, view, (0, 10)).unwrap_err().to_string();
-    assert!(e.contains("zero side"), "{e}");
+    for size in [(0, 10), (10, 0), (100_000, 10)] {
+        let e = shot(&cube, view, size).unwrap_err().to_string();
+        assert!(e.contains("each side must be 1 to 65536"), "{e}");
+    }
     let drawing = shot(&cube, view, size).unwrap();
     let dir = std::env::temp_dir().join("wirepass-drawing-errors");
     let _ = std::fs::create_dir_all(&dir);

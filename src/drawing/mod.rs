@@ -40,6 +40,10 @@ use glam::{DVec2, DVec3};
 use std::path::Path as FilePath;
 use web_time::{Duration, Instant};
 
+/// The longest side a drawing's view may have, in pixels: a drawing scales to any page
+/// ([`Page`]), so more adds nothing but work.
+pub const MAX_SIZE: u32 = 1 << 16;
+
 /// What a path draws, in the order a drawing paints them (later over earlier).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum PathClass {
@@ -137,9 +141,9 @@ impl Drawing {
     /// Depth fade and surface colours are not drawn.
     pub fn new(shot: &Shot<'_>) -> Result<Drawing> {
         let (width, height) = shot.size;
-        if width == 0 || height == 0 {
+        if width == 0 || height == 0 || width.max(height) > MAX_SIZE {
             return Err(Error::InvalidSetting(format!(
-                "drawing size {width}x{height} has a zero side"
+                "drawing size {width}x{height}: each side must be 1 to {MAX_SIZE} pixels"
             )));
         }
         shot.view.validate()?;

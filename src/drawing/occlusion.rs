@@ -38,6 +38,9 @@ const MAX_CORNERS: usize = 5 + crate::scene::MAX_SECTIONS;
 /// shows, far above the rounding of a projection.
 pub(crate) const OUTLINE_MARGIN: f64 = 1e-6;
 
+/// The most grid cells along a side of the image.
+const MAX_CELLS: f64 = 2048.0;
+
 /// Hidden intervals closer than this (in the segment's parameter) join: two triangles
 /// sharing a side hide a line up to it from either side, meeting there only to rounding.
 pub(crate) const JOIN: f64 = 1e-9;
@@ -265,7 +268,11 @@ impl<'a> Frame<'a> {
             .collect();
         let count = boxes.iter().flatten().count().max(1) as f64;
         // About one triangle's size on screen, were they spread over the image.
-        let cell = (self.size.x * self.size.y / count).sqrt().clamp(1.0, 64.0);
+        // At most MAX_CELLS a side, whatever the image's size.
+        let cell = (self.size.x * self.size.y / count)
+            .sqrt()
+            .clamp(1.0, 64.0)
+            .max(self.size.max_element() / MAX_CELLS);
         let columns = (self.size.x / cell).ceil().max(1.0) as usize;
         let rows = (self.size.y / cell).ceil().max(1.0) as usize;
         let range = |b: &[f64; 4]| {
