@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Times `wirepass drawing` on this machine's CPU and writes docs/drawing.md: for each case
+# Times `wirepass drawing` on this machine's CPU and writes docs/drawing-times.md: for each case
 # the median of RUNS runs (default 5) of each phase, and the size of what it wrote; and
 # docs/drawing-fandisk.svg, the drawing the docs show.
 #
@@ -70,5 +70,5 @@ done
     echo
     echo "![fandisk as an SVG drawing](drawing-fandisk.svg)"
 } >>"$out/drawing.md"
-cp "$out/drawing.md" docs/drawing.md
-cat docs/drawing.md
+cp "$out/drawing.md" docs/drawing-times.md
+cat docs/drawing-times.md
