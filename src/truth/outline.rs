@@ -128,7 +128,6 @@ pub(crate) fn outline_map(
         eye: shot.view.eye(),
     };
     let view = &view;
-    let eye = shot.view.eye();
     let (visible, hidden_stretches): (Vec<Vec<Stretch>>, Vec<Vec<Stretch>>) = world
         .objects
         .iter()
@@ -137,208 +136,9 @@ pub(crate) fn outline_map(
             let s = &styles[*o];
             s.outlines || s.edges || s.sectioned || shot.style.intersection_lines
         })
-        .flat_map(|(o, object)| {
-            let hidden = styles[o].hidden;
-            let hidden_edges = hidden.is_some_and(|h| h.edges);
-            let mesh = &world.meshes[object.mesh].mesh;
-            let local = edge_math::local_eye(object.transform, eye);
-            let first = caster.first_ids()[o];
-            let listed = styles[o].listed_edges();
-            let widths = (
-                styles[o].width,
-                styles[o].outline_width,
-                styles[o].section_width,
-                f64::from(shot.style.intersection_width()),
-            );
-            let patterns = (styles[o].edge_pattern, styles[o].outline_pattern);
-            let tris = mesh.triangles();
-            let neighbours = mesh.edge_neighbours();
-            let mut edges: Vec<((u32, u32), Draw)> = Vec::new();
-            if styles[o].outlines {
-                let outline = Draw {
-                    visible: true,
-                    hidden: hidden.is_some(),
-                    outline: true,
-                    cut: None,
-                    crossing: None,
-                    cap: Cap::None,
-                };
-                edges.extend(outline_edges(mesh, local).into_iter().map(|e| (e, outline)));
-            }
-            if styles[o].edges && !listed {
-                let splat = &patches[object.mesh].splat;
-                let draw = Draw {
-                    visible: true,
-                    hidden: hidden_edges,
-                    outline: false,
-                    cut: None,
-                    crossing: None,
-                    cap: Cap::None,
-                };
-                edges.extend(splat.iter().enumerate().flat_map(|(t, &bits)| {
-                    (0..3u32)
-                        .filter(move |i| bits & (1 << i) != 0)
-                        .map(move |i| ((t as u32, i), draw))
-                }));
-            }
-            if styles[o].edges && (hidden_edges || listed) {
-                // Every drawn edge has hidden parts to find, or visible ones to draw in
-                // their pattern; a shared one is drawn by the lower id only.
-                let mask = &masks[object.mesh];
-                let draw = Draw {
-                    visible: listed,
-                    hidden: hidden_edges,
-                    outline: false,
-                    cut: None,
-                    crossing: None,
-                    cap: Cap::None,
-                };
-                edges.extend((0..tris.len() as u32).flat_map(|t| {
-                    (0..3u32)
-                        .filter(move |&i| {
-                            let n = neighbours[t as usize][i as usize];
-                            mask[t as usize] & (1 << i) != 0 && (n == NO_NEIGHBOUR || t < n)
-                        })
-                        .map(move |i| ((t, i), draw))
-                }));
-            }
-            // Cut lines, each (triangle, 3 + plane), where a section plane crosses a triangle.
-            let sections = &world.sections;
-            if !sections.is_empty() {
-                edges.extend((0..tris.len() as u32).flat_map(|t| {
-                    let corners = caster.corners(first + t);
-                    (0..sections.len())
-                        .filter(move |&k| cut_segment(corners, &sections[k]).is_some())
-                        .map(move |k| {
-                            let draw = Draw {
-                                visible: true,
-                                hidden: false,
-                                outline: false,
-                                cut: Some(k),
-                                crossing: None,
-                                cap: Cap::None,
-                            };
-                            ((t, 3 + k as u32), draw)
-                        })
-                }));
-            }
-            // Intersection lines, each (lower triangle, 3 + MAX_SECTIONS + crossing).
-            if shot.style.intersection_lines {
-                let first_key = 3 + crate::scene::MAX_SECTIONS as u32;
-                edges.extend(mesh.intersections().iter().enumerate().map(|(k, c)| {
-                    let draw = Draw {
-                        visible: true,
-                        hidden: false,
-                        outline: false,
-                        cut: None,
-                        crossing: Some(k),
-                        cap: Cap::None,
-                    };
-                    ((c.t, first_key + k as u32), draw)
-                }));
-            }
-            // One entry per edge, drawing all that any of its entries asks.
-            edges.sort_unstable();
-            let mut merged: Vec<((u32, u32), Draw)> = Vec::with_capacity(edges.len());
-            for (e, d) in edges {
-                match merged.last_mut() {
-                    Some((last, m)) if *last == e => {
-                        m.visible |= d.visible;
-                        m.hidden |= d.hidden;
-                        m.outline |= d.outline;
-                    }
-                    _ => merged.push((e, d)),
-                }
-            }
-            // The periods of the patterns that run along chains (0 where none does): the
-            // hidden parts' of drawn edges, the drawn edges'.
-            let hidden_period = hidden
-                .filter(|_| hidden_edges)
-                .map_or(0.0, |h| f64::from(h.pattern.dash_period()[1]));
-            let periods = [hidden_period, if listed { patterns.0[1] } else { 0.0 }];
-            // Welded vertices and the chains' anchors, where a pattern runs along them.
-            let chained = (styles[o].edges && periods.iter().any(|&p| p > 0.0)).then(|| {
-                let weld = crate::mesh::adjacency::weld_by_position(mesh.positions());
-                let anchors = view.chain_anchors(mesh, &weld, first, &masks[object.mesh], periods);
-                (weld, anchors)
-            });
-            merged
-                .into_par_iter()
-                .map(move |((t, i), draw)| {
-                    if let Some(k) = draw.crossing {
-                        let c = mesh.intersections()[k];
-                        let ends = c.ends.map(|p| object.transform.transform_point3(p));
-                        let lines = (([0.0; 2], (0.0, true)), (0.0, true));
-                        return view.stretches(
-                            (first, first),
-                            (c.t, c.u, (ends[0], ends[1])),
-                            (o as u32, widths),
-                            draw,
-                            (lines, None),
-                        );
-                    }
-                    if let Some(k) = draw.cut {
-                        let corners = caster.corners(first + t);
-                        let ends = cut_segment(corners, &world.sections[k]).unwrap_or_default();
-                        let lines = (([0.0; 2], (0.0, true)), (0.0, true));
-                        let edge = (t, NO_NEIGHBOUR, ends);
-                        return view.stretches(
-                            (first, first),
-                            edge,
-                            (o as u32, widths),
-                            draw,
-                            (lines, None),
-                        );
-                    }
-                    let n = neighbours[t as usize][i as usize];
-                    let corners = tris[t as usize];
-                    let p = mesh.positions();
-                    let (a, b) = (corners[i as usize], corners[(i as usize + 1) % 3]);
-                    let world_corners = caster.corners(first + t);
-                    let ends = (
-                        world_corners[i as usize],
-                        world_corners[(i as usize + 1) % 3],
-                    );
-                    let draw = Draw {
-                        cap: if sections.is_empty() {
-                            Cap::None
-                        } else {
-                            capped(
-                                caster,
-                                (first + t, (n != NO_NEIGHBOUR).then(|| first + n)),
-                                eye,
-                            )
-                        },
-                        ..draw
-                    };
-                    let on_chain = chained.as_ref().and_then(|(weld, anchors)| {
-                        let (wa, wb) = (weld[a as usize], weld[b as usize]);
-                        let &(positions, entry) = anchors.get(&(wa.min(wb), wa.max(wb)))?;
-                        Some((positions, entry == wa))
-                    });
-                    // Where each pattern stands: along its chain where it runs along chains;
-                    // an outline's visible line, and any other edge, from the end that comes
-                    // first.
-                    let own = (0.0, comes_first(p[a as usize], p[b as usize]));
-                    let along = |k: usize| match on_chain {
-                        Some((positions, forward)) if periods[k] > 0.0 => (positions[k], forward),
-                        _ => own,
-                    };
-                    let visible = if draw.outline {
-                        (patterns.1, own)
-                    } else {
-                        (patterns.0, along(1))
-                    };
-                    let lines = (visible, along(0));
-                    view.stretches(
-                        (first, first),
-                        (t, n, ends),
-                        (o as u32, widths),
-                        draw,
-                        (lines, hidden),
-                    )
-                })
-                .collect::<Vec<_>>()
+        .flat_map(|(o, _)| {
+            let lines = listed_lines(caster, shot, o, &styles[o], (patches, masks));
+            view.object_stretches(shot, o, &styles[o], masks, lines)
         })
         .unzip();
     let between = if shot.style.intersection_lines {
@@ -352,6 +152,250 @@ pub(crate) fn outline_map(
     let stretches: Vec<Stretch> = hidden_stretches.into_iter().flatten().collect();
     let hidden = splat(&stretches, shot.size, fade, host);
     OutlineMap { line, hidden }
+}
+
+/// Every line of object `o` (style `style`) the map draws, each once, with all that its
+/// entries ask of it: its outline edges, the drawn edges of its large patches, its drawn
+/// edges where they are listed (patterned, cut, crossed) or have hidden parts, its cut
+/// lines and its own intersection lines; `masks` are each mesh's drawn edges.
+fn listed_lines(
+    caster: &RayCaster<'_>,
+    shot: &Shot<'_>,
+    o: usize,
+    style: &ObjectStyle,
+    (patches, masks): (&[Patches], &[Vec<u8>]),
+) -> Vec<((u32, u32), Draw)> {
+    let world = caster.world();
+    let object = &world.objects[o];
+    let hidden = style.hidden;
+    let hidden_edges = hidden.is_some_and(|h| h.edges);
+    let mesh = &world.meshes[object.mesh].mesh;
+    let first = caster.first_ids()[o];
+    let listed = style.listed_edges();
+    let tris = mesh.triangles();
+    let neighbours = mesh.edge_neighbours();
+    let eye = shot.view.eye();
+    let local = edge_math::local_eye(object.transform, eye);
+    let mut edges: Vec<((u32, u32), Draw)> = Vec::new();
+    if style.outlines {
+        let outline = Draw {
+            visible: true,
+            hidden: hidden.is_some(),
+            outline: true,
+            cut: None,
+            crossing: None,
+            cap: Cap::None,
+        };
+        edges.extend(outline_edges(mesh, local).into_iter().map(|e| (e, outline)));
+    }
+    if style.edges && !listed {
+        let splat = &patches[object.mesh].splat;
+        let draw = Draw {
+            visible: true,
+            hidden: hidden_edges,
+            outline: false,
+            cut: None,
+            crossing: None,
+            cap: Cap::None,
+        };
+        edges.extend(splat.iter().enumerate().flat_map(|(t, &bits)| {
+            (0..3u32)
+                .filter(move |i| bits & (1 << i) != 0)
+                .map(move |i| ((t as u32, i), draw))
+        }));
+    }
+    if style.edges && (hidden_edges || listed) {
+        // Every drawn edge has hidden parts to find, or visible ones to draw in
+        // their pattern; a shared one is drawn by the lower id only.
+        let mask = &masks[object.mesh];
+        let draw = Draw {
+            visible: listed,
+            hidden: hidden_edges,
+            outline: false,
+            cut: None,
+            crossing: None,
+            cap: Cap::None,
+        };
+        edges.extend((0..tris.len() as u32).flat_map(|t| {
+            (0..3u32)
+                .filter(move |&i| {
+                    let n = neighbours[t as usize][i as usize];
+                    mask[t as usize] & (1 << i) != 0 && (n == NO_NEIGHBOUR || t < n)
+                })
+                .map(move |i| ((t, i), draw))
+        }));
+    }
+    // Cut lines, each (triangle, 3 + plane), where a section plane crosses a triangle.
+    let sections = &world.sections;
+    if !sections.is_empty() {
+        edges.extend((0..tris.len() as u32).flat_map(|t| {
+            let corners = caster.corners(first + t);
+            (0..sections.len())
+                .filter(move |&k| cut_segment(corners, &sections[k]).is_some())
+                .map(move |k| {
+                    let draw = Draw {
+                        visible: true,
+                        hidden: false,
+                        outline: false,
+                        cut: Some(k),
+                        crossing: None,
+                        cap: Cap::None,
+                    };
+                    ((t, 3 + k as u32), draw)
+                })
+        }));
+    }
+    // Intersection lines, each (lower triangle, 3 + MAX_SECTIONS + crossing).
+    if shot.style.intersection_lines {
+        let first_key = 3 + crate::scene::MAX_SECTIONS as u32;
+        edges.extend(mesh.intersections().iter().enumerate().map(|(k, c)| {
+            let draw = Draw {
+                visible: true,
+                hidden: false,
+                outline: false,
+                cut: None,
+                crossing: Some(k),
+                cap: Cap::None,
+            };
+            ((c.t, first_key + k as u32), draw)
+        }));
+    }
+    // One entry per edge, drawing all that any of its entries asks.
+    edges.sort_unstable();
+    let mut merged: Vec<((u32, u32), Draw)> = Vec::with_capacity(edges.len());
+    for (e, d) in edges {
+        match merged.last_mut() {
+            Some((last, m)) if *last == e => {
+                m.visible |= d.visible;
+                m.hidden |= d.hidden;
+                m.outline |= d.outline;
+            }
+            _ => merged.push((e, d)),
+        }
+    }
+    merged
+}
+
+impl RayVisibility<'_> {
+    /// The visible and hidden stretches of each of object `o`'s `lines` ([`listed_lines`]),
+    /// its patterns anchored along its chains of drawn edges (`masks`: each mesh's).
+    fn object_stretches(
+        &self,
+        shot: &Shot<'_>,
+        o: usize,
+        style: &ObjectStyle,
+        masks: &[Vec<u8>],
+        merged: Vec<((u32, u32), Draw)>,
+    ) -> Vec<(Vec<Stretch>, Vec<Stretch>)> {
+        let (view, caster) = (self, self.caster);
+        let world = caster.world();
+        let object = &world.objects[o];
+        let hidden = style.hidden;
+        let hidden_edges = hidden.is_some_and(|h| h.edges);
+        let mesh = &world.meshes[object.mesh].mesh;
+        let first = caster.first_ids()[o];
+        let listed = style.listed_edges();
+        let tris = mesh.triangles();
+        let neighbours = mesh.edge_neighbours();
+        let eye = self.eye;
+        let sections = &world.sections;
+        let widths = (
+            style.width,
+            style.outline_width,
+            style.section_width,
+            f64::from(shot.style.intersection_width()),
+        );
+        let patterns = (style.edge_pattern, style.outline_pattern);
+        // The periods of the patterns that run along chains (0 where none does): the
+        // hidden parts' of drawn edges, the drawn edges'.
+        let hidden_period = hidden
+            .filter(|_| hidden_edges)
+            .map_or(0.0, |h| f64::from(h.pattern.dash_period()[1]));
+        let periods = [hidden_period, if listed { patterns.0[1] } else { 0.0 }];
+        // Welded vertices and the chains' anchors, where a pattern runs along them.
+        let chained = (style.edges && periods.iter().any(|&p| p > 0.0)).then(|| {
+            let weld = crate::mesh::adjacency::weld_by_position(mesh.positions());
+            let anchors = view.chain_anchors(mesh, &weld, first, &masks[object.mesh], periods);
+            (weld, anchors)
+        });
+        merged
+            .into_par_iter()
+            .map(move |((t, i), draw)| {
+                if let Some(k) = draw.crossing {
+                    let c = mesh.intersections()[k];
+                    let ends = c.ends.map(|p| object.transform.transform_point3(p));
+                    let lines = (([0.0; 2], (0.0, true)), (0.0, true));
+                    return view.stretches(
+                        (first, first),
+                        (c.t, c.u, (ends[0], ends[1])),
+                        (o as u32, widths),
+                        draw,
+                        (lines, None),
+                    );
+                }
+                if let Some(k) = draw.cut {
+                    let corners = caster.corners(first + t);
+                    let ends = cut_segment(corners, &world.sections[k]).unwrap_or_default();
+                    let lines = (([0.0; 2], (0.0, true)), (0.0, true));
+                    let edge = (t, NO_NEIGHBOUR, ends);
+                    return view.stretches(
+                        (first, first),
+                        edge,
+                        (o as u32, widths),
+                        draw,
+                        (lines, None),
+                    );
+                }
+                let n = neighbours[t as usize][i as usize];
+                let corners = tris[t as usize];
+                let p = mesh.positions();
+                let (a, b) = (corners[i as usize], corners[(i as usize + 1) % 3]);
+                let world_corners = caster.corners(first + t);
+                let ends = (
+                    world_corners[i as usize],
+                    world_corners[(i as usize + 1) % 3],
+                );
+                let draw = Draw {
+                    cap: if sections.is_empty() {
+                        Cap::None
+                    } else {
+                        capped(
+                            caster,
+                            (first + t, (n != NO_NEIGHBOUR).then(|| first + n)),
+                            eye,
+                        )
+                    },
+                    ..draw
+                };
+                let on_chain = chained.as_ref().and_then(|(weld, anchors)| {
+                    let (wa, wb) = (weld[a as usize], weld[b as usize]);
+                    let &(positions, entry) = anchors.get(&(wa.min(wb), wa.max(wb)))?;
+                    Some((positions, entry == wa))
+                });
+                // Where each pattern stands: along its chain where it runs along chains;
+                // an outline's visible line, and any other edge, from the end that comes
+                // first.
+                let own = (0.0, comes_first(p[a as usize], p[b as usize]));
+                let along = |k: usize| match on_chain {
+                    Some((positions, forward)) if periods[k] > 0.0 => (positions[k], forward),
+                    _ => own,
+                };
+                let visible = if draw.outline {
+                    (patterns.1, own)
+                } else {
+                    (patterns.0, along(1))
+                };
+                let lines = (visible, along(0));
+                view.stretches(
+                    (first, first),
+                    (t, n, ends),
+                    (o as u32, widths),
+                    draw,
+                    (lines, hidden),
+                )
+            })
+            .collect::<Vec<_>>()
+    }
 }
 
 // Whether one point comes before another in (x, y, z) order (in the mesh's own
