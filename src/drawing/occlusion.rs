@@ -15,7 +15,8 @@
 //!
 //! So each triangle hides one interval of s or two, found in closed form in f64, and a
 //! line's hidden parts are their union. Which triangles to ask comes from a grid over the
-//! image of the cut triangles' screen boxes.
+//! image of the cut triangles' screen boxes. A triangle seen edge-on (within the
+//! silhouettes' [`EDGE_ON`]) hides nothing: no pixel's ray meets it.
 
 // `!(a > b)` is deliberate: NaN must take the rejecting branch.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -32,14 +33,16 @@ use glam::{DVec2, DVec3, DVec4};
 const MAX_CORNERS: usize = 5 + crate::scene::MAX_SECTIONS;
 
 /// Pixels inside a surface's outline on screen (its boundary and silhouette edges) where it
-/// starts to hide: a line lying on
-/// another surface's outline (a back edge behind a front one in an axis-aligned view, where
-/// the side between them is seen edge-on) is not behind it. Far below what a drawing
-/// shows, far above the rounding of a projection.
+/// starts to hide: a line lying on another surface's outline (a back edge behind a front
+/// one in an axis-aligned view, where the side between them is seen edge-on) is not behind
+/// it. Far below what a drawing shows, far above the rounding of a projection.
 pub(crate) const OUTLINE_MARGIN: f64 = 1e-6;
 
 /// The most grid cells along a side of the image.
 const MAX_CELLS: f64 = 2048.0;
+
+/// The most (cell, triangle) entries the grid holds.
+const MAX_ENTRIES: f64 = 64e6;
 
 /// Hidden intervals closer than this (in the segment's parameter) join: two triangles
 /// sharing a side hide a line up to it from either side, meeting there only to rounding.
@@ -269,10 +272,25 @@ impl<'a> Frame<'a> {
         let count = boxes.iter().flatten().count().max(1) as f64;
         // About one triangle's size on screen, were they spread over the image.
         // At most MAX_CELLS a side, whatever the image's size.
-        let cell = (self.size.x * self.size.y / count)
+        let mut cell = (self.size.x * self.size.y / count)
             .sqrt()
             .clamp(1.0, 64.0)
             .max(self.size.max_element() / MAX_CELLS);
+        // Many large triangles over one another (depth complexity) would bin each into many
+        // cells: coarser cells keep the grid within MAX_ENTRIES.
+        let entries = |cell: f64| -> f64 {
+            boxes
+                .iter()
+                .flatten()
+                .map(|b| {
+                    let n = |lo: f64, hi: f64| (hi / cell).floor() - (lo / cell).floor() + 1.0;
+                    n(b[0], b[2]) * n(b[1], b[3])
+                })
+                .sum()
+        };
+        while entries(cell) > MAX_ENTRIES && cell < self.size.max_element() {
+            cell *= 2.0;
+        }
         let columns = (self.size.x / cell).ceil().max(1.0) as usize;
         let rows = (self.size.y / cell).ceil().max(1.0) as usize;
         let range = |b: &[f64; 4]| {
