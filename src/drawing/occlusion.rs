@@ -211,11 +211,6 @@ impl<'a> Frame<'a> {
         (s.0 < s.1).then_some(s)
     }
 
-    /// Global triangle `id` cut to the kept half-spaces; `None` where nothing is left.
-    fn polygon(&self, id: u32) -> Option<Polygon> {
-        clip(self.corners(id), &self.keep)
-    }
-
     /// The edges of global triangle `id` that are part of its surface's outline from the
     /// eye (bit i for edge i): boundaries and silhouettes.
     fn outline_sides(&self, id: u32) -> u8 {
@@ -252,16 +247,18 @@ impl<'a> Frame<'a> {
                 if !(n.dot(towards).abs() > EDGE_ON * n.length() * towards.length()) {
                     return None;
                 }
-                let polygon = self.polygon(id)?;
+                let polygon = clip(c, &self.keep)?;
                 let mut lo = DVec2::INFINITY;
                 let mut hi = DVec2::NEG_INFINITY;
                 let mut area = 0.0;
-                let projected: Vec<DVec2> =
-                    polygon.corners().iter().map(|&p| self.project(p)).collect();
-                for (k, &p) in projected.iter().enumerate() {
+                let corners = polygon.corners();
+                let mut last = self.project(corners[corners.len() - 1]);
+                for &corner in corners {
+                    let p = self.project(corner);
                     lo = lo.min(p);
                     hi = hi.max(p);
-                    area += p.perp_dot(projected[(k + 1) % projected.len()]);
+                    area += last.perp_dot(p);
+                    last = p;
                 }
                 // Edge-on (no area on screen) hides nothing; nor does what misses the image.
                 let lo = lo.max(DVec2::ZERO);
