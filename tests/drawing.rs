@@ -625,6 +625,40 @@ fn the_pdf_and_the_dxf_read_back_to_the_same_polylines() {
             entity.common.line_type_name == "CONTINUOUS",
             path.pattern[1] == 0.0
         );
+        // The linetype draws the path's pattern from the path's phase: a dash (or dot) at
+        // the same places along it, to the file's ten-thousandths.
+        if path.pattern[1] > 0.0 {
+            let kind = dxf
+                .line_types()
+                .find(|t| t.name == entity.common.line_type_name)
+                .unwrap();
+            let elements = &kind.dash_dot_space_lengths;
+            assert!((kind.total_pattern_length - path.pattern[1]).abs() < 1e-3);
+            let total: f64 = elements.iter().map(|e| e.abs()).sum();
+            assert!((total - path.pattern[1]).abs() < 1e-3, "{elements:?}");
+            let [dash, period] = path.pattern;
+            for k in 0..40 {
+                let along = 0.37 * f64::from(k);
+                // The element `along` falls in: a dash (or dot) is drawn there.
+                let mut at = along.rem_euclid(period);
+                let mut in_file = false;
+                for &e in elements {
+                    if at <= e.abs() {
+                        in_file = e >= 0.0;
+                        break;
+                    }
+                    at -= e.abs();
+                }
+                let position = (path.offset + along).rem_euclid(period);
+                let in_path = position <= dash;
+                // Only a position within the file's rounding of a dash's end may differ.
+                let near_end = position.min((position - dash).abs()).min(period - position) < 1e-3;
+                assert!(
+                    in_file == in_path || near_end,
+                    "{along} px along {path:?}: {elements:?}"
+                );
+            }
+        }
         let got: Vec<DVec2> = line
             .vertices()
             .map(|v| DVec2::new(v.location.x, height - v.location.y))

@@ -1,5 +1,6 @@
 //! DXF, release 12 (`AC1009`), which every CAD program imports: a layer per class, a
-//! linetype per pattern, a `POLYLINE` per path in page units with y up.
+//! linetype per pattern and phase (a linetype has no phase: its elements start where the
+//! path's pattern does), a `POLYLINE` per path in page units with y up.
 //!
 //! Written here rather than with a DXF crate: the format is a flat list of group codes and
 //! values, and the crates that write it pull in image, date and UUID libraries a drawing
@@ -33,7 +34,37 @@ fn aci(c: Color) -> u8 {
     ACI.iter().min_by_key(|(_, q)| d(*q)).map_or(7, |&(i, _)| i)
 }
 
-/// The name of the linetype of a pattern (dash, period in page units).
+/// Page units to the ten-thousandths the file keeps, and back.
+fn quantize(v: f64) -> i64 {
+    (v * 1e4).round() as i64
+}
+
+fn unquantize(v: i64) -> f64 {
+    v as f64 * 1e-4
+}
+
+/// The elements of a linetype (dashes positive, gaps negative, a dot 0) whose pattern of
+/// `dash` every `period` starts `phase` into it, as the path's does: a linetype has no phase
+/// of its own, so the pattern's elements are rotated to start where the path's does.
+fn elements(dash: f64, period: f64, phase: f64) -> Vec<f64> {
+    let gap = period - dash;
+    if phase <= 0.0 || phase >= period {
+        vec![dash, -gap]
+    } else if phase < dash {
+        // In a dash: its rest, the gap, then the dash up to the phase.
+        vec![dash - phase, -gap, phase]
+    } else {
+        // In a gap: its rest, the dash, then the gap up to the phase.
+        let before = phase - dash;
+        let mut e = vec![-(period - phase), dash];
+        if before > 0.0 {
+            e.push(-before);
+        }
+        e
+    }
+}
+
+/// The name of the linetype of a pattern and phase.
 fn linetype_name(k: usize) -> String {
     format!("WIREPASS{k}")
 }
@@ -41,19 +72,26 @@ fn linetype_name(k: usize) -> String {
 pub(super) fn write(drawing: &Drawing, page: &Page) -> String {
     let s = page.per_pixel;
     let extent = page.extent(drawing.size);
-    // Each distinct pattern, in page units.
-    let mut patterns: Vec<[u64; 2]> = drawing
+    // Each distinct pattern and phase, in page units, to a ten-thousandth.
+    let key = |p: &super::Path| {
+        p.pattern
+            .map(|v| v * s)
+            .map(quantize)
+            .into_iter()
+            .chain([quantize(p.offset * s)])
+            .collect::<Vec<i64>>()
+    };
+    let mut patterns: Vec<Vec<i64>> = drawing
         .paths
         .iter()
         .filter(|p| p.pattern[1] > 0.0)
-        .map(|p| p.pattern.map(|v| (v * s).to_bits()))
+        .map(key)
         .collect();
     patterns.sort_unstable();
     patterns.dedup();
     let linetype = |p: &super::Path| -> String {
         if p.pattern[1] > 0.0 {
-            let key = p.pattern.map(|v| (v * s).to_bits());
-            linetype_name(patterns.binary_search(&key).unwrap_or(0))
+            linetype_name(patterns.binary_search(&key(p)).unwrap_or(0))
         } else {
             "CONTINUOUS".into()
         }
@@ -87,19 +125,26 @@ pub(super) fn write(drawing: &Drawing, page: &Page) -> String {
     group(73, "0");
     group(40, "0");
     for (k, p) in patterns.iter().enumerate() {
-        let [dash, period] = p.map(f64::from_bits);
+        let [dash, period, phase] = [p[0], p[1], p[2]].map(unquantize);
+        let elements = elements(dash, period, phase);
         group(0, "LTYPE");
         group(2, &linetype_name(k));
         group(70, "0");
         group(
             3,
-            &format!("dash {} gap {}", number(dash), number(period - dash)),
+            &format!(
+                "dash {} gap {} from {}",
+                number(dash),
+                number(period - dash),
+                number(phase)
+            ),
         );
         group(72, "65");
-        group(73, "2");
+        group(73, &elements.len().to_string());
         group(40, &number(period));
-        group(49, &number(dash));
-        group(49, &number(-(period - dash)));
+        for e in elements {
+            group(49, &number(e));
+        }
     }
     group(0, "ENDTAB");
     group(0, "TABLE");

@@ -200,9 +200,9 @@ impl Drawing {
         pdf::write(self, page)
     }
 
-    /// The drawing as a DXF (R12) file: a layer per class, a linetype per pattern, a
-    /// polyline per path. CAD linetypes have no phase: each path's pattern starts at its
-    /// first point.
+    /// The drawing as a DXF (R12) file: a layer per class, a polyline per path, a linetype
+    /// per pattern and phase (a linetype has no phase of its own: its elements are rotated
+    /// to start where the path's pattern does).
     pub fn to_dxf(&self, page: &Page) -> String {
         dxf::write(self, page)
     }
