@@ -547,8 +547,7 @@ impl Viewer {
             vertices: wirepass::gpu::SnapVertices::Any,
             sections: scene.sections.clone(),
         };
-        let edges = EDGES[self.edges].1;
-        let l = hit.locate(&self.mesh, edges, DMat4::IDENTITY, &view, at, 8.0)?;
+        let l = hit.locate(&self.mesh, &view, at, 8.0)?;
         let mut words = format!(
             "triangle {} (polygon {}) at ({:.4}, {:.4}, {:.4})",
             l.triangle, l.polygon, l.point.x, l.point.y, l.point.z

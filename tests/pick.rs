@@ -193,9 +193,9 @@ fn every_pixel_picks_what_the_id_map_and_the_ground_truth_show() {
             };
             let object = &f.world.objects[hit.instance];
             let wm = &f.world.meshes[object.mesh];
-            let at = hit
-                .locate(&wm.mesh, wm.edges, object.transform, &f.view, (x, y), 3.0)
-                .unwrap();
+            // The hit carries the instance's placement and its mesh's drawn edges.
+            assert_eq!((hit.transform, hit.edges), (object.transform, wm.edges));
+            let at = hit.locate(&wm.mesh, &f.view, (x, y), 3.0).unwrap();
             // Off the surface at a silhouette: what is behind, here the background.
             let exact = if at.inside {
                 first[hit.instance] + at.triangle
@@ -270,8 +270,7 @@ f 1 2 3 4\nf 2 5 3\nf 5 6 7 8 9\n";
     let f = encoded(world, None);
     let mesh = &f.world.meshes[0].mesh;
     let locate = |hit: &wirepass::gpu::InstanceHit, px, radius| {
-        let (edges, at) = (EdgeSelection::Polygon, DMat4::IDENTITY);
-        hit.locate(mesh, edges, at, &f.view, px, radius).unwrap()
+        hit.locate(mesh, &f.view, px, radius).unwrap()
     };
     let mut polygons = Vec::new();
     for t in 0..6u32 {
@@ -341,9 +340,7 @@ fn vertices_on_no_drawn_edge_can_be_left_out_of_snapping() {
             panic!("no triangle next to vertex {v}");
         };
         let view = f.view.clone().snapping_to(vertices);
-        let at = hit
-            .locate(mesh, edges, DMat4::IDENTITY, &view, px, 3.0)
-            .unwrap();
+        let at = hit.locate(mesh, &view, px, 3.0).unwrap();
         at.vertex.map(|s| s.vertex)
     };
     assert_eq!(mesh.positions()[12], wirepass::glam::Vec3::ZERO);

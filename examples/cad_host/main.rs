@@ -126,9 +126,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (hit, at) = hit.ok_or("no pixel of the row shows a part")?;
     // A CAD host snaps to the corners of the lines it shows.
     let pick_view = PickView::new(&picked_scene, size).snapping_to(SnapVertices::OnDrawnEdges);
-    let placed = &parts[hit.instance];
     let mesh = [&scene.cow, &scene.monkey][hit.instance];
-    let location = hit.locate(mesh, edges, placed.transform, &pick_view, at, 8.0)?;
+    let location = hit.locate(mesh, &pick_view, at, 8.0)?;
     println!(
         "pixel {at:?}: instance {}, triangle {} (polygon {}), point {:.4}, normal {:.3}",
         hit.instance, location.triangle, location.polygon, location.point, location.normal

@@ -1024,6 +1024,7 @@ mod tests {
             scale: 0.25,
             order: vec![].into(),
             bounds: (DVec3::ZERO, DVec3::ZERO),
+            edges: Default::default(),
             lines: Default::default(),
             bounds_of_clusters: vec![].into(),
             intersections: vec![].into(),

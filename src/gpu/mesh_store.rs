@@ -66,7 +66,8 @@ pub(crate) struct MeshRecord {
     pub order: Arc<[u32]>,
     /// The mesh's bounds, in its own coordinates.
     pub bounds: (DVec3, DVec3),
-    /// What its edge selection asks of the passes.
+    /// Which of its edges are drawn, and what that asks of the passes.
+    pub edges: EdgeSelection,
     pub lines: MeshLines,
     /// Per cluster, its bounds without the splat flag (see [`cluster_records`]).
     pub bounds_of_clusters: Arc<[[f32; 8]]>,
@@ -84,7 +85,13 @@ pub(crate) struct MeshRecord {
 impl MeshRecord {
     /// The record of `data` placed at `bases` (vertices, triangles, clusters, chain records),
     /// of `counts` each.
-    fn new(data: MeshData, bases: [u32; 4], counts: [u32; 4], report: UploadReport) -> MeshRecord {
+    fn new(
+        data: MeshData,
+        edges: EdgeSelection,
+        bases: [u32; 4],
+        counts: [u32; 4],
+        report: UploadReport,
+    ) -> MeshRecord {
         let [vertex_base, triangle_base, cluster_base, chain_base] = bases;
         let [vertices, triangles, clusters, chain_records] = counts;
         MeshRecord {
@@ -102,6 +109,7 @@ impl MeshRecord {
             scale: data.scale,
             order: data.order,
             bounds: data.bounds,
+            edges,
             lines: data.lines,
             bounds_of_clusters: data.bounds_of_clusters,
             intersections: data.intersections,
@@ -122,7 +130,7 @@ impl MeshRecord {
             data.chains.records.len(),
         ]
         .map(|n| n as u32);
-        MeshRecord::new(data, [0; 4], counts, report)
+        MeshRecord::new(data, EdgeSelection::All, [0; 4], counts, report)
     }
 
     /// Stored (rebased, scaled) coordinates → the mesh's own coordinates.
@@ -371,6 +379,7 @@ impl MeshStore {
 
         let record = MeshRecord::new(
             data,
+            edges,
             [vertex_base, triangle_base, cluster_base, chain_base],
             [vertices, triangles, clusters, chain_records],
             report,
@@ -427,7 +436,8 @@ impl MeshStore {
                 record.triangles
             )));
         }
-        let edges = EdgeData::new(mesh, edges, &record.order);
+        let selection = edges;
+        let edges = EdgeData::new(mesh, selection, &record.order);
         let clusters = cluster_records(&record.bounds_of_clusters, &edges.info);
         // The chains change with the selection: their records move to a region of their size.
         let (old_base, old_records) = (record.chain_base, record.chain_records);
@@ -457,6 +467,7 @@ impl MeshStore {
         }
         let slot = id.slot as usize;
         if let Some(record) = self.slots[slot].1.as_mut() {
+            record.edges = selection;
             record.lines = edges.lines;
             record.chain_base = chain_base;
             record.chain_records = chain_records;
@@ -470,6 +481,11 @@ impl MeshStore {
     /// What inserting `id` took, step by step.
     pub fn upload_report(&self, id: MeshId) -> Result<UploadReport> {
         Ok(self.record(id)?.report)
+    }
+
+    /// Which edges of `id` are drawn: as inserted, or as last [set](Self::set_edges).
+    pub fn edges(&self, id: MeshId) -> Result<EdgeSelection> {
+        Ok(self.record(id)?.edges)
     }
 
     /// Number of triangles of `id`.

@@ -18,7 +18,7 @@ use crate::scene::Scene;
 use glam::{DMat4, DVec2, DVec3, DVec4};
 
 /// What one pixel of a frame shows.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Picked {
     /// No instance: the background.
     Background,
@@ -28,8 +28,9 @@ pub enum Picked {
     Instance(InstanceHit),
 }
 
-/// An instance's triangle that a pixel shows.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// An instance's triangle that a pixel shows, with what [`locate`](Self::locate) needs of
+/// the instance and its mesh as they were picked.
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct InstanceHit {
     /// The index of the instance in the scene the frame was prepared from.
     pub instance: usize,
@@ -40,6 +41,10 @@ pub struct InstanceHit {
     /// the rasterizer's rounding may give the neighbour; [`InstanceHit::locate`] finds the
     /// exact one ([`Location::triangle`]).
     pub triangle: u32,
+    /// The instance's transform in the scene the frame was prepared from.
+    pub transform: DMat4,
+    /// Which edges of the mesh the store draws.
+    pub edges: EdgeSelection,
 }
 
 /// What a rectangle of a frame shows.
@@ -207,11 +212,16 @@ impl PickedIds {
         };
         let rect = one.resolve(store, scene, true)?;
         Ok(match (rect.triangles.first(), rect.host) {
-            (Some(&(instance, triangle)), _) => Picked::Instance(InstanceHit {
-                instance,
-                mesh: scene.instances[instance].mesh,
-                triangle,
-            }),
+            (Some(&(instance, triangle)), _) => {
+                let placed = &scene.instances[instance];
+                Picked::Instance(InstanceHit {
+                    instance,
+                    mesh: placed.mesh,
+                    triangle,
+                    transform: placed.transform,
+                    edges: store.edges(placed.mesh)?,
+                })
+            }
             (None, true) => Picked::Host,
             (None, false) => Picked::Background,
         })
@@ -353,21 +363,20 @@ impl PickView {
 
 impl InstanceHit {
     /// Where the centre of image pixel `pixel` (the image's `(x, y)`, a frame's output
-    /// pixel plus its region's origin) meets this triangle of `mesh` (the mesh inserted as
-    /// [`mesh`](Self::mesh)) placed by `transform` (the instance's), and the drawn edge
-    /// (`edges`, as inserted) and the vertex nearest the pixel on screen, within
-    /// `snap_radius` pixels, among the triangles around this one's corners that face the
-    /// eye as it does. It scans the mesh once (a few milliseconds for millions of
-    /// triangles), keeping no adjacency between picks.
+    /// pixel plus its region's origin) meets this triangle of `mesh` (the host's copy of
+    /// the mesh inserted as [`mesh`](Self::mesh): the store keeps no f64-ready copy) placed
+    /// by the instance's [`transform`](Self::transform), and the drawn edge and the vertex
+    /// nearest the pixel on screen, within `snap_radius` pixels, among the triangles around
+    /// this one's corners that face the eye as it does. It scans the mesh once (a few
+    /// milliseconds for millions of triangles), keeping no adjacency between picks.
     pub fn locate(
         &self,
         mesh: &Mesh,
-        edges: EdgeSelection,
-        transform: DMat4,
         view: &PickView,
         pixel: (u32, u32),
         snap_radius: f64,
     ) -> Result<Location> {
+        let (transform, edges) = (self.transform, self.edges);
         let t = self.triangle as usize;
         let mut exact = t;
         let mut inside = false;

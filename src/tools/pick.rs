@@ -108,14 +108,7 @@ pub fn pick(ctx: &GpuContext, shot: &Shot<'_>, at: (u32, u32), snap: f64) -> Res
         vertices: crate::gpu::SnapVertices::Any,
         sections: shot.world.sections.clone(),
     };
-    let at = hit.locate(
-        &mesh.mesh,
-        mesh.edges,
-        object.transform,
-        &pick_view,
-        at,
-        snap,
-    )?;
+    let at = hit.locate(&mesh.mesh, &pick_view, at, snap)?;
     report.shows = "object";
     report.object = Some(hit.instance);
     report.mesh = Some(mesh.name.clone());

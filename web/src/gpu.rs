@@ -310,7 +310,7 @@ impl Gpu {
             Picked::Host => return Ok(format!("({}, {}): the host", at.0, at.1)),
             Picked::Instance(hit) => hit,
         };
-        let (m, transform) = model.instances[hit.instance];
+        let (m, _) = model.instances[hit.instance];
         let view = PickView {
             view: scene.view,
             image: frame.output_size(),
@@ -318,7 +318,7 @@ impl Gpu {
             sections: scene.sections.clone(),
         };
         let l = hit
-            .locate(&model.meshes[m].0, self.ids[m].1, transform, &view, at, 8.0)
+            .locate(&model.meshes[m].0, &view, at, 8.0)
             .map_err(err)?;
         let mut words = format!(
             "instance {}, triangle {} (polygon {}) at ({:.4}, {:.4}, {:.4})",

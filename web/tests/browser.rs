@@ -279,16 +279,7 @@ async fn picking_works_in_the_page() {
                 Picked::Instance(hit) => {
                     let object = &case.world.objects[hit.instance];
                     let mesh = &case.world.meshes[object.mesh];
-                    let at = hit
-                        .locate(
-                            &mesh.mesh,
-                            mesh.edges,
-                            object.transform,
-                            &pick_view,
-                            (x, y),
-                            4.0,
-                        )
-                        .unwrap();
+                    let at = hit.locate(&mesh.mesh, &pick_view, (x, y), 4.0).unwrap();
                     raster_agree += usize::from(first[hit.instance] + hit.triangle == truth.ids[k]);
                     let id = if at.inside {
                         first[hit.instance] + at.triangle
