@@ -55,7 +55,7 @@ use crate::error::{Error, Result};
 use crate::mesh::EdgeSelection;
 use crate::scene::HiddenOverride;
 use crate::scene::InstanceStyle;
-use crate::style::{Color, LinePattern};
+use crate::style::{Color, HiddenLines, LinePattern};
 use crate::world::{Object, World, WorldMesh};
 use glam::{DMat4, DQuat, DVec3, EulerRot};
 use serde_json::Value;
@@ -154,61 +154,14 @@ pub fn load_scene(
     let mut loaded: HashMap<(String, String), usize> = HashMap::new();
     let mut highlight = Vec::new();
     for (i, o) in objects.iter().enumerate() {
-        let field = |name: &str| format!("objects[{i}].{name}");
-        let o = o
-            .as_object()
-            .ok_or_else(|| fail(format!("objects[{i}] is not an object")))?;
-        for key in o.keys() {
-            if ![
-                "mesh",
-                "transform",
-                "edges",
-                "outlines",
-                "wire_color",
-                "fill_color",
-                "line_width",
-                "outline_color",
-                "outline_width",
-                "edge_pattern",
-                "outline_pattern",
-                "hidden",
-                "hidden_color",
-                "hidden_width",
-                "highlight",
-            ]
-            .contains(&key.as_str())
-            {
-                return Err(fail(format!(
-                    "{}: unknown field (mesh, transform, edges, outlines, wire_color, \
-                     fill_color, line_width, outline_color, outline_width, edge_pattern, \
-                     outline_pattern, hidden, hidden_color, hidden_width, highlight)",
-                    field(key)
-                )));
-            }
-        }
-        let spec = o
-            .get("mesh")
-            .and_then(Value::as_str)
-            .ok_or_else(|| fail(format!("{}: missing, or not a string", field("mesh"))))?;
-        let (object_edges, hidden) = match o.get("edges") {
-            None => (edges, false),
-            Some(Value::String(s)) if s == "none" => (edges, true),
-            Some(Value::String(s)) => (
-                Some(
-                    s.parse::<EdgeSelection>()
-                        .map_err(|e| fail(format!("{}: {e}", field("edges"))))?,
-                ),
-                false,
-            ),
-            Some(_) => return Err(fail(format!("{}: not a string", field("edges")))),
-        };
+        let o = FileObject::new(o, i).map_err(fail)?;
+        let (spec, object_edges, edges_off) = o.mesh(edges).map_err(fail)?;
         let resolved = resolve(base, spec);
         let key = (resolved.clone(), format!("{object_edges:?}"));
         let mesh = match loaded.get(&key) {
             Some(&m) => m,
             None => {
-                let mesh =
-                    load_mesh(&resolved).map_err(|e| fail(format!("{}: {e}", field("mesh"))))?;
+                let mesh = load_mesh(&resolved).map_err(|e| fail(o.says("mesh", e)))?;
                 let (mesh, object_edges) = mesh.resolve_edges(object_edges);
                 world.meshes.push(WorldMesh {
                     mesh: Arc::new(mesh),
@@ -219,102 +172,10 @@ pub fn load_scene(
                 world.meshes.len() - 1
             }
         };
-        let transform = match o.get("transform") {
-            None => DMat4::IDENTITY,
-            Some(t) => transform(t).map_err(|m| fail(format!("{}: {m}", field("transform"))))?,
-        };
-        crate::scene::check_transform(&transform, i)
-            .map_err(|e| fail(format!("{}: {e}", field("transform"))))?;
-        let mut style = InstanceStyle {
-            edges: hidden.then_some(false),
-            ..InstanceStyle::default()
-        };
-        if let Some(v) = o.get("outlines") {
-            style.outlines = Some(
-                v.as_bool()
-                    .ok_or_else(|| fail(format!("{}: not true or false", field("outlines"))))?,
-            );
-        }
-        let color = |name: &str| -> Result<Option<Color>> {
-            let Some(v) = o.get(name) else {
-                return Ok(None);
-            };
-            let s = v
-                .as_str()
-                .ok_or_else(|| fail(format!("{}: not a string", field(name))))?;
-            Color::from_hex(s)
-                .map(Some)
-                .map_err(|e| fail(format!("{}: {e}", field(name))))
-        };
-        style.wire_color = color("wire_color")?;
-        style.fill_color = color("fill_color")?;
-        style.outline_color = color("outline_color")?;
-        let width = |name: &str| -> Result<Option<f32>> {
-            o.get(name)
-                .map(|v| {
-                    v.as_f64()
-                        .map(|w| w as f32)
-                        .ok_or_else(|| fail(format!("{}: not a number", field(name))))
-                })
-                .transpose()
-        };
-        style.line_width = width("line_width")?;
-        style.outline_width = width("outline_width")?;
-        let pattern = |name: &str| -> Result<Option<LinePattern>> {
-            o.get(name)
-                .map(|v| {
-                    v.as_str()
-                        .ok_or_else(|| fail(format!("{}: not a string", field(name))))
-                        .and_then(|t| {
-                            LinePattern::parse_visible(t)
-                                .map_err(|e| fail(format!("{}: {e}", field(name))))
-                        })
-                })
-                .transpose()
-        };
-        style.edge_pattern = pattern("edge_pattern")?;
-        style.outline_pattern = pattern("outline_pattern")?;
-        // The object's own hidden lines; what it leaves out comes from the file's style,
-        // else the defaults.
-        let pattern = match o.get("hidden") {
-            None => None,
-            Some(v) => Some(
-                v.as_str()
-                    .ok_or_else(|| fail(format!("{}: not a string", field("hidden"))))
-                    .and_then(|t| {
-                        LinePattern::parse(t).map_err(|e| fail(format!("{}: {e}", field("hidden"))))
-                    })?,
-            ),
-        };
-        let (hidden_color, hidden_width) = (color("hidden_color")?, width("hidden_width")?);
-        if pattern.is_some() || hidden_color.is_some() || hidden_width.is_some() {
-            let pattern = pattern
-                .or(file_style.hidden)
-                .unwrap_or(Some(crate::style::HiddenLines::default().pattern));
-            style.hidden = pattern.map_or(HiddenOverride::Off, |pattern| {
-                HiddenOverride::Lines(crate::style::HiddenLines {
-                    pattern,
-                    color: hidden_color
-                        .or(file_style.hidden_color)
-                        .unwrap_or(crate::style::HiddenLines::default().color),
-                    width: hidden_width
-                        .or(file_style.hidden_width)
-                        .unwrap_or(crate::style::HiddenLines::default().width),
-                    behind_host: false,
-                    edges: true,
-                })
-            });
-        }
-        style
-            .validate(i)
-            .map_err(|e| fail(format!("objects[{i}]: {e}")))?;
-        if let Some(v) = o.get("highlight") {
-            let on = v
-                .as_bool()
-                .ok_or_else(|| fail(format!("{}: not true or false", field("highlight"))))?;
-            if on {
-                highlight.push(i);
-            }
+        let transform = o.transform().map_err(fail)?;
+        let style = o.style(edges_off, &file_style).map_err(fail)?;
+        if o.flag("highlight").map_err(fail)? == Some(true) {
+            highlight.push(i);
         }
         world.objects.push(Object {
             mesh,
@@ -336,6 +197,167 @@ pub fn load_scene(
         style: file_style,
         highlight,
     })
+}
+
+/// The fields an object of a scene file may have.
+const OBJECT_FIELDS: [&str; 15] = [
+    "mesh",
+    "transform",
+    "edges",
+    "outlines",
+    "wire_color",
+    "fill_color",
+    "line_width",
+    "outline_color",
+    "outline_width",
+    "edge_pattern",
+    "outline_pattern",
+    "hidden",
+    "hidden_color",
+    "hidden_width",
+    "highlight",
+];
+
+/// One entry of a scene file's `objects`, read field by field; errors are messages naming
+/// the field (`objects[i].name: …`).
+struct FileObject<'a> {
+    fields: &'a serde_json::Map<String, Value>,
+    index: usize,
+}
+
+type Message<T> = std::result::Result<T, String>;
+
+impl<'a> FileObject<'a> {
+    /// Object `index` of the list, checked for unknown fields.
+    fn new(value: &'a Value, index: usize) -> Message<FileObject<'a>> {
+        let fields = value
+            .as_object()
+            .ok_or_else(|| format!("objects[{index}] is not an object"))?;
+        let object = FileObject { fields, index };
+        match fields.keys().find(|k| !OBJECT_FIELDS.contains(&k.as_str())) {
+            Some(key) => {
+                Err(object.says(key, format!("unknown field ({})", OBJECT_FIELDS.join(", "))))
+            }
+            None => Ok(object),
+        }
+    }
+
+    /// `message` about field `name`.
+    fn says(&self, name: &str, message: impl std::fmt::Display) -> String {
+        format!("objects[{}].{name}: {message}", self.index)
+    }
+
+    fn text(&self, name: &str) -> Message<Option<&'a str>> {
+        self.fields
+            .get(name)
+            .map(|v| v.as_str().ok_or_else(|| self.says(name, "not a string")))
+            .transpose()
+    }
+
+    fn flag(&self, name: &str) -> Message<Option<bool>> {
+        self.fields
+            .get(name)
+            .map(|v| {
+                v.as_bool()
+                    .ok_or_else(|| self.says(name, "not true or false"))
+            })
+            .transpose()
+    }
+
+    fn width(&self, name: &str) -> Message<Option<f32>> {
+        self.fields
+            .get(name)
+            .map(|v| {
+                v.as_f64()
+                    .map(|w| w as f32)
+                    .ok_or_else(|| self.says(name, "not a number"))
+            })
+            .transpose()
+    }
+
+    fn color(&self, name: &str) -> Message<Option<Color>> {
+        self.text(name)?
+            .map(|t| Color::from_hex(t).map_err(|e| self.says(name, e)))
+            .transpose()
+    }
+
+    fn pattern(&self, name: &str) -> Message<Option<LinePattern>> {
+        self.text(name)?
+            .map(|t| LinePattern::parse_visible(t).map_err(|e| self.says(name, e)))
+            .transpose()
+    }
+
+    /// Its mesh spec, the edges it asks for (`default` where it names none) and whether it
+    /// draws none of them (`"edges": "none"`).
+    fn mesh(
+        &self,
+        default: Option<EdgeSelection>,
+    ) -> Message<(&'a str, Option<EdgeSelection>, bool)> {
+        let spec = self
+            .fields
+            .get("mesh")
+            .and_then(Value::as_str)
+            .ok_or_else(|| self.says("mesh", "missing, or not a string"))?;
+        Ok(match self.text("edges")? {
+            None => (spec, default, false),
+            Some("none") => (spec, default, true),
+            Some(s) => {
+                let edges = s
+                    .parse::<EdgeSelection>()
+                    .map_err(|e| self.says("edges", e))?;
+                (spec, Some(edges), false)
+            }
+        })
+    }
+
+    /// Its placement: the identity where it gives none.
+    fn transform(&self) -> Message<DMat4> {
+        let t = match self.fields.get("transform") {
+            None => DMat4::IDENTITY,
+            Some(t) => transform(t).map_err(|m| self.says("transform", m))?,
+        };
+        crate::scene::check_transform(&t, self.index).map_err(|e| self.says("transform", e))?;
+        Ok(t)
+    }
+
+    /// Its style; its hidden lines take what they leave out from the file's `style`, else
+    /// the defaults.
+    fn style(&self, edges_off: bool, file: &FileStyle) -> Message<InstanceStyle> {
+        let mut style = InstanceStyle {
+            edges: edges_off.then_some(false),
+            outlines: self.flag("outlines")?,
+            wire_color: self.color("wire_color")?,
+            fill_color: self.color("fill_color")?,
+            outline_color: self.color("outline_color")?,
+            line_width: self.width("line_width")?,
+            outline_width: self.width("outline_width")?,
+            edge_pattern: self.pattern("edge_pattern")?,
+            outline_pattern: self.pattern("outline_pattern")?,
+            ..InstanceStyle::default()
+        };
+        let pattern = self
+            .text("hidden")?
+            .map(|t| LinePattern::parse(t).map_err(|e| self.says("hidden", e)))
+            .transpose()?;
+        let (color, width) = (self.color("hidden_color")?, self.width("hidden_width")?);
+        if pattern.is_some() || color.is_some() || width.is_some() {
+            let default = HiddenLines::default();
+            let pattern = pattern.or(file.hidden).unwrap_or(Some(default.pattern));
+            style.hidden = pattern.map_or(HiddenOverride::Off, |pattern| {
+                HiddenOverride::Lines(HiddenLines {
+                    pattern,
+                    color: color.or(file.hidden_color).unwrap_or(default.color),
+                    width: width.or(file.hidden_width).unwrap_or(default.width),
+                    behind_host: false,
+                    edges: true,
+                })
+            });
+        }
+        style
+            .validate(self.index)
+            .map_err(|e| format!("objects[{}]: {e}", self.index))?;
+        Ok(style)
+    }
 }
 
 /// What a scene file holds: its objects, its camera, and its frame style.
