@@ -613,7 +613,17 @@ fn listen<E: JsCast>(
     Ok(())
 }
 
+/// Listens to the canvas's pointer and wheel, files dropped or chosen, the toolbar, the
+/// window's size and the keys.
 fn wire_events(app: &Shared, root: &HtmlElement) -> Result<(), JsValue> {
+    wire_pointer(app)?;
+    wire_files(app, root)?;
+    wire_toolbar(app, root)?;
+    wire_keys(app, root)
+}
+
+/// Orbit, pan and zoom by pointer, pinch and wheel; a click picks.
+fn wire_pointer(app: &Shared) -> Result<(), JsValue> {
     let canvas: web_sys::EventTarget = app.borrow().canvas.clone().into();
     listen(
         &canvas,
@@ -680,8 +690,19 @@ fn wire_events(app: &Shared, root: &HtmlElement) -> Result<(), JsValue> {
     })?;
     listen(&canvas, "contextmenu", app, |_, e: web_sys::Event| {
         e.prevent_default()
-    })?;
+    })
+}
 
+/// The control named `name` in the page's toolbar.
+fn control(root: &HtmlElement, name: &str) -> Result<web_sys::EventTarget, JsValue> {
+    let found = root.query_selector(&format!("[name={name}]"))?;
+    found
+        .map(Into::into)
+        .ok_or_else(|| JsValue::from_str(&format!("no control {name}")))
+}
+
+/// A file dropped on the page or chosen in the toolbar opens.
+fn wire_files(app: &Shared, root: &HtmlElement) -> Result<(), JsValue> {
     let root_target: web_sys::EventTarget = root.clone().into();
     listen(&root_target, "dragover", app, |_, e: web_sys::DragEvent| {
         e.prevent_default()
@@ -696,12 +717,8 @@ fn wire_events(app: &Shared, root: &HtmlElement) -> Result<(), JsValue> {
             open_file(app, file);
         }
     })?;
-    let find = |name: &str| -> Result<web_sys::Element, JsValue> {
-        root.query_selector(&format!("[name={name}]"))?
-            .ok_or_else(|| JsValue::from_str(&format!("no control {name}")))
-    };
     listen(
-        &find("file")?.into(),
+        &control(root, "file")?,
         "change",
         app,
         |app, e: web_sys::Event| {
@@ -710,9 +727,13 @@ fn wire_events(app: &Shared, root: &HtmlElement) -> Result<(), JsValue> {
                 open_file(app, file);
             }
         },
-    )?;
+    )
+}
+
+/// The toolbar's export button, selects, check box and width slider.
+fn wire_toolbar(app: &Shared, root: &HtmlElement) -> Result<(), JsValue> {
     listen(
-        &find("export")?.into(),
+        &control(root, "export")?,
         "click",
         app,
         |app, _: web_sys::Event| {
@@ -729,7 +750,7 @@ fn wire_events(app: &Shared, root: &HtmlElement) -> Result<(), JsValue> {
     // A select of the toolbar sets what `apply` sets to its selected index.
     let on_select = |name: &str, apply: fn(&mut App, usize)| {
         listen(
-            &find(name)?.into(),
+            &control(root, name)?,
             "change",
             app,
             move |app, e: web_sys::Event| {
@@ -747,7 +768,7 @@ fn wire_events(app: &Shared, root: &HtmlElement) -> Result<(), JsValue> {
     on_select("edges", App::set_edges)?;
     on_select("hidden", App::set_hidden)?;
     listen(
-        &find("outlines")?.into(),
+        &control(root, "outlines")?,
         "change",
         app,
         |app, e: web_sys::Event| {
@@ -759,7 +780,7 @@ fn wire_events(app: &Shared, root: &HtmlElement) -> Result<(), JsValue> {
         },
     )?;
     listen(
-        &find("width")?.into(),
+        &control(root, "width")?,
         "input",
         app,
         |app, e: web_sys::Event| {
@@ -769,8 +790,12 @@ fn wire_events(app: &Shared, root: &HtmlElement) -> Result<(), JsValue> {
                 schedule(app);
             }
         },
-    )?;
+    )
+}
 
+/// A resize redraws; the keys change the style, the edges and the section planes, and keep
+/// the toolbar in step.
+fn wire_keys(app: &Shared, root: &HtmlElement) -> Result<(), JsValue> {
     let window: web_sys::EventTarget = web_sys::window().ok_or("no window")?.into();
     listen(&window, "resize", app, |app, _: web_sys::Event| {
         schedule(app)
