@@ -397,32 +397,85 @@ pub fn bench_scene(
     shot: &Shot<'_>,
     timing: Timing,
 ) -> Result<Vec<Run>> {
-    let Timing {
-        frames,
-        warmup,
-        edges,
-        methods,
-    } = timing;
-    if frames == 0 {
+    if timing.frames == 0 {
         return Err(Error::InvalidSetting("--frames must be at least 1".into()));
     }
-    let timed = |m: Timed| methods.is_empty() || methods.contains(&m);
-    let device = &ctx.device;
-    let queue = &ctx.queue;
-    let size = shot.size;
     let up = Uploaded::new(&ctx.device, &ctx.queue, shot.world)?;
     let lines = up.edge_lines(&ctx.device, shot.world)?;
+    let (subjects, skipped) = subjects(ctx, shot, &up, &timing)?;
+    ctx.finish()?;
+    let times = time_frames(ctx, &subjects, (&up.store, &lines), &timing)?;
+    let store_bytes = up.store.gpu_bytes();
+    let run = |method: String| Run {
+        scene: name.to_owned(),
+        triangles: shot.world.triangle_count(),
+        size: [shot.size.0, shot.size.1],
+        method,
+        outlines: shot.style.outlines,
+        passes: BTreeMap::new(),
+        total_median_ms: f64::NAN,
+        cpu: Stats {
+            median_ms: f64::NAN,
+            p10_ms: f64::NAN,
+            p90_ms: f64::NAN,
+        },
+        gpu_bytes: 0,
+        edge_work: None,
+        skipped: None,
+        gl: None,
+    };
+    let mut runs = Vec::new();
+    for (subject, (spans, totals, cpu)) in subjects.iter().zip(times) {
+        runs.push(Run {
+            passes: spans
+                .iter()
+                .map(|(name, v)| (name.clone(), Stats::of(v)))
+                .collect(),
+            total_median_ms: Stats::of(&totals).median_ms,
+            cpu: Stats::of(&cpu),
+            gpu_bytes: match subject {
+                Subject::Gs(..) => subject.bytes(&lines),
+                _ => store_bytes + subject.bytes(&lines),
+            },
+            edge_work: edge_shares(ctx, subject)?,
+            gl: match subject {
+                Subject::Gs(pass, _) => Some(format!(
+                    "{}; timed by {}",
+                    pass.description(),
+                    pass.timing()
+                )),
+                _ => None,
+            },
+            ..run(subject.name())
+        });
+    }
+    runs.extend(skipped.into_iter().map(|(method, why)| Run {
+        skipped: Some(why),
+        ..run(method.to_owned())
+    }));
+    Ok(runs)
+}
+
+/// A method that cannot run here, and why.
+type Skipped = (&'static str, String);
+
+/// What `timing` asks to time on `shot`, each prepared, and the methods that cannot run
+/// here with why (gs where no OpenGL context with geometry shaders can be made).
+fn subjects(
+    ctx: &GpuContext,
+    shot: &Shot<'_>,
+    up: &Uploaded,
+    timing: &Timing,
+) -> Result<(Vec<Subject>, Vec<Skipped>)> {
+    let timed = |m: Timed| timing.methods.is_empty() || timing.methods.contains(&m);
+    let (device, queue) = (&ctx.device, &ctx.queue);
+    let size = shot.size;
     let scene = up.scene(shot.world, shot.view);
     let storage = || {
         // RENDER_ATTACHMENT: the edge pass clears the background instead of writing it.
         let usage = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::RENDER_ATTACHMENT;
-        texture_2d(
-            device,
-            "wirepass bench output",
-            size,
-            wgpu::TextureFormat::Rgba8Unorm,
-            usage,
-        )
+        let format = wgpu::TextureFormat::Rgba8Unorm;
+        texture_2d(device, "wirepass bench output", size, format, usage)
     };
     let forward_format = wgpu::TextureFormat::Rgba8UnormSrgb;
     let attachment = || {
@@ -442,14 +495,14 @@ pub fn bench_scene(
             Subject::Deferred(pass, frame, storage())
         });
     }
-    for &selection in &edges {
+    for &selection in &timing.edges {
         let mut world = shot.world.clone();
         for m in &mut world.meshes {
             let (mesh, e) = (*m.mesh).clone().resolve_edges(Some(selection));
             m.mesh = Arc::new(mesh);
             m.edges = e;
         }
-        let up = Box::new(Uploaded::new(&ctx.device, &ctx.queue, &world)?);
+        let up = Box::new(Uploaded::new(device, queue, &world)?);
         let scene = up.scene(&world, shot.view);
         let mut pass = DeferredPass::new(device, PassOptions::default())?;
         let frame = pass.prepare(device, &up.store, &scene, shot.style, size)?;
@@ -480,12 +533,16 @@ pub fn bench_scene(
         let frame = two_pass.prepare(device, &up.store, &scene, shot.style, size)?;
         subjects.push(Subject::TwoPass(two_pass, frame, attachment()));
     }
-    // Where no OpenGL context with geometry shaders can be made, gs is reported skipped.
     let mut skipped = Vec::new();
     if timed(Timed::Gs) {
-        let gpu = (device, queue);
         let made = GsPass::new().and_then(|mut pass| {
-            let frame = pass.prepare(gpu, &up.store, &scene, shot.style, (size, false))?;
+            let frame = pass.prepare(
+                (device, queue),
+                &up.store,
+                &scene,
+                shot.style,
+                (size, false),
+            )?;
             Ok(Subject::Gs(Box::new(pass), frame))
         });
         match made {
@@ -494,102 +551,67 @@ pub fn bench_scene(
             Err(e) => return Err(e),
         }
     }
-    ctx.finish()?;
+    Ok((subjects, skipped))
+}
 
+/// One subject's times over the timed frames: each GPU span's, and each group's (the spans
+/// before a name's first `.`), per frame; the frame's GPU total; the CPU's recording time.
+type SubjectTimes = (BTreeMap<String, Vec<f64>>, Vec<f64>, Vec<f64>);
+
+/// Runs `timing.warmup` untimed frames, then `timing.frames` timed ones, each running every
+/// subject once, in turn.
+fn time_frames(
+    ctx: &GpuContext,
+    subjects: &[Subject],
+    drawn: (&MeshStore, &EdgeLines),
+    timing: &Timing,
+) -> Result<Vec<SubjectTimes>> {
+    let (device, queue) = (&ctx.device, &ctx.queue);
     // Room for every span a frame can have (the host's depth seeding included), and more.
     let mut timer = GpuTimer::new(device, queue, 16)?;
-    let mut gpu: Vec<BTreeMap<String, Vec<f64>>> = vec![BTreeMap::new(); subjects.len()];
-    let mut totals = vec![Vec::new(); subjects.len()];
-    let mut cpu = vec![Vec::new(); subjects.len()];
-    for frame in 0..warmup + frames {
-        for (i, subject) in subjects.iter().enumerate() {
-            let (spans, recorded) =
-                subject.time((device, queue), (&up.store, &lines), &mut timer)?;
+    let mut times: Vec<SubjectTimes> = vec![Default::default(); subjects.len()];
+    for frame in 0..timing.warmup + timing.frames {
+        for (subject, (gpu, totals, cpu)) in subjects.iter().zip(&mut times) {
+            let (spans, recorded) = subject.time((device, queue), drawn, &mut timer)?;
             ctx.finish()?;
-            if frame >= warmup {
-                cpu[i].push(recorded);
-                totals[i].push(spans.iter().map(|s| s.1).sum());
-                let mut groups: BTreeMap<String, f64> = BTreeMap::new();
-                for (name, ms) in spans {
-                    if let Some((group, _)) = name.split_once('.') {
-                        *groups.entry(group.to_owned()).or_default() += ms;
-                    }
-                    gpu[i].entry(name.to_owned()).or_default().push(ms);
+            if frame < timing.warmup {
+                continue;
+            }
+            cpu.push(recorded);
+            totals.push(spans.iter().map(|s| s.1).sum());
+            let mut groups: BTreeMap<String, f64> = BTreeMap::new();
+            for (name, ms) in spans {
+                if let Some((group, _)) = name.split_once('.') {
+                    *groups.entry(group.to_owned()).or_default() += ms;
                 }
-                for (group, ms) in groups {
-                    gpu[i].entry(group).or_default().push(ms);
-                }
+                gpu.entry(name.to_owned()).or_default().push(ms);
+            }
+            for (group, ms) in groups {
+                gpu.entry(group).or_default().push(ms);
             }
         }
     }
-    let store_bytes = up.store.gpu_bytes();
-    let mut shares = Vec::new();
-    for subject in &subjects {
-        shares.push(match subject {
-            Subject::Deferred(_, frame, _)
-            | Subject::RenderPass(_, frame, _)
-            | Subject::Edges(_, _, _, frame, _) => {
-                let w = frame.edge_work(device, queue)?;
-                Some(EdgeShares {
-                    tiles: f64::from(w.tiles) / f64::from(w.all_tiles.max(1)),
-                    outlined_tiles: f64::from(w.outlined_tiles) / f64::from(w.all_tiles.max(1)),
-                    refined: f64::from(w.refined) / f64::from(w.pixels.max(1)),
-                    outline_clusters: w.outline_clusters,
-                    outline_pieces: w.outline_pieces,
-                })
-            }
-            _ => None,
-        });
-    }
-    Ok(subjects
-        .iter()
-        .enumerate()
-        .map(|(i, subject)| Run {
-            scene: name.to_owned(),
-            triangles: shot.world.triangle_count(),
-            size: [size.0, size.1],
-            method: subject.name(),
-            outlines: shot.style.outlines,
-            passes: gpu[i]
-                .iter()
-                .map(|(name, v)| (name.clone(), Stats::of(v)))
-                .collect(),
-            total_median_ms: Stats::of(&totals[i]).median_ms,
-            cpu: Stats::of(&cpu[i]),
-            gpu_bytes: match subject {
-                Subject::Gs(..) => subject.bytes(&lines),
-                _ => store_bytes + subject.bytes(&lines),
-            },
-            edge_work: shares[i],
-            skipped: None,
-            gl: match subject {
-                Subject::Gs(pass, _) => Some(format!(
-                    "{}; timed by {}",
-                    pass.description(),
-                    pass.timing()
-                )),
-                _ => None,
-            },
-        })
-        .chain(skipped.into_iter().map(|(method, why)| Run {
-            scene: name.to_owned(),
-            triangles: shot.world.triangle_count(),
-            size: [size.0, size.1],
-            method: method.to_owned(),
-            outlines: shot.style.outlines,
-            passes: BTreeMap::new(),
-            total_median_ms: f64::NAN,
-            cpu: Stats {
-                median_ms: f64::NAN,
-                p10_ms: f64::NAN,
-                p90_ms: f64::NAN,
-            },
-            gpu_bytes: 0,
-            edge_work: None,
-            skipped: Some(why),
-            gl: None,
-        }))
-        .collect())
+    Ok(times)
+}
+
+/// The deferred subjects' share of tiles and pixels their edge pass worked on, and their
+/// outline pass's work.
+fn edge_shares(ctx: &GpuContext, subject: &Subject) -> Result<Option<EdgeShares>> {
+    let frame = match subject {
+        Subject::Deferred(_, frame, _)
+        | Subject::RenderPass(_, frame, _)
+        | Subject::Edges(_, _, _, frame, _) => frame,
+        _ => return Ok(None),
+    };
+    let w = frame.edge_work(&ctx.device, &ctx.queue)?;
+    let all_tiles = f64::from(w.all_tiles.max(1));
+    Ok(Some(EdgeShares {
+        tiles: f64::from(w.tiles) / all_tiles,
+        outlined_tiles: f64::from(w.outlined_tiles) / all_tiles,
+        refined: f64::from(w.refined) / f64::from(w.pixels.max(1)),
+        outline_clusters: w.outline_clusters,
+        outline_pieces: w.outline_pieces,
+    }))
 }
 
 /// How a run names an edge selection: `edges=all`, `edges=polygon`, `edges=feature:30`.
