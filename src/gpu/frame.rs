@@ -300,166 +300,43 @@ impl FrameRecords {
         super::targets::check_size(device, region.size)?;
         // Where the device's largest texture leaves no room for the whole band, a narrower one.
         let room = device.limits().max_texture_dimension_2d - region.size.0.max(region.size.1);
-        // Instances that pass through each other draw their edges where visible, where
-        // they draw outlines (without, a line may reach past the silhouette only so); they and
-        // meshes that pass through themselves test their lines' visibility more widely.
-        let mut placed = Vec::with_capacity(scene.instances.len());
-        let mut crossing = false;
-        for i in scene.instances.iter() {
-            let record = store.record(i.mesh)?;
-            placed.push((record.bounds, i.transform));
-            crossing |= record.lines.crossed;
-        }
-        let outlines_of =
-            |i: usize| -> bool { scene.instances[i].style.outlines.unwrap_or(style.outlines) };
-        let pair_crossings = instance_pair_crossings(
-            store,
-            scene,
-            &placed,
-            |(a, b)| style.intersection_lines || outlines_of(a) || outlines_of(b),
-            pairs,
-        )?;
-        // Where either draws hidden lines, a pair whose bounds meet is drawn the wide way
-        // whether or not it crosses: the narrow window can miss the first fraction of a pixel
-        // of a hidden run where the other's surface in front of it ends beside it.
-        let hides = |i: usize| scene.instances[i].style.hidden_in(style).is_some();
-        let mut crossed = vec![false; scene.instances.len()];
-        for ((a, b), found) in &pair_crossings {
-            if !found.is_empty() || hides(*a) || hides(*b) {
-                crossed[*a] = outlines_of(*a);
-                crossed[*b] = outlines_of(*b);
-            }
-        }
-        crossing |= crossed.contains(&true);
+        let crossings = Crossings::new(store, scene, style, pairs)?;
         let guard = if guarded {
             let band = guard_band(scene, style);
-            (band + if crossing { CROSSING_BAND } else { 0 }).min(room / 2)
+            let band = band + if crossings.any { CROSSING_BAND } else { 0 };
+            band.min(room / 2)
         } else {
             0
         };
         let target = (region.size.0 + 2 * guard, region.size.1 + 2 * guard);
-        // Group instances by mesh (stable, so each mesh's instances keep the scene's order),
-        // so every mesh is one instanced draw.
-        let mut order: Vec<u32> = (0..scene.instances.len() as u32).collect();
-        let keys: Vec<(u32, u32)> = scene
-            .instances
-            .iter()
-            .map(|i| {
-                store
-                    .record(i.mesh)
-                    .map(|r| (r.triangle_base, r.vertex_base))
-            })
-            .collect::<Result<_>>()?;
-        order.sort_by_key(|&i| keys[i as usize]);
+        let order = draw_order(store, scene)?;
 
         let view = scene.view;
-        let eye = view.eye();
+        let look = (view.eye(), view.view_depth_row());
         let light = light_world_dir(&view, style);
-        let fade_row = view.view_depth_row();
         let mut records = Vec::with_capacity(order.len());
-        let mut draws: Vec<DrawGroup> = Vec::new();
-        let mut clusters = 0u64;
-        let mut outlines = false;
-        let mut patches = false;
         let mut hidden_styles = Vec::with_capacity(order.len());
-        let mut patterns = false;
+        let mut needs = Needs::default();
+        let mut clusters = 0u64;
         for (slot, &i) in order.iter().enumerate() {
             let instance = &scene.instances[i as usize];
             let mesh = store.record(instance.mesh)?;
-            let s = &instance.style;
-            let draws_outline = s.outlines.unwrap_or(style.outlines);
-            let draws_edges = s.edges.unwrap_or(true);
-            // The outline pass also draws the edges of large patches.
-            outlines |= draws_outline || (draws_edges && mesh.lines.splat);
-            patches |= draws_edges && mesh.lines.small_patches;
-            // Hidden lines are drawn by the outline pass, from every drawn line in view; so
-            // are patterned edges.
-            let hidden = s.hidden_in(style).filter(|_| draws_outline || draws_edges);
-            let edge_pattern = s.edge_pattern_in(style).dash_period();
-            let outline_pattern = s.outline_pattern_in(style).dash_period();
-            let patterned_edges = draws_edges && edge_pattern[1] > 0.0;
-            // Section planes cut the drawn edges short, and another instance may cross them:
-            // the outline pass draws them where they are visible.
-            let listed_edges = patterned_edges
-                || (draws_edges && (!scene.sections.is_empty() || crossed[i as usize]));
-            // Cut lines too: every instance has them where a section plane crosses it.
-            outlines |= hidden.is_some() || listed_edges || !scene.sections.is_empty();
-            patterns |= patterned_edges
-                || (draws_outline && outline_pattern[1] > 0.0)
-                || hidden.is_some_and(|h| h.pattern.dash_period()[1] > 0.0);
-            let flags = if draws_edges { INSTANCE_EDGES } else { 0 }
-                | if draws_outline { INSTANCE_OUTLINES } else { 0 }
-                | if hidden.is_some() { INSTANCE_HIDDEN } else { 0 }
-                | if hidden.is_some_and(|h| h.behind_host) {
-                    INSTANCE_BEHIND_HOST
-                } else {
-                    0
-                }
-                | if hidden.is_some_and(|h| h.edges) {
-                    INSTANCE_HIDDEN_EDGES
-                } else {
-                    0
-                }
-                | if listed_edges {
-                    INSTANCE_LISTED_EDGES
-                } else {
-                    0
-                }
-                | if crossed[i as usize] {
-                    INSTANCE_CROSSED
-                } else {
-                    0
-                };
-            let wire = s.wire_color.unwrap_or(style.wire_color);
-            let width = s.line_width.unwrap_or(style.line_width);
-            let record = instance_record(
-                &view,
-                (eye, fade_row),
-                instance.transform,
-                mesh,
-                (
-                    [
-                        wire.0,
-                        s.fill_color.unwrap_or(style.fill_color).0,
-                        s.outline_color_in(style).0,
-                    ],
-                    [width, s.outline_width_in(style)],
-                    flags,
-                ),
-                (slot as u32, clusters as u32),
-            );
-            let record = InstanceRecord {
-                edge_pattern,
-                outline_pattern,
-                ..with_hidden(record, hidden)
-            };
+            let placed = (slot as u32, clusters as u32);
+            let crossed = crossings.instances[i as usize];
+            let (record, hidden, asks) =
+                instance_entry(scene, style, look, instance, mesh, crossed, placed);
+            needs = needs.and(asks);
+            records.push(record);
             hidden_styles.push(hidden);
             clusters += u64::from(mesh.clusters);
-            records.push(record);
-            let slot = slot as u32;
-            match draws.last_mut() {
-                Some(d)
-                    if d.first_index == 3 * mesh.triangle_base
-                        && d.base_vertex == mesh.vertex_base as i32 =>
-                {
-                    d.instances.end = slot + 1;
-                }
-                _ => draws.push(DrawGroup {
-                    mesh: instance.mesh,
-                    first_index: 3 * mesh.triangle_base,
-                    index_count: 3 * mesh.triangles,
-                    base_vertex: mesh.vertex_base as i32,
-                    triangles: mesh.triangles,
-                    instances: slot..slot + 1,
-                }),
-            }
         }
+        let draws = draw_groups(store, scene, &order)?;
         let clusters = u32::try_from(clusters)
             .map_err(|_| Error::InvalidScene(format!("{clusters} clusters over all instances")))?;
         let hidden_color = hidden_styles.iter().flatten().map(|h| h.color).next();
         let (chain_work, phase_words, chains) = phase_tables(store, scene, &order, &mut records)?;
         let intersections = if style.intersection_lines {
-            intersection_records(store, scene, &order, &pair_crossings)?
+            intersection_records(store, scene, &order, &crossings.pairs)?
         } else {
             Vec::new()
         };
@@ -469,7 +346,7 @@ impl FrameRecords {
                 intersections.len()
             ))
         })?;
-        outlines |= !intersections.is_empty();
+        needs.outlines |= !intersections.is_empty();
         // The edge pass must know whose line, and of which class, each outline-pass pixel
         // holds where colours differ between instances or between an outline and its edges.
         // Likewise for hidden lines whose colours differ between instances.
@@ -549,16 +426,203 @@ impl FrameRecords {
             store: buffers,
             region,
             guard,
-            outlines,
-            patches,
+            outlines: needs.outlines,
+            patches: needs.patches,
             hidden,
-            patterns,
+            patterns: needs.patterns,
             mixed_colors,
-            crossing: crossing || intersections_count > 0,
+            crossing: crossings.any || intersections_count > 0,
             chain_work,
             intersections,
         })
     }
+}
+
+/// Which instances cross others, and how: what decides how widely the frame tests its
+/// lines' visibility.
+struct Crossings {
+    /// The intersection lines of the instance pairs whose bounds meet.
+    pairs: PairCrossings,
+    /// Per instance (scene order): whether it draws its lines the wide way, because it
+    /// passes through another where it draws outlines (without, a line may reach past the
+    /// silhouette only so), or it or the other draws hidden lines.
+    instances: Vec<bool>,
+    /// Whether any instance does, or any mesh passes through itself.
+    any: bool,
+}
+
+impl Crossings {
+    fn new(
+        store: &MeshStore,
+        scene: &Scene<'_>,
+        style: &Style,
+        pairs: Option<&mut PairCache>,
+    ) -> Result<Crossings> {
+        let mut placed = Vec::with_capacity(scene.instances.len());
+        let mut any = false;
+        for i in scene.instances.iter() {
+            let record = store.record(i.mesh)?;
+            placed.push((record.bounds, i.transform));
+            any |= record.lines.crossed;
+        }
+        let outlines_of =
+            |i: usize| -> bool { scene.instances[i].style.outlines.unwrap_or(style.outlines) };
+        let wanted = |(a, b)| style.intersection_lines || outlines_of(a) || outlines_of(b);
+        let pairs = instance_pair_crossings(store, scene, &placed, wanted, pairs)?;
+        // Where either draws hidden lines, a pair whose bounds meet is drawn the wide way
+        // whether or not it crosses: the narrow window can miss the first fraction of a pixel
+        // of a hidden run where the other's surface in front of it ends beside it.
+        let hides = |i: usize| scene.instances[i].style.hidden_in(style).is_some();
+        let mut instances = vec![false; scene.instances.len()];
+        for ((a, b), found) in &pairs {
+            if !found.is_empty() || hides(*a) || hides(*b) {
+                instances[*a] = outlines_of(*a);
+                instances[*b] = outlines_of(*b);
+            }
+        }
+        any |= instances.contains(&true);
+        Ok(Crossings {
+            pairs,
+            instances,
+            any,
+        })
+    }
+}
+
+/// The scene's instances grouped by mesh (stable, so each mesh's instances keep the
+/// scene's order), so that every mesh is one instanced draw: slot → instance.
+fn draw_order(store: &MeshStore, scene: &Scene<'_>) -> Result<Vec<u32>> {
+    let mut order: Vec<u32> = (0..scene.instances.len() as u32).collect();
+    let keys: Vec<(u32, u32)> = scene
+        .instances
+        .iter()
+        .map(|i| {
+            store
+                .record(i.mesh)
+                .map(|r| (r.triangle_base, r.vertex_base))
+        })
+        .collect::<Result<_>>()?;
+    order.sort_by_key(|&i| keys[i as usize]);
+    Ok(order)
+}
+
+/// One instanced draw per run of slots of one mesh.
+fn draw_groups(store: &MeshStore, scene: &Scene<'_>, order: &[u32]) -> Result<Vec<DrawGroup>> {
+    let mut draws: Vec<DrawGroup> = Vec::new();
+    for (slot, &i) in order.iter().enumerate() {
+        let id = scene.instances[i as usize].mesh;
+        let mesh = store.record(id)?;
+        let slot = slot as u32;
+        match draws.last_mut() {
+            Some(d)
+                if d.first_index == 3 * mesh.triangle_base
+                    && d.base_vertex == mesh.vertex_base as i32 =>
+            {
+                d.instances.end = slot + 1;
+            }
+            _ => draws.push(DrawGroup {
+                mesh: id,
+                first_index: 3 * mesh.triangle_base,
+                index_count: 3 * mesh.triangles,
+                base_vertex: mesh.vertex_base as i32,
+                triangles: mesh.triangles,
+                instances: slot..slot + 1,
+            }),
+        }
+    }
+    Ok(draws)
+}
+
+/// Which of the frame's optional passes and modules its instances need.
+#[derive(Clone, Copy, Debug, Default)]
+struct Needs {
+    /// The outline pass: outlines, edges of large patches, hidden, listed and cut lines.
+    outlines: bool,
+    /// The edge pass's small-patch lookups.
+    patches: bool,
+    /// Dash patterns.
+    patterns: bool,
+}
+
+impl Needs {
+    fn and(self, other: Needs) -> Needs {
+        Needs {
+            outlines: self.outlines || other.outlines,
+            patches: self.patches || other.patches,
+            patterns: self.patterns || other.patterns,
+        }
+    }
+}
+
+/// One instance's record in `slot` (its clusters from `cluster_first` in the frame's
+/// list), its hidden lines, and what it needs of the frame's passes. `crossed`: it passes
+/// through another instance ([`Crossings`]).
+fn instance_entry(
+    scene: &Scene<'_>,
+    style: &Style,
+    look: (DVec4, DVec4),
+    instance: &crate::scene::Instance,
+    mesh: &MeshRecord,
+    crossed: bool,
+    (slot, cluster_first): (u32, u32),
+) -> (InstanceRecord, Option<crate::HiddenLines>, Needs) {
+    let s = &instance.style;
+    let sections = !scene.sections.is_empty();
+    let draws_outline = s.outlines.unwrap_or(style.outlines);
+    let draws_edges = s.edges.unwrap_or(true);
+    // Hidden lines are drawn by the outline pass, from every drawn line in view; so are
+    // patterned edges.
+    let hidden = s.hidden_in(style).filter(|_| draws_outline || draws_edges);
+    let edge_pattern = s.edge_pattern_in(style).dash_period();
+    let outline_pattern = s.outline_pattern_in(style).dash_period();
+    let patterned_edges = draws_edges && edge_pattern[1] > 0.0;
+    // Section planes cut the drawn edges short, and another instance may cross them: the
+    // outline pass draws them where they are visible.
+    let listed_edges = patterned_edges || (draws_edges && (sections || crossed));
+    let needs = Needs {
+        // The outline pass also draws the edges of large patches, and cut lines: every
+        // instance has them where a section plane crosses it.
+        outlines: draws_outline
+            || (draws_edges && mesh.lines.splat)
+            || hidden.is_some()
+            || listed_edges
+            || sections,
+        patches: draws_edges && mesh.lines.small_patches,
+        patterns: patterned_edges
+            || (draws_outline && outline_pattern[1] > 0.0)
+            || hidden.is_some_and(|h| h.pattern.dash_period()[1] > 0.0),
+    };
+    let flag = |on: bool, bit: u32| if on { bit } else { 0 };
+    let flags = flag(draws_edges, INSTANCE_EDGES)
+        | flag(draws_outline, INSTANCE_OUTLINES)
+        | flag(hidden.is_some(), INSTANCE_HIDDEN)
+        | flag(hidden.is_some_and(|h| h.behind_host), INSTANCE_BEHIND_HOST)
+        | flag(hidden.is_some_and(|h| h.edges), INSTANCE_HIDDEN_EDGES)
+        | flag(listed_edges, INSTANCE_LISTED_EDGES)
+        | flag(crossed, INSTANCE_CROSSED);
+    let colors = [
+        s.wire_color.unwrap_or(style.wire_color).0,
+        s.fill_color.unwrap_or(style.fill_color).0,
+        s.outline_color_in(style).0,
+    ];
+    let widths = [
+        s.line_width.unwrap_or(style.line_width),
+        s.outline_width_in(style),
+    ];
+    let record = instance_record(
+        &scene.view,
+        look,
+        instance.transform,
+        mesh,
+        (colors, widths, flags),
+        (slot, cluster_first),
+    );
+    let record = InstanceRecord {
+        edge_pattern,
+        outline_pattern,
+        ..with_hidden(record, hidden)
+    };
+    (record, hidden, needs)
 }
 
 /// The section planes as coefficients of the points of every instance's clip space (rows
