@@ -52,7 +52,7 @@ run's ratios against it and flags those that worsened by more than 15 %.
 
 - \`floor\`: the visibility pass and a compute pass that reads each pixel's id and writes a
   flat colour, the least a deferred pass can cost.
-- \`deferred\`: the visibility, outline and edge passes into a storage texture;
+- \`deferred\`: the visibility, trace and edge passes into a storage texture;
   \`render-pass\`: the same into the frame's result, composited into a host's render pass
   (\`OutputTarget::RenderPass\`, \`Composite::Shaded\`), the path hosts take.
 - \`forward\`, \`two-pass\`: the forward baselines on wgpu; \`gs\`: the published
@@ -61,7 +61,7 @@ run's ratios against it and flags those that worsened by more than 15 %.
   stages there), by its timestamps on a GPU.
 - \`bench/scenes/side-by-side.json\`: Spot, and Suzanne beside it, their bounds meeting but
   not their surfaces; \`through-each-other.json\`: Suzanne passing through Spot, whose
-  lines the outline pass draws where visible, in one-pixel pieces tested over 9×9 windows.
+  lines the trace pass draws where visible, in one-pixel pieces tested over 9×9 windows.
 - Ratios: \`deferred ÷ gs\` and \`÷ forward\`, the whole frame; \`edge ÷ floor\`, the edge
   pass's dispatches against the floor's one compute pass; \`edge ÷ edge at sphere:20000\`,
   the edge pass against its time on the sphere of fewest triangles (flat is 1).

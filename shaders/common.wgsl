@@ -36,11 +36,11 @@ struct Frame {
     // store split over two bindings (src/gpu/mesh_store.rs); the capacity otherwise.
     vertex_split: u32,
     triangle_split: u32,
-    // Clusters of all instances together: the outline cull's range.
+    // Clusters of all instances together: the trace cull's range.
     clusters: u32,
     // Host depth: 1 when the id target was seeded from the host's depth.
     host_depth: u32,
-    // Room of the outline pass's overflow list (`overflow_list` in outline.wgsl).
+    // Room of the trace pass's overflow list (`overflow_list` in trace.wgsl).
     overflow_room: u32,
     // Opacity of the shaded surface over the background (`see_through`).
     fill_opacity: f32,
@@ -48,7 +48,7 @@ struct Frame {
     // share one).
     hidden_color: vec4<f32>,
     // Chains of drawn edges (PATTERNS, `chain_phases`): words of the phase tables in the
-    // outline buffer, chains over all instances, entries of `chain_work`.
+    // trace buffer, chains over all instances, entries of `chain_work`.
     chain_work: vec4<u32>,
     // Linear RGBA of back faces seen through a section's cut (`sections_on` 1), and the
     // section planes as coefficients of clip-space points (`section_sides`; unused: 0).
@@ -57,7 +57,7 @@ struct Frame {
     sections_on: u32,
     // The cut lines' width in pixels and linear RGBA colour.
     section_width: f32,
-    // The frame's intersection segments (`intersections` in outline.wgsl), and their lines'
+    // The frame's intersection segments (`intersections` in trace.wgsl), and their lines'
     // width and colour.
     intersections: u32,
     intersection_width: f32,
@@ -97,7 +97,7 @@ struct Instance {
     triangle_base: u32,
     triangles: u32,
     cluster_base: u32,
-    // The first of this instance's clusters among all instances' (the outline cull's index).
+    // The first of this instance's clusters among all instances' (the trace cull's index).
     cluster_first: u32,
     // This record's place in the instance buffer.
     index: u32,
@@ -342,7 +342,7 @@ fn dash_nearest(s: f32, lo: f32, hi: f32, dash: f32, period: f32) -> f32 {
 }
 
 // Which line colours a pixel most: lines are ranked by their intensity in 1/4095 steps, and
-// equal ones by nearness (src/style.rs, line_key, is the twin). The outline pass keeps the
+// equal ones by nearness (src/style.rs, line_key, is the twin). The trace pass keeps the
 // greatest key per pixel with an atomic max; the distance is kept in KEY_DISTANCE_STEPS a
 // pixel.
 fn line_key(intensity: f32, d: f32) -> u32 {
@@ -400,7 +400,7 @@ struct Cluster {
     spread: f32,
 }
 
-// Whether the cluster holds drawn edges of a large patch, which the outline pass draws
+// Whether the cluster holds drawn edges of a large patch, which the trace pass draws
 // whatever the eye: mesh_store::cluster_records stores its spread as -1 - spread.
 fn cluster_splats(c: Cluster) -> bool {
     return c.spread < 0.0;

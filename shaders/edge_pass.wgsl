@@ -15,8 +15,8 @@
 // written, without lines. Only where the background is not one colour that a clear of the
 // output lays down instead (DeferredPass::background_clear).
 //
-// `outlined_main`, dispatched indirectly over the tiles the outline pass listed (those its
-// lines reach): their background and host pixels get the outline pass's line, if any.
+// `traced_main`, dispatched indirectly over the tiles the trace pass listed (those its
+// lines reach): their background and host pixels get the trace pass's line, if any.
 //
 // `tile_main`, dispatched indirectly over the listed tiles: the triangle the rasterizer gave
 // a pixel is tested exactly at the centre; where it covers the centre with room to spare
@@ -28,17 +28,17 @@
 // `refine_main`, dispatched indirectly over that list only: the exact coverage search among
 // the neighbourhood's triangles and the walks across edges from them.
 //
-// Flags: OUTLINES (read what the outline pass left), PATCHES (some instance draws a mesh with
+// Flags: TRACED (read what the trace pass left), PATCHES (some instance draws a mesh with
 // undrawn edges: a pixel near one searches its patch, `patch_distance`), COLORS (instances differ in line
-// colour: the outline pass also left which instance's line a pixel holds), HIDDEN (the outline
+// colour: the trace pass also left which instance's line a pixel holds), HIDDEN (the trace
 // pass left hidden lines, drawn under the visible ones: `hidden_at`), HOST (the host's
 // depth seeded the targets: a triangle must also be nearer than it), and the output
 // mode: MODE_SHADE, MODE_OVERLAY, MODE_RESULT (with SHADED: surface and lines, else lines
 // only), MODE_DIAGNOSTIC.
-#if OUTLINES
-// What the outline pass left per target pixel: the greatest `line_key` (and, with COLORS,
+#if TRACED
+// What the trace pass left per target pixel: the greatest `line_key` (and, with COLORS,
 // the greatest (level, instance) pair after it); then the tiles its lines reach
-// (`outline_tile_marks`).
+// (`traced_tile_marks`).
 @group(0) @binding(12) var<storage, read> acc: array<u32>;
 #endif
 
@@ -114,7 +114,7 @@ struct Pixel {
     kind: u32,
 }
 
-// The class of the outline pass's line with owner word `owner` (COLORS; an edge without).
+// The class of the trace pass's line with owner word `owner` (COLORS; an edge without).
 fn owner_kind(owner: u32) -> u32 {
     let kind = owner & OWNER_CLASS;
     var line = select(LINE_CLASS_EDGE, LINE_CLASS_CUT, kind == OWNER_CUT);
@@ -122,12 +122,12 @@ fn owner_kind(owner: u32) -> u32 {
     return select(line, LINE_CLASS_INTERSECTION, kind == OWNER_INTERSECTION);
 }
 
-// The line the outline pass left in target pixel `xy`: its key (0 for none) and its owner
+// The line the trace pass left in target pixel `xy`: its key (0 for none) and its owner
 // (the instance slot whose line it is, and OWNER_OUTLINE for an outline: `owner_color`).
 fn outline_at(xy: vec2<u32>) -> vec2<u32> {
     var key = 0u;
     var owner = 0u;
-#if OUTLINES
+#if TRACED
     let k = xy.y * u32(frame.target_size.x) + xy.x;
 #if COLORS
     key = acc[2u * k];
@@ -139,7 +139,7 @@ fn outline_at(xy: vec2<u32>) -> vec2<u32> {
     return vec2<u32>(key, owner);
 }
 
-// The key of the hidden line the outline pass left in target pixel `xy` (0 for none), and
+// The key of the hidden line the trace pass left in target pixel `xy` (0 for none), and
 // its owner word (COLORS: `hidden_color_of`; 0 otherwise).
 fn hidden_at(xy: vec2<u32>) -> vec2<u32> {
 #if HIDDEN
@@ -155,7 +155,7 @@ fn hidden_at(xy: vec2<u32>) -> vec2<u32> {
 }
 
 // A pixel whose centre no triangle covers (`inst` is BACKGROUND_ID or HOST_ID): only the
-// outline pass's line colours it, `outline` as outline_at gives it (0 for no line).
+// trace pass's line colours it, `outline` as outline_at gives it (0 for no line).
 fn empty_pixel(xy: vec2<u32>, inst: u32, outline: vec2<u32>) -> Pixel {
     var p: Pixel;
     p.inst = inst;
@@ -179,7 +179,7 @@ fn empty_pixel(xy: vec2<u32>, inst: u32, outline: vec2<u32>) -> Pixel {
 }
 
 // Bits of `info` (mesh_records.rs, EdgeData; INFO_*): the triangle's patch is larger than
-// PATCH_TRIANGLES or crosses another surface (its drawn edges come from the outline pass), or
+// PATCH_TRIANGLES or crosses another surface (its drawn edges come from the trace pass), or
 // is two triangles. Where the patch crosses another surface (INFO_CROSSED) its pixels take
 // no lines of their own, which the crossing surface may hide right beside them.
 #if PATCHES
@@ -412,7 +412,7 @@ fn patch_search(s: Sample, point: vec2<f32>) -> f32 {
 // whether the pixel's patch must be searched instead (PATCHES): where an undrawn edge is
 // nearer than the line's reach and the drawn edges, the nearest line may lie beyond it (and
 // the line of a drawn edge pass closer than the edge). A large patch's pixels there take
-// their lines from the outline pass, which draws its drawn edges.
+// their lines from the trace pass, which draws its drawn edges.
 struct Own {
     distance: f32,
     search: bool,
@@ -425,7 +425,7 @@ struct Own {
 fn own_lines(s: Sample) -> Own {
     let flags = instances[slot(s.inst)].flags;
     let bits = info[instances[slot(s.inst)].triangle_base + s.tri];
-    // Patterned edges and those of crossed patches are drawn by the outline pass.
+    // Patterned edges and those of crossed patches are drawn by the trace pass.
     let edges = (flags & (INSTANCE_EDGES | INSTANCE_LISTED_EDGES)) == INSTANCE_EDGES && (bits & INFO_CROSSED) == 0u;
     let mask = select(0u, bits & 7u, edges);
     let near = vec3<f32>(s.clip0.z, s.clip1.z, s.clip2.z);
@@ -446,7 +446,7 @@ fn own_lines(s: Sample) -> Own {
 }
 
 // A pixel whose centre triangle `s` covers, `own` pixels from a line of its own triangle or
-// patch: the stronger of that line and the outline pass's colours it, equal ones going to the
+// patch: the stronger of that line and the trace pass's colours it, equal ones going to the
 // nearer.
 fn surface_pixel(xy: vec2<u32>, s: Sample, own: f32) -> Pixel {
     var p: Pixel;
@@ -568,7 +568,7 @@ fn no_sample(inst: u32) -> Sample {
     return s;
 }
 
-// Pixels without a triangle, without lines (those over the background are outlined_main's).
+// Pixels without a triangle, without lines (those over the background are traced_main's).
 // Background next to foreground is written here too; classify_main listed it for
 // refine_main, which decides it.
 @compute @workgroup_size(8, 8)
@@ -649,11 +649,11 @@ fn classify_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var listed = (from_left | from_right | from_above | from_below) & inside & ~fg;
 #if MODE_RESULT
     // The tiles whose result may be other than transparent: foreground, background the
-    // refine dispatch decides, the outline pass's lines.
+    // refine dispatch decides, the trace pass's lines.
     var drawn = any((fg | listed) != vec2<u32>(0u));
-#if OUTLINES
+#if TRACED
     let columns_out = (u32(frame.output_size.x) + 7u) / 8u;
-    drawn = drawn || acc[outline_tile_marks() + gid.y * columns_out + gid.x] != 0u;
+    drawn = drawn || acc[traced_tile_marks() + gid.y * columns_out + gid.x] != 0u;
 #endif
     if all(gid.xy == vec2<u32>(0u)) {
         atomicStore(&composite_rw.vertices, 6u);
@@ -690,11 +690,11 @@ fn classify_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
 }
 
-#if OUTLINES
-// The outline pass's lines over the background and host pixels of the tiles they reach.
+#if TRACED
+// The trace pass's lines over the background and host pixels of the tiles they reach.
 @compute @workgroup_size(8, 8)
-fn outlined_main(@builtin(local_invocation_id) local: vec3<u32>, @builtin(workgroup_id) group: vec3<u32>) {
-    let list = outline_tile_list();
+fn traced_main(@builtin(local_invocation_id) local: vec3<u32>, @builtin(workgroup_id) group: vec3<u32>) {
+    let list = traced_tile_list();
     let t = list_group(group);
     if t < acc[list + 3u] {
         let tile = acc[list + 4u + t];

@@ -1,6 +1,6 @@
 // The scene as the compute passes see it: the frame, the instances, the mesh store and the
 // id target, with the exact test of one triangle at one screen point. Assembled after
-// common.wgsl, before the outline and edge passes.
+// common.wgsl, before the trace and edge passes.
 //
 // Flags: SPLIT (the store's vertex and per-triangle buffers are bound as two halves each),
 // UNIFORM_INSTANCES (the frame's instance records fit a uniform buffer) and ONE_INSTANCE (the
@@ -32,23 +32,23 @@ fn list_group(group: vec3<u32>) -> u32 {
     return group.y * LIST_WIDTH + group.x;
 }
 
-// The outline buffer (`acc` in the edge pass, `acc_rw` in the outline pass; sized by
-// src/gpu/targets.rs): the outline pass's line per target pixel (one word, two with COLORS),
+// The trace buffer (`acc` in the edge pass, `acc_rw` in the trace pass; sized by
+// src/gpu/targets.rs): the trace pass's line per target pixel (one word, two with COLORS),
 // with HIDDEN its hidden line per target pixel (`hidden_lines`), then a mark per 8×8 output
 // tile its lines reach, then the list of those tiles (a list header as `list_size` fills it,
 // then one packed tile per item), then the phase tables (`chain_phases`), then its list of
 // pieces.
-fn outline_tile_count() -> u32 {
+fn traced_tile_count() -> u32 {
     let size = vec2<u32>(frame.output_size);
     return ((size.x + 7u) / 8u) * ((size.y + 7u) / 8u);
 }
 
-// The class bits of the outline pass's owner word (COLORS: intensity level << 20 | class
+// The class bits of the trace pass's owner word (COLORS: intensity level << 20 | class
 // bits | instance slot): an outline's line (the instance's outline colour, not its line
 // colour), a section's cut line (the frame's section line colour), both for an
 // intersection line (the frame's intersection line colour; of equal intensity, it wins
 // over the others); then the slot's bits (OWNER_*, from src/gpu/shaders.rs).
-// The colour of the outline pass's line whose owner word is `owner`: the owning instance's
+// The colour of the trace pass's line whose owner word is `owner`: the owning instance's
 // outline colour for an outline, the section line colour for a cut line, the intersection
 // line colour for an intersection line, its line colour for a drawn edge.
 fn owner_color(owner: u32) -> vec4<f32> {
@@ -76,7 +76,7 @@ fn hidden_color_of(owner: u32) -> vec4<f32> {
 }
 
 // Word offset of the tile marks.
-fn outline_tile_marks() -> u32 {
+fn traced_tile_marks() -> u32 {
 #if HIDDEN
     // The hidden lines take as many words as the lines.
     return 2u * hidden_lines();
@@ -86,8 +86,8 @@ fn outline_tile_marks() -> u32 {
 }
 
 // Word offset of the tile list's header.
-fn outline_tile_list() -> u32 {
-    return outline_tile_marks() + outline_tile_count();
+fn traced_tile_list() -> u32 {
+    return traced_tile_marks() + traced_tile_count();
 }
 
 // Where instance slot `i`'s record is read: with ONE_INSTANCE always slot 0, a constant

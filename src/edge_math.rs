@@ -160,13 +160,13 @@ pub fn nearer(a_near: f64, b_near: f64, b_w: f64) -> bool {
 /// a front face).
 pub const CAP_MARGIN: f64 = 1e-6;
 
-/// Twin of `REACH_SLACK` in outline.wgsl: pixels past a line's reach that still take its
-/// distance from the outline map (the line has no intensity there). Both implementations
+/// Twin of `REACH_SLACK` in trace.wgsl: pixels past a line's reach that still take its
+/// distance from the traced map (the line has no intensity there). Both implementations
 /// allow it, so that f32 rounding decides only for pixels within its own error of this
 /// boundary, not for all within a slack the GPU alone allows.
 pub const REACH_SLACK: f64 = 1e-3;
 
-/// Twin of `DASH_SLACK` in outline.wgsl: a dash (or dot) of a line pattern that reaches
+/// Twin of `DASH_SLACK` in trace.wgsl: a dash (or dot) of a line pattern that reaches
 /// within this many pixels of a drawn run of the line (a visible or hidden part of it, up to
 /// its edge's end) is drawn from the run's nearest point. The pattern starts with a dash at
 /// a chain's first vertex, which is where the run of its first edge ends: the two meet
@@ -174,7 +174,7 @@ pub const REACH_SLACK: f64 = 1e-3;
 /// drawn or not by the last bit.
 pub const DASH_SLACK: f64 = 1e-3;
 
-/// Twin of `END_INSET` in outline.wgsl: pixels inside a line's ends at which the visibility
+/// Twin of `END_INSET` in trace.wgsl: pixels inside a line's ends at which the visibility
 /// of each end is tested. At a vertex every triangle round it agrees with the line only to
 /// rounding, so the end itself could flip to a class its line has nowhere else, and a run of
 /// no length is still drawn as a dot a line wide.

@@ -9,7 +9,7 @@ use crate::error::{Error, Result};
 use crate::style::{Color, HiddenLines, LinePattern, MAX_LINE_WIDTH};
 use glam::{DMat4, DVec3};
 
-/// Most instances a frame may hold: instance slots must fit 18 bits of the outline pass's
+/// Most instances a frame may hold: instance slots must fit 18 bits of the trace pass's
 /// per-pixel owner word, whose next two say whether the line is an outline, a section's cut
 /// line or an edge.
 pub const MAX_INSTANCES: u32 = 1 << 18;

@@ -132,7 +132,7 @@ pub struct Style {
     pub outline_width: Option<f32>,
     /// The pattern of the drawn edges' visible lines
     /// ([`InstanceStyle::edge_pattern`](crate::InstanceStyle::edge_pattern) overrides it).
-    /// Patterned edges are drawn by the outline pass (their visible runs, like an
+    /// Patterned edges are drawn by the trace pass (their visible runs, like an
     /// outline's), so their cost follows the number of drawn edges in view; solid edges
     /// cost nothing more. Only the deferred pass and the ground truth draw patterns.
     pub edge_pattern: LinePattern,
@@ -143,7 +143,7 @@ pub struct Style {
     /// Draw the outline (silhouette and boundary edges) at full width, over the background
     /// and farther surfaces too, and always, whatever the edge selection. Only the deferred
     /// pass and the ground truth can; the forward baselines draw each edge inside its own
-    /// triangles, so their outlines are half as wide. See `shaders/outline.wgsl`.
+    /// triangles, so their outlines are half as wide. See `shaders/trace.wgsl`.
     pub outlines: bool,
     /// Fade lines with their distance from the eye; `None` draws every line at full strength.
     pub depth_fade: Option<DepthFade>,
@@ -431,7 +431,7 @@ pub struct DepthFade {
 }
 
 /// Widest line a style may ask for, in pixels: a line's reach bounds how far the edge pass
-/// and the outline pass look around a pixel.
+/// and the trace pass look around a pixel.
 pub const MAX_LINE_WIDTH: f32 = 256.0;
 
 #[cfg_attr(not(feature = "truth"), doc(hidden))]

@@ -16,7 +16,7 @@ use wirepass::{Color, EdgeSelection, InstanceStyle, Style, View};
 
 const SIZE: (u32, u32) = (360, 200);
 
-/// fandisk (feature edges: its faces are large patches, whose drawn edges the outline pass
+/// fandisk (feature edges: its faces are large patches, whose drawn edges the trace pass
 /// draws too) beside a torus with polygon edges; the torus has outlines of its own.
 fn world() -> World {
     let fandisk = load("fandisk.obj");

@@ -236,7 +236,7 @@ fn instances_through_each_other() {
             &Style::default(),
         );
     }
-    // Along the box's -x face, through which the mirrored Suzanne passes: the outline
+    // Along the box's -x face, through which the mirrored Suzanne passes: the trace
     // pass's pieces see through wide windows (crossed instances) at every sample.
     check(
         "instances, along a crossed face",
@@ -511,7 +511,7 @@ fn intersection_lines_are_drawn_where_visible() {
 }
 
 /// The same frame drawn again from the same upload is the same to the bit: a batch of the
-/// outline pass's pieces (wide visibility windows where instances cross) keeps under
+/// trace pass's pieces (wide visibility windows where instances cross) keeps under
 /// llvmpipe's loop cap whichever pieces share it (`src/gpu/loop_budget.rs`). The cameras look
 /// along the box's -x face, through which the mirrored Suzanne passes, and through it.
 #[test]

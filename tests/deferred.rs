@@ -408,13 +408,13 @@ fn timer_reports_every_pass() {
             names,
             [
                 "visibility",
-                "outline.cull",
-                "outline.draw",
-                "outline.pieces",
+                "trace.cull",
+                "trace.list",
+                "trace.pieces",
                 "edge.classify",
                 "edge.border",
                 "edge.background",
-                "edge.outlined",
+                "edge.traced",
                 "edge.tiles",
                 "edge.refine"
             ]
@@ -544,10 +544,10 @@ fn edge_work_lists_the_tiles_with_foreground_and_the_background_beside_it() {
     // The tiles the outline's lines reach, each listed once: there are more pieces, each
     // reaching a tile at least, than tiles.
     assert!(
-        work.outlined_tiles > 10 && work.outlined_tiles <= work.all_tiles,
+        work.traced_tiles > 10 && work.traced_tiles <= work.all_tiles,
         "{work:?}"
     );
-    assert!(work.outline_pieces > work.all_tiles, "{work:?}");
+    assert!(work.traced_pieces > work.all_tiles, "{work:?}");
     assert_eq!(work.pixels, 7000);
     assert!(tiles > 10 && beside > 50, "{tiles} tiles, {beside} beside");
     // Every background pixel beside the foreground once, and the foreground the exact test
@@ -565,7 +565,7 @@ fn edge_work_lists_the_tiles_with_foreground_and_the_background_beside_it() {
     let (store, scene) = single(&mesh, EdgeSelection::Polygon, away.to_view(100.0 / 70.0));
     let (_, work) = draw(&store, &scene);
     assert_eq!(
-        (work.tiles, work.outlined_tiles, work.refined),
+        (work.tiles, work.traced_tiles, work.refined),
         (0, 0, 0),
         "{work:?}"
     );
@@ -658,7 +658,7 @@ fn async_readback_reads_what_the_blocking_one_reads() {
     let work = frame.edge_work(d, &ctx.queue).unwrap();
     let awaited = pollster::block_on(frame.edge_work_async(d, &ctx.queue)).unwrap();
     assert_eq!(work, awaited);
-    assert!(work.tiles > 0 && work.outline_clusters > 0, "{work:?}");
+    assert!(work.tiles > 0 && work.traced_clusters > 0, "{work:?}");
     ctx.finish().unwrap();
 }
 
@@ -784,7 +784,7 @@ fn gpu_tuning_draws_what_the_software_tuning_draws() {
         )
         .unwrap();
         ctx.queue.submit([encoder.finish()]);
-        frame.edge_work(device, &ctx.queue).unwrap().outline_pieces
+        frame.edge_work(device, &ctx.queue).unwrap().traced_pieces
     });
     assert!(
         pieces[0] > 50 && 2 * pieces[1] > 3 * pieces[0],

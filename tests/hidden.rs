@@ -302,7 +302,7 @@ fn hidden_line_styles_per_instance() {
         1.0,
     );
     let view = perspective(&world, DVec3::new(2.5, 1.8, 3.2));
-    // The torus's edges dashed in the last case: drawn by the outline pass, which must not
+    // The torus's edges dashed in the last case: drawn by the trace pass, which must not
     // draw hidden parts of them where the torus has no hidden lines.
     let pattern = LinePattern::Dashed {
         dash: 5.0,

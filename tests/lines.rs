@@ -481,7 +481,7 @@ fn an_edge_just_outside_the_image_draws_its_line_inside() {
 #[test]
 fn set_edges_redraws_a_stored_mesh_as_a_fresh_upload_would() {
     // Uploaded drawing every edge, switched to polygon edges (quads searched per pixel) and
-    // to feature edges (large patches, lines from the outline pass): each frame equals that of
+    // to feature edges (large patches, lines from the trace pass): each frame equals that of
     // a mesh uploaded with the selection in the first place.
     let mesh = load("suzanne.obj");
     let size = (160, 120);

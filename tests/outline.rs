@@ -76,7 +76,7 @@ fn outlines_reach_over_the_background_in_deferred_only() {
 
 /// With outlines off the deferred pass draws the edges of small patches (here every edge, a
 /// triangle mesh's polygon edges) inside their triangles, like the forward method: no
-/// background pixel has a line. (Lines of large patches come from the outline pass and reach
+/// background pixel has a line. (Lines of large patches come from the trace pass and reach
 /// over the background where they lie on a silhouette: tests/lines.rs.)
 #[test]
 fn outlines_off_keep_lines_inside_their_triangles() {
@@ -224,7 +224,7 @@ fn faces_seen_edge_on_fold_into_outlines() {
 }
 
 /// A 2 M-triangle sphere at 1280×720: each pole is a fan of about 2000 slivers, and the
-/// outline passes beside it, where background pixels next to the rim were once off by up to
+/// trace passes beside it, where background pixels next to the rim were once off by up to
 /// 0.19 px. Every pixel within the bounds.
 #[test]
 fn outline_beside_a_pole_fan_of_slivers() {
@@ -250,7 +250,7 @@ fn within_bounds(name: &str, scene: &TestScene) -> Rendering {
     truth
 }
 
-/// A frame whose pieces overflow the outline pass's piece list draws the same lines, to the
+/// A frame whose pieces overflow the trace pass's piece list draws the same lines, to the
 /// bit: the clusters (and groups of intersection segments) it had no room for are drawn by
 /// lanes of their own, every piece of their lines. fandisk with dashed hidden lines and a
 /// section plane lists thousands of pieces; Suzanne's eyes add intersection lines.

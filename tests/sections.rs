@@ -122,7 +122,7 @@ fn a_plane_that_misses_everything_changes_nothing() {
     );
     let view = perspective(&world, DVec3::new(1.5, 2.0, 2.5));
     assert_eq!(check("missing", &world, view, &Style::default()), (0, 0));
-    // The same image as without it, but for the drawn edges now found by the outline pass
+    // The same image as without it, but for the drawn edges now found by the trace pass
     // (the same lines within the usual bounds).
     let plain = shoot_world(
         &World::single(mesh, EdgeSelection::All),

@@ -50,7 +50,7 @@ fn a_mesh_split_over_two_bindings_renders_as_if_whole() {
     };
     let camera = below.camera(mesh.bounds_f64(), size).unwrap();
     // The mesh's triangles are stored in cluster order: where each file triangle is stored.
-    let order = &mesh.outline_clusters().order;
+    let order = &mesh.traced_clusters().order;
     let mut stored = vec![0u32; order.len()];
     for (s, &t) in order.iter().enumerate() {
         stored[t as usize] = s as u32;
@@ -166,7 +166,7 @@ fn a_mesh_past_two_bindings_is_a_clear_error() {
 }
 
 #[test]
-fn an_image_past_the_outline_buffer_limit_is_a_clear_error() {
+fn an_image_past_the_trace_buffer_limit_is_a_clear_error() {
     let (small, _turn) = small_device();
     let device = &small.device;
     let mesh = Procedural::Sphere(200).build().unwrap();
@@ -180,17 +180,17 @@ fn an_image_past_the_outline_buffer_limit_is_a_clear_error() {
         .unwrap();
     let msg = e.to_string();
     assert!(
-        msg.contains("outline buffer") && msg.contains("max_storage_buffer_binding_size = 65536"),
+        msg.contains("trace buffer") && msg.contains("max_storage_buffer_binding_size = 65536"),
         "{msg}"
     );
     small.finish().unwrap();
 }
 
-/// The outline pass lists the pieces of outline edges after the lines (and their tiles) in its
+/// The trace pass lists the pieces of outline edges after the lines (and their tiles) in its
 /// buffer; where the buffer has no room left for them, the piece dispatch draws the
 /// clusters it could not list in lanes of their own, to the same image.
 #[test]
-fn outline_pieces_past_the_list_s_room_are_drawn_all_the_same() {
+fn traced_pieces_past_the_list_s_room_are_drawn_all_the_same() {
     let (small, _turn) = small_device();
     let mesh = Arc::new(Procedural::Sphere(2000).build().unwrap());
     // Two spheres with lines of different colours keep two words a target pixel: at 82 × 81
@@ -224,7 +224,7 @@ fn outline_pieces_past_the_list_s_room_are_drawn_all_the_same() {
         style: &style,
         size,
     };
-    // What the outline pass listed on the small device, and its room.
+    // What the trace pass listed on the small device, and its room.
     let up = Uploaded::new(&small.device, &small.queue, &world).unwrap();
     let mut pass = DeferredPass::new(&small.device, PassOptions::default()).unwrap();
     let frame = pass
@@ -256,7 +256,7 @@ fn outline_pieces_past_the_list_s_room_are_drawn_all_the_same() {
     small.queue.submit([encoder.finish()]);
     let work = frame.edge_work(&small.device, &small.queue).unwrap();
     assert!(
-        work.piece_room < 64 && work.outline_pieces > 2 * work.piece_room && work.overflowed > 0,
+        work.piece_room < 64 && work.traced_pieces > 2 * work.piece_room && work.overflowed > 0,
         "{work:?}"
     );
 

@@ -1,4 +1,4 @@
-//! The pass's work, held to a recorded table: on fixed scenes, what the outline pass and the
+//! The pass's work, held to a recorded table: on fixed scenes, what the trace pass and the
 //! edge pass's later dispatches take on (tiles, refined pixels, listed clusters, lines and
 //! pieces, overflowed clusters) and the pipelines the frame builds are deterministic, so a
 //! change that makes the pass do more shows here, on any machine, where a time would not.
@@ -25,7 +25,7 @@ const TABLE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/work.txt");
 /// The counters, in the table's column order.
 const COLUMNS: [&str; 8] = [
     "tiles",
-    "outlined",
+    "traced",
     "refined",
     "clusters",
     "lines",
@@ -170,22 +170,22 @@ fn measure(case: &Case) -> [u64; 8] {
     queue.submit([encoder.finish()]);
     let EdgeWork {
         tiles,
-        outlined_tiles,
+        traced_tiles,
         refined,
-        outline_clusters,
+        traced_clusters,
         outline_lines,
-        outline_pieces,
+        traced_pieces,
         overflowed,
         ..
     } = frame.edge_work(device, queue).unwrap();
     ctx.finish().unwrap();
     [
         tiles,
-        outlined_tiles,
+        traced_tiles,
         refined,
-        outline_clusters,
+        traced_clusters,
         outline_lines,
-        outline_pieces,
+        traced_pieces,
         overflowed,
         pass.pipelines_built() as u32,
     ]
@@ -215,8 +215,8 @@ fn write_table(rows: &[(&str, [u64; 8])]) {
          # A number more than 10 % off its record fails tests/work.rs until this table is\n\
          # updated in the same commit, with the reason in its message:\n\
          #   WIREPASS_RECORD_WORK=1 cargo test --test work\n\
-         # tiles: 8x8 output tiles with foreground; outlined: tiles the outline pass's lines\n\
-         # reach; refined: pixels the refine dispatch decides; clusters: clusters the outline\n\
+         # tiles: 8x8 output tiles with foreground; traced: tiles the trace pass's lines\n\
+         # reach; refined: pixels the refine dispatch decides; clusters: clusters the trace\n\
          # cull lists; lines: lines it lists pieces of; pieces: pieces it lists; overflowed:\n\
          # clusters the piece list had no room for; pipelines: pipelines the frame built.\n",
     );

@@ -642,7 +642,7 @@ struct BenchArgs {
     /// Directory for bench.json, bench.csv and the plots.
     #[arg(long)]
     out: PathBuf,
-    /// Time the deferred method with its outline pass (on), without (off, the same lines
+    /// Time the deferred method with its trace pass (on), without (off, the same lines
     /// the forward baselines draw), or both (`on,off`); the methods that draw no outline
     /// (forward, two-pass, gs) are timed with the first setting only.
     #[arg(long, alias = "silhouettes", default_value = "on", value_delimiter = ',', value_parser = parse_switch)]

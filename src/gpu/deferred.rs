@@ -1,5 +1,5 @@
 //! The deferred wireframe pass, which orchestrates a frame: the host-depth seed (with the
-//! host's depth), the visibility pass, the outline pass (where an instance draws outlines)
+//! host's depth), the visibility pass, the trace pass (where an instance draws outlines)
 //! and the edge pass, for a whole scene of instances at once. Each sub-pass is a type in a
 //! file of its own; this file prepares frames and records the sub-passes in order.
 
@@ -12,8 +12,8 @@ use super::host_depth::{HostFrame, HostImport};
 use super::instance_crossings::PairCache;
 use super::mesh_store::MeshStore;
 use super::options::{OutputTarget, PassOptions, TriangleIds};
-use super::outline_pass::{piece_size_at, OutlinePass};
 use super::targets::{self, check_sampled, check_storage_output, TargetSpec, Targets, LIST_HEADER};
+use super::trace_pass::{piece_size_at, TracePass};
 use super::variants::{Mode, Variant};
 use super::visibility::Visibility;
 use super::{shaders, GpuTimer};
@@ -163,7 +163,7 @@ pub struct DeferredPass {
     format: wgpu::TextureFormat,
     visibility: Visibility,
     host: HostImport,
-    outline: OutlinePass,
+    outline: TracePass,
     edge: EdgePass,
     composite: Option<(CompositePipeline, Composite)>,
     /// Counts the encodes that write a result for [`render`](Self::render).
@@ -171,7 +171,7 @@ pub struct DeferredPass {
     /// Header every list starts a frame with: no work, one workgroup row.
     reset: wgpu::Buffer,
     pub(super) diagnostics: bool,
-    /// Entries of the outline pass's piece list, where a test sets it.
+    /// Entries of the trace pass's piece list, where a test sets it.
     pub(super) piece_room: Option<u64>,
     pub(super) targets: Option<Targets>,
     cull: Option<wgpu::Buffer>,
@@ -236,7 +236,7 @@ impl DeferredPass {
             format,
             visibility,
             host: HostImport::new(),
-            outline: OutlinePass::new(format, software),
+            outline: TracePass::new(format, software),
             edge: EdgePass::new(device, format, software)?,
             composite,
             results: AtomicU64::new(0),
@@ -294,10 +294,10 @@ impl DeferredPass {
             Some(&mut self.pairs),
         )?;
         let mut data = FrameData::new(device, store, records);
-        // The diagnostic map names the class of each pixel's line, which the outline pass's
-        // owner words tell apart (the image is the same with them; the outline buffer takes
+        // The diagnostic map names the class of each pixel's line, which the trace pass's
+        // owner words tell apart (the image is the same with them; the trace buffer takes
         // twice the memory).
-        data.mixed_colors |= self.diagnostics && data.outlines;
+        data.mixed_colors |= self.diagnostics && data.traced;
         let host = match &canvas.host_depth {
             Some(h) => Some(self.host.prepare(device, h, &scene.view, region.image)?),
             None => None,
@@ -326,7 +326,7 @@ impl DeferredPass {
             let limit = device.limits().max_storage_buffer_binding_size;
             if cull_bytes > limit {
                 return Err(Error::OverLimit {
-                    what: "the outline pass's cluster list for this scene, in bytes".into(),
+                    what: "the trace pass's cluster list for this scene, in bytes".into(),
                     value: cull_bytes,
                     limit_name: "max_storage_buffer_binding_size",
                     limit,
@@ -425,7 +425,7 @@ impl DeferredPass {
         // The floor's pipeline is built with the pass.
         if let Some(mode) = self.mode(target)? {
             let variant = self.variant(frame);
-            if variant.outlines {
+            if variant.traced {
                 let intersections = frame.data.intersections() > 0;
                 self.outline.warm_up(device, variant, intersections)?;
             }
@@ -450,20 +450,20 @@ impl DeferredPass {
     fn variant(&self, frame: &PreparedFrame) -> Variant {
         Variant {
             split: frame.data.split(),
-            outlines: frame.data.outlines,
+            traced: frame.data.traced,
             patches: frame.data.patches,
-            colors: frame.data.outlines && frame.data.mixed_colors,
+            colors: frame.data.traced && frame.data.mixed_colors,
             hidden: frame.data.hidden,
-            patterns: frame.data.outlines && frame.data.patterns,
-            sections: frame.data.outlines && frame.data.sections(),
-            crossing: frame.data.outlines && frame.data.crossing,
+            patterns: frame.data.traced && frame.data.patterns,
+            sections: frame.data.traced && frame.data.sections(),
+            crossing: frame.data.traced && frame.data.crossing,
             host: frame.host.is_some(),
             uniform_instances: frame.data.uniform_instances,
             one_instance: frame.data.uniforms.instances() == 1,
         }
     }
 
-    /// Records the visibility pass, the outline pass (where an instance draws its outline)
+    /// Records the visibility pass, the trace pass (where an instance draws its outline)
     /// and the edge pass into `encoder`. `store` must be the store the frame was prepared
     /// with, unchanged but for inserted meshes.
     pub fn encode(
@@ -586,7 +586,7 @@ impl DeferredPass {
             ));
         };
         let variant = self.variant(frame);
-        if variant.outlines {
+        if variant.traced {
             let buffers = (t, &frame.cull, &self.reset);
             let timer = timer.as_deref_mut();
             self.outline

@@ -16,9 +16,9 @@ use crate::error::Result;
 pub struct EdgeWork {
     /// 8×8 output tiles holding foreground, which the tile dispatch visited.
     pub tiles: u32,
-    /// Output tiles the outline pass's lines reach, whose background the edge pass's
-    /// outlined dispatch visited (0 where the outline pass did not run).
-    pub outlined_tiles: u32,
+    /// Output tiles the trace pass's lines reach, whose background the edge pass's
+    /// traced dispatch visited (0 where the trace pass did not run).
+    pub traced_tiles: u32,
     /// Output tiles in all.
     pub all_tiles: u32,
     /// Pixels the refine dispatch decided: centres the exact test could not settle from the
@@ -26,15 +26,15 @@ pub struct EdgeWork {
     pub refined: u32,
     /// Output pixels in all.
     pub pixels: u32,
-    /// Clusters of 64 triangles the outline pass's cull listed (those that may hold an
+    /// Clusters of 64 triangles the trace pass's cull listed (those that may hold an
     /// outline edge from the eye, or a drawn edge of a large patch), 0 where it did not run.
-    pub outline_clusters: u32,
-    /// Lines the outline pass listed pieces of (outline and drawn edges, cut and
+    pub traced_clusters: u32,
+    /// Lines the trace pass listed pieces of (outline and drawn edges, cut and
     /// intersection lines with a piece within reach of the targets), 0 where it did not run.
     pub outline_lines: u32,
     /// Pieces (up to 2 px, or 1 px for [`Tuning::Gpu`](super::Tuning::Gpu)) of those lines
-    /// the outline pass listed or found beyond its list's room, 0 where it did not run.
-    pub outline_pieces: u32,
+    /// the trace pass listed or found beyond its list's room, 0 where it did not run.
+    pub traced_pieces: u32,
     /// How many of them its piece list has room for.
     pub piece_room: u32,
     /// Clusters (and groups of 64 intersection segments) whose pieces the list had no room
@@ -43,7 +43,7 @@ pub struct EdgeWork {
 }
 
 impl PreparedFrame {
-    /// What the outline pass and the edge pass's tile and refine dispatches took on in the
+    /// What the trace pass and the edge pass's tile and refine dispatches took on in the
     /// last encode of this frame, read back from the GPU (it waits for the work submitted so
     /// far): for tools, tests and benchmarks. [`edge_work_async`](Self::edge_work_async)
     /// reads it without blocking.
@@ -77,39 +77,39 @@ impl PreparedFrame {
     }
 
     /// Where the counts lie (a list's is the last word of its header): the tile list, the
-    /// outlined tiles, the refine list, the cluster list, the lines and the pieces listed,
-    /// and the overflow list (the last five only where the outline pass ran).
+    /// traced tiles, the refine list, the cluster list, the lines and the pieces listed,
+    /// and the overflow list (the last five only where the trace pass ran).
     fn counters(&self) -> [(Option<&wgpu::Buffer>, u64); 7] {
         let t = &self.targets;
-        let outlines = |b| self.data.outlines.then_some(b);
+        let traced = |b| self.data.traced.then_some(b);
         let count = LIST_HEADER - 4;
         [
             (Some(&t.tiles), count),
-            (outlines(&t.acc), t.acc_tiles + count),
+            (traced(&t.acc), t.acc_tiles + count),
             (Some(&t.work), count),
-            (outlines(&self.cull), count),
-            (outlines(&t.acc), t.acc_overflow),
-            (outlines(&t.acc), t.acc_pieces + count),
-            (outlines(&t.acc), t.acc_overflow + count),
+            (traced(&self.cull), count),
+            (traced(&t.acc), t.acc_overflow),
+            (traced(&t.acc), t.acc_pieces + count),
+            (traced(&t.acc), t.acc_overflow + count),
         ]
     }
 
     /// The work from the counts at [`counters`](Self::counters).
     fn edge_work_of(
         &self,
-        [tiles, outlined_tiles, refined, clusters, lines, pieces, overflowed]: [u32; 7],
+        [tiles, traced_tiles, refined, clusters, lines, pieces, overflowed]: [u32; 7],
     ) -> EdgeWork {
         let (w, h) = self.targets.output;
         let tile = super::edge_pass::TILE;
         EdgeWork {
             tiles,
-            outlined_tiles,
+            traced_tiles,
             all_tiles: w.div_ceil(tile) * h.div_ceil(tile),
             refined,
             pixels: w * h,
-            outline_clusters: clusters,
+            traced_clusters: clusters,
             outline_lines: lines,
-            outline_pieces: pieces,
+            traced_pieces: pieces,
             piece_room: self.targets.piece_room(),
             overflowed,
         }
@@ -129,7 +129,7 @@ impl PreparedFrame {
 
 impl DeferredPass {
     /// Enables [`OutputTarget::Diagnostic`], which needs 24 more bytes of targets per pixel
-    /// (and, where the outline pass runs, a second word per pixel in its buffer, which tells
+    /// (and, where the trace pass runs, a second word per pixel in its buffer, which tells
     /// outlines from edges for the line-class map); tools and tests use it, a renderer does
     /// not need it.
     pub fn with_diagnostics(mut self) -> Self {
@@ -138,7 +138,7 @@ impl DeferredPass {
         self
     }
 
-    /// Gives the outline pass's piece list room for `pieces` entries instead of one per 8
+    /// Gives the trace pass's piece list room for `pieces` entries instead of one per 8
     /// target pixels, so that a test can draw a frame whose pieces overflow it.
     pub fn with_piece_room(mut self, pieces: u64) -> Self {
         self.piece_room = Some(pieces);

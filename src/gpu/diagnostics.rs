@@ -10,13 +10,13 @@ use super::GpuTimer;
 #[derive(Default)]
 pub struct EncodeOptions<'t> {
     /// Timestamps around each pass, into this timer: the deferred pass names its spans
-    /// `"visibility"`, `"outline.cull"`, `"outline.draw"` and `"outline.pieces"` (when
+    /// `"visibility"`, `"trace.cull"`, `"trace.list"` and `"trace.pieces"` (when
     /// outlines are drawn), and `"edge.classify"`, `"edge.border"`, `"edge.clear"` or
-    /// `"edge.background"` (whichever lays down the background), `"edge.outlined"` (with
+    /// `"edge.background"` (whichever lays down the background), `"edge.traced"` (with
     /// outlines), `"edge.tiles"` and `"edge.refine"`; the baselines name theirs `"draw"`
     /// (two-pass: `"fill"` and `"lines"`).
     pub timer: Option<&'t mut GpuTimer>,
-    /// The deferred pass only: record the outline and edge passes over the ids the frame's
+    /// The deferred pass only: record the trace and edge passes over the ids the frame's
     /// last encode rasterized, without the visibility pass (a second output of one frame).
     pub reuse_ids: bool,
     /// The baselines only: also write the id and diagnostic maps of their frame.

@@ -1,7 +1,7 @@
 //! The edge pass (compute, `shaders/edge_pass.wgsl`): per pixel, the exact distance to the
 //! visible lines and the composited colour. Six dispatches (docs/how-it-works.md): classify
 //! lists the 8×8 tiles with foreground and the background pixels next to it; border adds
-//! the guard band's; the background is cleared or written; then the outlined tiles, the
+//! the guard band's; the background is cleared or written; then the traced tiles, the
 //! listed tiles and the refine list write the output.
 
 use super::bindings::{dispatch, store_resources, Compute, Res, Size, Sources};
@@ -20,8 +20,8 @@ pub(crate) struct EdgePipelines {
     /// Writes the pixels without a triangle, where no clear lays them down.
     background: Compute,
     classify: Compute,
-    /// Lines over the background of the tiles the outline pass lists; with outlines only.
-    outlined: Option<Compute>,
+    /// Lines over the background of the tiles the trace pass lists; with outlines only.
+    traced: Option<Compute>,
     border: Compute,
     tiles: Compute,
     refine: Compute,
@@ -44,7 +44,7 @@ impl EdgePass {
     pub(crate) fn built(&self) -> usize {
         let sets: usize = self.cache.lock().map_or(0, |c| {
             c.values()
-                .map(|p| 5 + usize::from(p.outlined.is_some()))
+                .map(|p| 5 + usize::from(p.traced.is_some()))
                 .sum()
         });
         sets + usize::from(cfg!(feature = "diagnostics"))
@@ -129,7 +129,7 @@ impl EdgePass {
         if v.host {
             common.push(Res::HostDepth);
         }
-        if v.outlines {
+        if v.traced {
             common.push(Res::Acc);
         }
         let with = |extra: &[Res]| {
@@ -141,18 +141,18 @@ impl EdgePass {
         let background = Compute::new(device, &module, "background_main", with(&[]), color)?;
         let mut classify_res = vec![Res::Frame, Res::Ids, Res::TilesRw, Res::WorkRw];
         if let Mode::Result { .. } = mode {
-            // It lists the tiles the composite draws, the outline pass's among them.
+            // It lists the tiles the composite draws, the trace pass's among them.
             classify_res.push(Res::CompositeRw);
-            if v.outlines {
+            if v.traced {
                 classify_res.push(Res::Acc);
             }
         }
         let classify = Compute::new(device, &module, "classify_main", classify_res, color)?;
-        let outlined = if v.outlines {
+        let traced = if v.traced {
             Some(Compute::new(
                 device,
                 &module,
-                "outlined_main",
+                "traced_main",
                 with(&[]),
                 color,
             )?)
@@ -179,7 +179,7 @@ impl EdgePass {
         let p = Arc::new(EdgePipelines {
             background,
             classify,
-            outlined,
+            traced,
             border,
             tiles,
             refine,
@@ -233,9 +233,9 @@ impl EdgePass {
                 Size::Grid(columns, rows),
             ));
         }
-        if let Some(outlined) = &edge.outlined {
+        if let Some(traced) = &edge.traced {
             let size = Size::Indirect(&t.acc, t.acc_tiles);
-            dispatches.push(("wirepass edge outlined", "edge.outlined", outlined, size));
+            dispatches.push(("wirepass edge traced", "edge.traced", traced, size));
         }
         dispatches.extend([
             (

@@ -95,7 +95,7 @@ pub(crate) const INSTANCE_BEHIND_HOST: u32 = 8;
 /// `Instance.flags`: the hidden parts of its drawn edges are drawn, not only its outline's.
 pub(crate) const INSTANCE_HIDDEN_EDGES: u32 = 16;
 /// `Instance.flags`: its drawn edges are patterned, cut by section planes or crossed by
-/// another instance, so the outline pass draws them (their visible runs) and the edge pass
+/// another instance, so the trace pass draws them (their visible runs) and the edge pass
 /// leaves them.
 pub(crate) const INSTANCE_LISTED_EDGES: u32 = 32;
 /// `Instance.flags`: it has a phase table (`chain_phases`).
@@ -104,7 +104,7 @@ pub(crate) const INSTANCE_PHASES: u32 = 64;
 /// lines' visibility is tested over a wider window ([`CROSSING_BAND`]).
 pub(crate) const INSTANCE_CROSSED: u32 = 128;
 
-/// Pixels the guard band grows by in a frame where surfaces may cross: the outline pass
+/// Pixels the guard band grows by in a frame where surfaces may cross: the trace pass
 /// tests the visibility of their lines against the ids up to four pixels around each point
 /// (the surface that a line passes into may be visible only a few pixels away, where the
 /// surfaces in front of it end), not one.
@@ -150,7 +150,7 @@ impl InstanceRecord {
 }
 
 /// Pixels of guard band the deferred pass keeps around its output, from the widest line of
-/// the scene: lines whose edges lie just outside the output reach into it, the outline pass
+/// the scene: lines whose edges lie just outside the output reach into it, the trace pass
 /// tests their visibility against the ids one pixel around each point (a few more in a
 /// frame where surfaces may cross, which adds [`CROSSING_BAND`]), and the coverage
 /// search reads the ids around each pixel. So the output is the same whether the image is
@@ -200,22 +200,22 @@ pub(crate) struct FrameData {
     pub region: Region,
     /// Pixels of guard band around the output in the targets.
     pub guard: u32,
-    /// Whether the outline pass runs: an instance draws outlines, or edges of a mesh with
-    /// large patches.
-    pub outlines: bool,
+    /// Whether the trace pass runs: an instance draws outlines, or edges of a mesh with
+    /// large patches, or a hidden, listed, cut or intersection line is drawn.
+    pub traced: bool,
     /// Whether an instance draws the edges of a mesh with small patches (the edge pass then
     /// searches them).
     pub patches: bool,
-    /// Whether hidden lines are drawn (by the outline pass, with `outlines`).
+    /// Whether hidden lines are drawn (by the trace pass, with `traced`).
     pub hidden: bool,
-    /// Whether a line is dashed or dotted (the outline pass then finds the patterns'
-    /// positions along chains and draws dashes, with `outlines`).
+    /// Whether a line is dashed or dotted (the trace pass then finds the patterns'
+    /// positions along chains and draws dashes, with `traced`).
     pub patterns: bool,
-    /// Whether instances differ in line colour (the outline pass then keeps, per pixel,
+    /// Whether instances differ in line colour (the trace pass then keeps, per pixel,
     /// which instance's line it holds).
     pub mixed_colors: bool,
     /// Whether surfaces may cross: a mesh passes through itself, instances may pass through
-    /// each other, or the frame draws intersection lines (the outline pass then looks wider
+    /// each other, or the frame draws intersection lines (the trace pass then looks wider
     /// round its lines' points).
     pub crossing: bool,
     /// The instances whose chains' pattern positions `chain_phases` finds ([`ChainWork`]),
@@ -242,7 +242,7 @@ pub(crate) struct FrameRecords {
     pub region: Region,
     /// Pixels of guard band around the output in the targets.
     pub guard: u32,
-    pub outlines: bool,
+    pub traced: bool,
     pub patches: bool,
     pub hidden: bool,
     pub patterns: bool,
@@ -252,7 +252,7 @@ pub(crate) struct FrameRecords {
     pub intersections: Vec<IntersectionRecord>,
 }
 
-/// One intersection segment of a frame (`struct Intersection` in outline.wgsl): where
+/// One intersection segment of a frame (`struct Intersection` in trace.wgsl): where
 /// triangle `t` of the instance in `slot` crosses triangle `u` of the instance in `other`
 /// (the same one where a mesh passes through itself), its ends `a`, `b` in the first
 /// instance's local (stored) coordinates.
@@ -270,7 +270,7 @@ pub(crate) struct IntersectionRecord {
 
 /// An instance whose drawn edges' chains carry a dashed or dotted hidden-line pattern: its
 /// slot, its mesh's first chain record, its number of chains, and the chains of the
-/// instances before it in the list (`chain_phases` in outline.wgsl finds its chain by it).
+/// instances before it in the list (`chain_phases` in trace.wgsl finds its chain by it).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub(crate) struct ChainWork {
@@ -346,7 +346,7 @@ impl FrameRecords {
                 intersections.len()
             ))
         })?;
-        needs.outlines |= !intersections.is_empty();
+        needs.traced |= !intersections.is_empty();
         // The edge pass must know whose line, and of which class, each outline-pass pixel
         // holds where colours differ between instances or between an outline and its edges.
         // Likewise for hidden lines whose colours differ between instances.
@@ -426,7 +426,7 @@ impl FrameRecords {
             store: buffers,
             region,
             guard,
-            outlines: needs.outlines,
+            traced: needs.traced,
             patches: needs.patches,
             hidden,
             patterns: needs.patterns,
@@ -536,8 +536,8 @@ fn draw_groups(store: &MeshStore, scene: &Scene<'_>, order: &[u32]) -> Result<Ve
 /// Which of the frame's optional passes and modules its instances need.
 #[derive(Clone, Copy, Debug, Default)]
 struct Needs {
-    /// The outline pass: outlines, edges of large patches, hidden, listed and cut lines.
-    outlines: bool,
+    /// The trace pass: outlines, edges of large patches, hidden, listed and cut lines.
+    traced: bool,
     /// The edge pass's small-patch lookups.
     patches: bool,
     /// Dash patterns.
@@ -547,7 +547,7 @@ struct Needs {
 impl Needs {
     fn and(self, other: Needs) -> Needs {
         Needs {
-            outlines: self.outlines || other.outlines,
+            traced: self.traced || other.traced,
             patches: self.patches || other.patches,
             patterns: self.patterns || other.patterns,
         }
@@ -570,19 +570,19 @@ fn instance_entry(
     let sections = !scene.sections.is_empty();
     let draws_outline = s.outlines.unwrap_or(style.outlines);
     let draws_edges = s.edges.unwrap_or(true);
-    // Hidden lines are drawn by the outline pass, from every drawn line in view; so are
+    // Hidden lines are drawn by the trace pass, from every drawn line in view; so are
     // patterned edges.
     let hidden = s.hidden_in(style).filter(|_| draws_outline || draws_edges);
     let edge_pattern = s.edge_pattern_in(style).dash_period();
     let outline_pattern = s.outline_pattern_in(style).dash_period();
     let patterned_edges = draws_edges && edge_pattern[1] > 0.0;
     // Section planes cut the drawn edges short, and another instance may cross them: the
-    // outline pass draws them where they are visible.
+    // trace pass draws them where they are visible.
     let listed_edges = patterned_edges || (draws_edges && (sections || crossed));
     let needs = Needs {
-        // The outline pass also draws the edges of large patches, and cut lines: every
+        // The trace pass also draws the edges of large patches, and cut lines: every
         // instance has them where a section plane crosses it.
-        outlines: draws_outline
+        traced: draws_outline
             || (draws_edges && mesh.lines.splat)
             || hidden.is_some()
             || listed_edges
@@ -660,7 +660,7 @@ pub(crate) const PHASE_ENTRY_WORDS: u32 = 3;
 
 /// The phase tables of a frame's patterns: a pattern runs along chains of drawn edges, so
 /// each instance drawing its edges, or their hidden parts, in a dashed or dotted pattern
-/// gets a phase table in the outline buffer, if its mesh has chains (its record is marked
+/// gets a phase table in the trace buffer, if its mesh has chains (its record is marked
 /// `INSTANCE_PHASES` and given the table's place). Returns the tables' work, their words in
 /// all (a power of two) and the chains in all.
 fn phase_tables(
@@ -787,7 +787,7 @@ impl FrameData {
             order,
             store: buffers,
             guard,
-            outlines,
+            traced,
             patches,
             hidden,
             patterns,
@@ -838,7 +838,7 @@ impl FrameData {
             store_version: (store.store_id(), store.version()),
             region,
             guard,
-            outlines,
+            traced,
             patches,
             hidden,
             patterns,
@@ -863,12 +863,12 @@ impl FrameData {
         self.uniforms.intersections
     }
 
-    /// Entries of the outline pass's overflow list.
+    /// Entries of the trace pass's overflow list.
     pub fn overflow_room(&self) -> u32 {
         self.uniforms.overflow_room
     }
 
-    /// Words of the outline buffer's phase tables, and the chains `chain_phases` visits.
+    /// Words of the trace buffer's phase tables, and the chains `chain_phases` visits.
     pub fn chain_phases(&self) -> (u32, u32) {
         (self.uniforms.chain_work[0], self.uniforms.chain_work[1])
     }
@@ -968,7 +968,7 @@ fn instance_record(
     }
 }
 
-/// Room of the outline pass's overflow list (`overflow_list` in outline.wgsl): an entry for
+/// Room of the trace pass's overflow list (`overflow_list` in trace.wgsl): an entry for
 /// each cluster and each group of 64 intersection segments, whose pieces the piece list may
 /// have had no room for; a power of two, so that the targets, which hold the list, are
 /// rebuilt only when a scene grows past it.

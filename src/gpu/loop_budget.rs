@@ -1,4 +1,4 @@
-//! How long the outline pass's loops may run: llvmpipe's cap on loop iterations, and the
+//! How long the trace pass's loops may run: llvmpipe's cap on loop iterations, and the
 //! piece lengths that keep under it.
 //!
 //! Mesa's software rasterizer llvmpipe (under lavapipe's Vulkan and under Mesa's GL driver)
@@ -8,10 +8,10 @@
 //! in and the shader goes on with what it has, without an error. A batch runs each loop
 //! until its slowest lane is done, so what counts is the sum, over the loops the batch
 //! enters, of the most iterations any of its lanes needs; and which pieces share a batch
-//! changes from frame to frame. A batch of outline pieces past the cap draws some of its
+//! changes from frame to frame. A batch of traced pieces past the cap draws some of its
 //! lines in part, and differently each frame.
 //!
-//! So on a software rasterizer the outline pass cuts an edge into pieces short enough that
+//! So on a software rasterizer the trace pass cuts an edge into pieces short enough that
 //! the most a batch of them can loop ([`piece_loops`]) stays under the cap, for lines up to
 //! [`COVERED_WIDTH`] wide: the samples along a piece ([`RUN_SAMPLES_PER_PX`] a pixel, and
 //! [`RUN_BISECTIONS`] more at each change of visibility, at most one a step), each looking
@@ -33,11 +33,11 @@ pub(crate) const LOOP_CAP: u32 = 65_535;
 
 /// Steps of a walk across edges from a rasterized triangle towards a point (`locate` in
 /// scene.wgsl): enough to go round a vertex's fan of small triangles from a rasterized
-/// neighbour to the one that owns the point, and, in the outline pass, to cross the few
+/// neighbour to the one that owns the point, and, in the trace pass, to cross the few
 /// pixels' worth of sub-pixel triangles between a rasterized triangle and one that hides a
 /// point of an outline.
 pub(crate) const WALK_STEPS: u32 = 24;
-/// Steps of the outline pass's walks from the outer ring of a wide window and from the
+/// Steps of the trace pass's walks from the outer ring of a wide window and from the
 /// line's triangles' other neighbours: they only cross the sheet's last few triangles.
 pub(crate) const FOLD_STEPS: u32 = 4;
 /// Samples of visibility a pixel along an outline piece.
@@ -53,8 +53,8 @@ pub(crate) const COVERED_WIDTH: u32 = 16;
 /// pattern's phase-table probes, the output tiles a piece marks.
 const OTHER_LOOPS: u32 = 1024;
 
-/// The radii of the windows of pixel ids the outline pass looks at round a sample
-/// (`line_window` in outline.wgsl): the 3×3 pixels round it; 5×5 with section planes and for
+/// The radii of the windows of pixel ids the trace pass looks at round a sample
+/// (`line_window` in trace.wgsl): the 3×3 pixels round it; 5×5 with section planes and for
 /// intersection lines; 9×9 where the line's triangles cross other surfaces.
 pub(crate) const WINDOW_RADII: [u32; 3] = [1, 2, 4];
 

@@ -63,7 +63,7 @@ pub(crate) struct MeshLines {
     /// Some triangle of a small patch has an undrawn edge: pixels near one search their
     /// patch (`patch_distance`).
     pub small_patches: bool,
-    /// Some drawn edge borders a large patch: the outline pass draws it.
+    /// Some drawn edge borders a large patch: the trace pass draws it.
     pub splat: bool,
     /// Some patch crosses another surface of the mesh ([`Patches::crossed`]).
     pub crossed: bool,
@@ -88,7 +88,7 @@ pub(crate) struct MeshData {
     pub intersections: Arc<[StoredCrossing]>,
 }
 
-/// Two triangles of a mesh that cross ([`Mesh::intersections`]) as the outline pass draws
+/// Two triangles of a mesh that cross ([`Mesh::intersections`]) as the trace pass draws
 /// their intersection line: their stored ids, and the segment's ends in stored coordinates.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct StoredCrossing {
@@ -117,7 +117,7 @@ impl MeshData {
                         mesh.outline_hints();
                     }),
                     timed(&|| {
-                        mesh.outline_clusters();
+                        mesh.traced_clusters();
                     }),
                 )
             },
@@ -146,7 +146,7 @@ impl MeshData {
                 [q.x, q.y, q.z, f32::from_bits(pack_normal(*n))]
             })
             .collect();
-        let clusters = mesh.outline_clusters();
+        let clusters = mesh.traced_clusters();
         let order: Arc<[u32]> = clusters.order.clone().into();
         let mut stored = vec![0u32; order.len()];
         for (s, &t) in order.iter().enumerate() {
@@ -262,11 +262,11 @@ fn neighbour_word(mesh: &Mesh, stored: &[u32], t: usize, i: usize) -> u32 {
 
 /// Bit of [`EdgeData::info`]: the triangle's patch is large ([`Patches::large`]).
 pub(crate) const INFO_LARGE_PATCH: u32 = 1 << 11;
-/// First of the three bits of [`EdgeData::info`] that mark the edges the outline pass draws
+/// First of the three bits of [`EdgeData::info`] that mark the edges the trace pass draws
 /// for a large patch ([`Patches::splat`]).
 pub(crate) const INFO_SPLAT_SHIFT: u32 = 12;
 /// Bit of [`EdgeData::info`]: the triangle's patch crosses another surface of the mesh
-/// ([`Patches::crossed`]): its pixels take their lines from the outline pass only.
+/// ([`Patches::crossed`]): its pixels take their lines from the trace pass only.
 pub(crate) const INFO_CROSSED: u32 = 1 << 29;
 /// Bit of [`EdgeData::info`]: the triangle's patch is a quad (two triangles), which the edge
 /// pass searches without a queue.
@@ -333,7 +333,7 @@ fn quad_bits(mesh: &Mesh, mask: &[u8], stored: &[u32], t: usize) -> u32 {
 }
 
 /// First of the three bits of [`EdgeData::info`] that mark the drawn edges in a chain of more
-/// than one edge, whose pattern position the outline pass looks up ([`ChainRecords`]); an
+/// than one edge, whose pattern position the trace pass looks up ([`ChainRecords`]); an
 /// edge alone starts its pattern at its end that comes first, as its chain would.
 pub(crate) const INFO_CHAINED_SHIFT: u32 = 26;
 
@@ -342,13 +342,13 @@ pub(crate) struct EdgeData {
     /// Per stored triangle, the 4 bytes the passes read (`triangle_info` in common.wgsl):
     /// bits 0–2 the drawn edges, bit 3 a boundary edge, bits 4–7 the fold code of
     /// [`Mesh::outline_hints`], bits 8–10 the edges that may be drawn as outlines, bit 11
-    /// a large patch, bits 12–14 the drawn edges the outline pass draws, bit 15 a patch of
+    /// a large patch, bits 12–14 the drawn edges the trace pass draws, bit 15 a patch of
     /// two triangles, bits 16–25 that quad's other triangle ([`quad_bits`]), bits 26–28 the
     /// drawn edges in chains ([`INFO_CHAINED_SHIFT`]), bit 29 a patch that crosses another
     /// surface ([`INFO_CROSSED`]).
     pub info: Vec<u32>,
     pub lines: MeshLines,
-    /// The drawn edges' chains, as the outline pass's chain records.
+    /// The drawn edges' chains, as the trace pass's chain records.
     pub chains: ChainRecords,
 }
 
@@ -356,7 +356,7 @@ impl EdgeData {
     pub fn new(mesh: &Mesh, edges: EdgeSelection, order: &[u32]) -> EdgeData {
         let mask = mesh.edge_mask(edges);
         let neighbours = mesh.edge_neighbours();
-        // Each edge splatted from the side with the lower stored id, the side the outline
+        // Each edge splatted from the side with the lower stored id, the side the trace
         // pass draws a silhouette from.
         let mut stored = vec![0u32; order.len()];
         for (s, &t) in order.iter().enumerate() {
@@ -409,13 +409,13 @@ impl EdgeData {
     }
 }
 
-/// A mesh's chains of more than one drawn edge ([`crate::mesh::chains`]) as the outline
+/// A mesh's chains of more than one drawn edge ([`crate::mesh::chains`]) as the trace
 /// pass's `chain_phases` reads them, in 16-byte records: one per chain (its first edge
 /// record, relative to the first record, and its edge count), then one per edge in chain order (its
 /// start and end vertex as the triangle listing it runs, and [`phase_key`] | forward << 31,
 /// and its place in the phase table). Each frame, `chain_phases` writes every edge's key and
 /// pattern position into its instance's phase table, an open-addressed hash table (linear
-/// probing from [`phase_slot`]) whose layout is fixed here: the outline pass finds an edge's
+/// probing from [`phase_slot`]) whose layout is fixed here: the trace pass finds an edge's
 /// position by its key, probing only slots written in the same frame.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub(crate) struct ChainRecords {
@@ -431,14 +431,14 @@ pub(crate) fn phase_key(t: u32, i: u32) -> u32 {
 }
 
 /// The slot a phase table of 2^`log2` slots probes first for `key` (twin of `phase_slot` in
-/// outline.wgsl): Fibonacci hashing.
+/// trace.wgsl): Fibonacci hashing.
 pub(crate) fn phase_slot(key: u32, log2: u32) -> u32 {
     key.wrapping_mul(0x9e37_79b1) >> (32 - log2)
 }
 
 impl ChainRecords {
     /// The chain records of `mesh`'s drawn edges (`mask`), each shared edge listed from the
-    /// side with the lower stored index (`stored`), as the outline pass lists it; and per
+    /// side with the lower stored index (`stored`), as the trace pass lists it; and per
     /// triangle, the edges in those chains.
     fn new(mesh: &Mesh, mask: &[u8], stored: &[u32]) -> (ChainRecords, Vec<u8>) {
         let neighbours = mesh.edge_neighbours();
@@ -492,8 +492,8 @@ impl ChainRecords {
     }
 }
 
-/// The cluster records the outline pass reads: `bounds` with the spread of each cluster
-/// holding an edge to splat (`info`, stored order) stored as −1 − spread, so the outline
+/// The cluster records the trace pass reads: `bounds` with the spread of each cluster
+/// holding an edge to splat (`info`, stored order) stored as −1 − spread, so the trace
 /// pass visits it whatever the eye (`cluster_splats` in common.wgsl), and the radius of each
 /// cluster holding no drawn edge stored as −1 − radius, so that hidden lines skip it
 /// (`cluster_draws`).

@@ -7,11 +7,11 @@
 //! and the unit normal packed octahedrally into 32 bits. Per triangle: three vertex indices
 //! (12 bytes, also the index buffer), the triangle across each edge and which of its corners
 //! lies off that edge (12 bytes), and 4 bytes of edge data; `mesh_records.rs` makes these
-//! records from a mesh. Per cluster of 64 triangles: the outline pass's bounds
+//! records from a mesh. Per cluster of 64 triangles: the trace pass's bounds
 //! (32 bytes).
 //!
 //! A mesh's triangles are stored in its clusters' order (a Morton curve through the
-//! triangles, [`Mesh::outline_clusters`]), so a cluster is a run of 64 consecutive triangles
+//! triangles, [`Mesh::traced_clusters`]), so a cluster is a run of 64 consecutive triangles
 //! and nearby triangles sit together in memory; [`MeshStore::file_triangle`] maps a stored
 //! triangle back to the file's numbering.
 

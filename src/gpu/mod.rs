@@ -1,6 +1,6 @@
 //! The pass on the GPU: the mesh store, a frame's scene data and targets, and the passes.
 //! [`DeferredPass`] orchestrates a frame's sub-passes, each in a file of its own
-//! (`visibility`, `host_depth`, the outline and edge dispatches, `composite`); the
+//! (`visibility`, `host_depth`, the trace and edge dispatches, `composite`); the
 //! forward methods it is measured against are in `baselines` (feature `diagnostics`). It uses the frame's terms
 //! (camera, scene, style, edge math) and the meshes, nothing of the loaders, the ground truth
 //! or the tools.
@@ -29,9 +29,9 @@ mod loop_budget;
 mod mesh_records;
 mod mesh_store;
 mod options;
-mod outline_pass;
 mod pick;
 mod readback;
+mod trace_pass;
 // The WGSL sources and their assembly: public for the tests that validate them.
 #[cfg(feature = "diagnostics")]
 pub mod shaders;

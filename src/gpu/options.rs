@@ -64,13 +64,13 @@ pub enum Tuning {
     Auto,
     /// For a software rasterizer: a clear lays the background down where the output allows
     /// one, and outline edges are drawn in pieces a lane each, as long as llvmpipe's cap on
-    /// a batch's loop iterations allows (2 px, or 1 px where the outline pass looks at a
+    /// a batch's loop iterations allows (2 px, or 1 px where the trace pass looks at a
     /// wide window round each sample).
     Software,
     /// For a GPU: a dispatch writes the background (a clear of a storage texture took an
     /// NVIDIA H200 six times as long: 0.147 against 0.025 ms at 1920×1080), and outline
     /// edges are drawn in pieces of up to 1 px, so that a frame's few outline edges fill
-    /// more lanes (the outline pass 2.3 → 0.34 ms for a 20 k-triangle sphere there).
+    /// more lanes (the trace pass 2.3 → 0.34 ms for a 20 k-triangle sphere there).
     Gpu,
 }
 

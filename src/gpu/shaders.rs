@@ -11,7 +11,7 @@
 /// `gpu::mesh_store`.
 pub const COMMON: &str = include_str!("../../shaders/common.wgsl");
 /// The scene's bindings and fetches (instances, the mesh store, the id target), and the
-/// exact per-pixel triangle test, shared by the outline and edge passes.
+/// exact per-pixel triangle test, shared by the trace and edge passes.
 pub const SCENE: &str = include_str!("../../shaders/scene.wgsl");
 /// Visibility pass: instanced, with `@builtin(primitive_index)`, or vertex-pulled.
 pub const VISIBILITY: &str = include_str!("../../shaders/visibility.wgsl");
@@ -19,8 +19,8 @@ pub const VISIBILITY: &str = include_str!("../../shaders/visibility.wgsl");
 pub const EDGE_PASS: &str = include_str!("../../shaders/edge_pass.wgsl");
 /// The benchmark floor (compute): an id read and a flat colour.
 pub const FLOOR: &str = include_str!("../../shaders/floor.wgsl");
-/// The outline pass (compute).
-pub const OUTLINE: &str = include_str!("../../shaders/outline.wgsl");
+/// The trace pass (compute).
+pub const TRACE: &str = include_str!("../../shaders/trace.wgsl");
 /// The forward single-pass baseline (vertex-pulled altitudes); see `gpu::ForwardPass`.
 pub const FORWARD: &str = include_str!("../../shaders/forward.wgsl");
 /// The two-pass baseline (fill + edge lines), assembled after [`FORWARD`]; see `gpu::TwoPass`.
@@ -105,7 +105,7 @@ pub fn assemble(parts: &[&str], flags: &[&str]) -> String {
 pub(crate) const NO_EDGE: f32 = 3.0e38;
 
 /// Bits of an owner word above its instance slot (`OWNER_INSTANCE`): the class of the
-/// outline pass's line at a pixel.
+/// trace pass's line at a pixel.
 const OWNER_CLASS_SHIFT: u32 = crate::scene::MAX_INSTANCES.trailing_zeros();
 const _: () = assert!(crate::scene::MAX_INSTANCES.is_power_of_two());
 // An owner word keeps a line key's top 12 bits over the owner: slot and class take 20.
@@ -224,9 +224,9 @@ pub fn edge_source(format: wgpu::TextureFormat, flags: &[&str]) -> String {
     assemble(&[SCENE, &edge, &floor, encode_output(format)], flags)
 }
 
-/// The outline pass's module for the frame's `flags`.
-pub fn outline_source(flags: &[&str]) -> String {
-    assemble(&[SCENE, OUTLINE], flags)
+/// The trace pass's module for the frame's `flags`.
+pub fn trace_source(flags: &[&str]) -> String {
+    assemble(&[SCENE, TRACE], flags)
 }
 
 /// The host-depth seeding module, for a single- or multisampled host depth texture.
@@ -267,7 +267,7 @@ mod tests {
     fn shared_constants_are_declared_once_from_rust() {
         let declared = constants();
         let sources = [
-            COMMON, SCENE, VISIBILITY, EDGE_PASS, FLOOR, OUTLINE, FORWARD, TWO_PASS, COMPOSITE,
+            COMMON, SCENE, VISIBILITY, EDGE_PASS, FLOOR, TRACE, FORWARD, TWO_PASS, COMPOSITE,
             HOST_DEPTH,
         ];
         let mut names = std::collections::HashSet::new();

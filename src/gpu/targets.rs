@@ -1,5 +1,5 @@
 //! The deferred pass's size-dependent targets, rebuilt only when the size changes: the id
-//! and depth targets of the visibility pass, the outline pass's per-pixel lines, the edge
+//! and depth targets of the visibility pass, the trace pass's per-pixel lines, the edge
 //! pass's list of pixels to refine, and, where asked for, the result for compositing and the
 //! diagnostic maps.
 
@@ -75,19 +75,19 @@ pub const DIAGNOSTIC_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Fl
 /// linear RGBA.
 pub const RESULT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
-/// Size of the header (indirect dispatch size x, y, z, then a count) of the outline and
-/// refine lists.
+/// Size of the header (indirect dispatch size x, y, z, then a count) of the traced-tile
+/// and refine lists.
 pub(crate) const LIST_HEADER: u64 = 16;
-/// Room in the outline pass's piece list: a piece per this many target pixels, and at least
+/// Room in the trace pass's piece list: a piece per this many target pixels, and at least
 /// MIN_PIECES (a piece is at most 2 px of an outline edge, 1 px on a GPU; the 1280×720 views
 /// of a 200 k-triangle sphere and of stanford-bunny list 1 151 and 4 900 on lavapipe).
 const PIXELS_PER_PIECE: u64 = 8;
 const MIN_PIECES: u64 = 1 << 16;
-/// Words per listed piece (outline.wgsl, `list_pieces`).
+/// Words per listed piece (trace.wgsl, `list_pieces`).
 pub(crate) const PIECE_WORDS: u32 = 4;
 const PIECE_BYTES: u64 = 4 * PIECE_WORDS as u64;
 
-/// Entries of the outline pass's piece list for targets of `size` (before the binding limit
+/// Entries of the trace pass's piece list for targets of `size` (before the binding limit
 /// trims it).
 pub(crate) fn piece_room(size: (u32, u32)) -> u64 {
     (u64::from(size.0) * u64::from(size.1) / PIXELS_PER_PIECE).max(MIN_PIECES)
@@ -101,11 +101,11 @@ pub(crate) struct Targets {
     pub output: (u32, u32),
     pub ids: wgpu::Texture,
     pub depth: wgpu::Texture,
-    /// The outline buffer (`outline_tile_marks` in scene.wgsl): one u32 per target pixel,
+    /// The trace buffer (`traced_tile_marks` in scene.wgsl): one u32 per target pixel,
     /// or two where instances differ in line colour, and as many more for hidden lines where
     /// they are drawn; a mark per output tile; the list of
     /// the tiles the lines reach, from byte `acc_tiles`; the phase tables of chains of drawn
-    /// edges (`chain_phases` in outline.wgsl), from byte `acc_phases`; the outline pass's
+    /// edges (`chain_phases` in trace.wgsl), from byte `acc_phases`; the trace pass's
     /// overflow list, from byte `acc_overflow`, and its piece list, from byte `acc_pieces`.
     pub acc: wgpu::Buffer,
     pub acc_tiles: u64,
@@ -138,9 +138,9 @@ pub(crate) struct TargetSpec {
     pub acc_hidden: bool,
     /// Words of phase tables.
     pub acc_phase_words: u32,
-    /// Entries of the outline pass's overflow list.
+    /// Entries of the trace pass's overflow list.
     pub acc_overflow_room: u32,
-    /// Entries of the outline pass's piece list ([`piece_room`]).
+    /// Entries of the trace pass's piece list ([`piece_room`]).
     pub acc_pieces: u64,
     pub result: bool,
     pub diagnostic: bool,
@@ -154,7 +154,7 @@ impl Targets {
     }
 
     #[cfg(feature = "diagnostics")]
-    /// Pieces the outline pass's list has room for (outline.wgsl, `piece_room`).
+    /// Pieces the trace pass's list has room for (trace.wgsl, `piece_room`).
     pub fn piece_room(&self) -> u32 {
         let room = (self.acc.size() - self.acc_pieces - LIST_HEADER) / PIECE_BYTES;
         u32::try_from(room).unwrap_or(u32::MAX)
@@ -167,7 +167,7 @@ impl Targets {
         let binding = device.limits().max_storage_buffer_binding_size;
         let tiles = u64::from(spec.output.0.div_ceil(8)) * u64::from(spec.output.1.div_ceil(8));
         // The lines, the tile marks and list, the phase tables, the overflow list, then the
-        // outline pass's piece list: its header, then room for a piece per PIXELS_PER_PIECE
+        // trace pass's piece list: its header, then room for a piece per PIXELS_PER_PIECE
         // target pixels (at least MIN_PIECES), less where the binding limit leaves less (the
         // overflow list takes the clusters whose pieces it has no room for).
         let words = (1 + u64::from(spec.acc_colors)) * (1 + u64::from(spec.acc_hidden));
@@ -177,7 +177,7 @@ impl Targets {
         let acc_pieces = acc_overflow + LIST_HEADER + 4 * u64::from(spec.acc_overflow_room);
         if acc_pieces + LIST_HEADER > binding {
             return Err(Error::OverLimit {
-                what: format!("the outline buffer for a {w}x{h} target, in bytes"),
+                what: format!("the trace buffer for a {w}x{h} target, in bytes"),
                 value: acc_pieces + LIST_HEADER,
                 limit_name: "max_storage_buffer_binding_size",
                 limit: binding,

@@ -50,23 +50,24 @@ impl Mode {
 /// The WGSL flag of the benchmark floor, the edge module's one pipeline without a [`Mode`].
 pub(crate) const FLOOR_FLAGS: &[&str] = &["MODE_FLOOR"];
 
-/// Settings constant over a frame that specialise the outline and edge pipelines.
+/// Settings constant over a frame that specialise the trace and edge pipelines.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub(crate) struct Variant {
     pub split: bool,
-    pub outlines: bool,
+    /// The trace pass runs ([`FrameData::traced`](super::frame::FrameData)).
+    pub traced: bool,
     pub patches: bool,
-    /// Outline colours differ between instances; only with outlines.
+    /// Outline colours differ between instances; only with `traced`.
     pub colors: bool,
-    /// Hidden lines are drawn (by the outline pass); only with outlines.
+    /// Hidden lines are drawn (by the trace pass); only with `traced`.
     pub hidden: bool,
-    /// A line is dashed or dotted; only with outlines, and only the outline pass reads it.
+    /// A line is dashed or dotted; only with `traced`, and only the trace pass reads it.
     pub patterns: bool,
-    /// The frame has section planes; only with outlines, and only the outline pass reads it
+    /// The frame has section planes; only with `traced`, and only the trace pass reads it
     /// (the edge pass's section colour is a select on the frame's value).
     pub sections: bool,
     /// Surfaces may cross ([`FrameData::crossing`](super::frame::FrameData)); only with
-    /// outlines, and only the outline pass reads it.
+    /// `traced`, and only the trace pass reads it.
     pub crossing: bool,
     pub host: bool,
     /// The instance records are bound as a uniform array.
@@ -77,7 +78,7 @@ pub(crate) struct Variant {
 
 impl Variant {
     /// This variant as the edge pass's pipelines are specialised: without the settings only
-    /// the outline pass reads.
+    /// the trace pass reads.
     pub(crate) fn for_edges(self) -> Variant {
         Variant {
             patterns: false,
@@ -88,12 +89,12 @@ impl Variant {
     }
 
     /// Every variant a frame can select: `colors`, `hidden`, `patterns`, `sections` and
-    /// `crossing` need `outlines`, `one_instance` needs `uniform_instances`; for validation,
+    /// `crossing` need `traced`, `one_instance` needs `uniform_instances`; for validation,
     /// sections and crossings are taken each alone, and both together with patterns.
     pub(crate) fn all() -> Vec<Variant> {
         let mut all = Vec::new();
         for split in [false, true] {
-            for (outlines, colors, hidden) in [
+            for (traced, colors, hidden) in [
                 (false, false, false),
                 (true, false, false),
                 (true, true, false),
@@ -105,10 +106,10 @@ impl Variant {
                         for (uniform_instances, one_instance) in
                             [(false, false), (true, false), (true, true)]
                         {
-                            for patterns in [false, true].into_iter().filter(|&p| outlines || !p) {
-                                // Sections and crossings: only with outlines, and each
+                            for patterns in [false, true].into_iter().filter(|&p| traced || !p) {
+                                // Sections and crossings: only with `traced`, and each
                                 // alone or both, the last with patterns only.
-                                let cuts: &[(bool, bool)] = match (outlines, patterns) {
+                                let cuts: &[(bool, bool)] = match (traced, patterns) {
                                     (false, _) => &[(false, false)],
                                     (true, false) => {
                                         &[(false, false), (true, false), (false, true)]
@@ -118,7 +119,7 @@ impl Variant {
                                 for &(sections, crossing) in cuts {
                                     all.push(Variant {
                                         split,
-                                        outlines,
+                                        traced,
                                         patches,
                                         colors,
                                         hidden,
@@ -143,7 +144,7 @@ impl Variant {
     pub(crate) fn flags(self) -> Vec<&'static str> {
         [
             (self.split, "SPLIT"),
-            (self.outlines, "OUTLINES"),
+            (self.traced, "TRACED"),
             (self.patches, "PATCHES"),
             (self.colors, "COLORS"),
             (self.hidden, "HIDDEN"),
@@ -161,9 +162,9 @@ impl Variant {
         .collect()
     }
 
-    /// The WGSL flags of this variant's outline module, with pieces of 1 px for a GPU
+    /// The WGSL flags of this variant's trace module, with pieces of 1 px for a GPU
     /// (`short_pieces`, [`Tuning`](super::Tuning)).
-    pub(crate) fn outline_flags(self, short_pieces: bool) -> Vec<&'static str> {
+    pub(crate) fn trace_flags(self, short_pieces: bool) -> Vec<&'static str> {
         let mut flags = self.flags();
         if short_pieces {
             flags.push("SHORT_PIECES");
@@ -173,7 +174,7 @@ impl Variant {
 }
 
 /// Every module the crate builds, named by its settings: each pass in each of its
-/// specialisations (the edge and outline passes in every output mode and frame variant a
+/// specialisations (the edge and trace passes in every output mode and frame variant a
 /// frame can select), for validation without a GPU.
 #[cfg_attr(not(feature = "diagnostics"), allow(dead_code))]
 pub fn shader_modules() -> Vec<(String, String)> {
@@ -220,11 +221,11 @@ pub fn shader_modules() -> Vec<(String, String)> {
             }
         }
     }
-    for v in variants.iter().filter(|v| v.outlines) {
+    for v in variants.iter().filter(|v| v.traced) {
         // Both tunings (`Tuning`).
         for short in [false, true] {
-            let flags = v.outline_flags(short);
-            out.push((format!("outline {flags:?}"), outline_source(&flags)));
+            let flags = v.trace_flags(short);
+            out.push((format!("outline {flags:?}"), trace_source(&flags)));
         }
     }
     for split in [false, true] {

@@ -17,7 +17,7 @@ pub const EDGE_ON_MARGIN: f64 = 2e-5;
 /// The bound on sin(fold) that code `q` of [`outline_hints`] stands for: 0 for flat, then
 /// powers of two from 2⁻¹³ to 1, and above 1 (never skip) for [`ANY_FOLD`]; with a 1 %
 /// and 10⁻⁶ margin for f32 rounding, and [`EDGE_ON_MARGIN`]. Twin of the decoding in
-/// outline.wgsl.
+/// trace.wgsl.
 pub fn fold_bound(q: u8) -> f64 {
     match q {
         0 => 1e-6 + EDGE_ON_MARGIN,

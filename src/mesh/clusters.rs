@@ -1,4 +1,4 @@
-//! Clusters of nearby triangles with bounds that let the GPU outline pass skip a whole cluster
+//! Clusters of nearby triangles with bounds that let the GPU trace pass skip a whole cluster
 //! at once, so that its cost follows the triangles near the outline rather than the triangle
 //! count.
 //!
@@ -19,7 +19,7 @@ use super::adjacency::{fold_bound, ANY_FOLD};
 use crate::mesh::par::*;
 use glam::DVec3;
 
-/// Triangles per cluster (the last may have fewer); the outline pass's workgroup size.
+/// Triangles per cluster (the last may have fewer); the trace pass's workgroup size.
 pub const CLUSTER_TRIANGLES: usize = 64;
 
 /// The spread of a cluster that may hold an outline edge from any view: over π/2 fails
@@ -206,7 +206,7 @@ mod tests {
             let partners = mesh.quad_partners();
             let paired = partners.iter().filter(|&&p| p != NO_NEIGHBOUR).count();
             assert!(paired > mesh.triangle_count() / 2, "{paired} paired");
-            let order = &mesh.outline_clusters().order;
+            let order = &mesh.traced_clusters().order;
             let mut stored = vec![usize::MAX; order.len()];
             for (s, &t) in order.iter().enumerate() {
                 assert_eq!(stored[t as usize], usize::MAX, "triangle {t} stored twice");

@@ -1,6 +1,6 @@
 //! Triangle meshes as every method sees them: positions, smooth normals, triangles, and the
 //! per-triangle mask that says which triangle edges were edges of the source polygons; and
-//! what is computed from them once (adjacency, patches, outline clusters). The loaders are
+//! what is computed from them once (adjacency, patches, traced clusters). The loaders are
 //! in `formats` (feature `formats`). It uses only the crate's error type.
 
 pub(crate) mod chains;
@@ -144,11 +144,11 @@ pub struct Mesh {
     weld: std::sync::OnceLock<Vec<u32>>,
     /// Edge adjacency, computed on first use.
     neighbours: std::sync::OnceLock<Vec<[u32; 3]>>,
-    /// Per triangle, what lets the outline pass skip it: see [`Mesh::outline_hints`].
+    /// Per triangle, what lets the trace pass skip it: see [`Mesh::outline_hints`].
     outline_hints: std::sync::OnceLock<Vec<u8>>,
-    /// Per cluster of triangles, what lets the outline pass skip it: see
-    /// [`Mesh::outline_clusters`].
-    outline_clusters: std::sync::OnceLock<clusters::Clusters>,
+    /// Per cluster of triangles, what lets the trace pass skip it: see
+    /// [`Mesh::traced_clusters`].
+    traced_clusters: std::sync::OnceLock<clusters::Clusters>,
     /// The crossing pairs, and per triangle whether it crosses another: see
     /// [`Mesh::crossed_triangles`].
     crossings: std::sync::OnceLock<(Vec<crossings::Crossing>, Vec<bool>)>,
@@ -253,7 +253,7 @@ impl Mesh {
             weld: Default::default(),
             neighbours: Default::default(),
             outline_hints: Default::default(),
-            outline_clusters: Default::default(),
+            traced_clusters: Default::default(),
             crossings: Default::default(),
         })
     }
@@ -416,7 +416,7 @@ impl Mesh {
 
     // What the pass computes from the mesh: for the ground truth and the tests.
     #[cfg_attr(not(feature = "truth"), doc(hidden))]
-    /// Per triangle, 5 bits that let the GPU outline pass skip triangles that cannot have an
+    /// Per triangle, 5 bits that let the GPU trace pass skip triangles that cannot have an
     /// outline edge: bit 0 set when an edge has no neighbour (a boundary, always an outline),
     /// bits 1–4 a code q bounding how far the surface folds at its edges: a neighboured edge
     /// can be a silhouette only while the eye sees the triangle within
@@ -456,11 +456,11 @@ impl Mesh {
     // What the pass computes from the mesh: for the ground truth and the tests.
     #[cfg_attr(not(feature = "truth"), doc(hidden))]
     /// The triangles in clusters of `clusters::CLUSTER_TRIANGLES` nearby ones, with bounds
-    /// that let the GPU outline pass skip a cluster when, from the current eye, none of its
+    /// that let the GPU trace pass skip a cluster when, from the current eye, none of its
     /// triangles can have an outline edge. See `clusters::clusters`. Computed once, on
     /// first use.
-    pub fn outline_clusters(&self) -> &clusters::Clusters {
-        computed_once(&self.outline_clusters, || {
+    pub fn traced_clusters(&self) -> &clusters::Clusters {
+        computed_once(&self.traced_clusters, || {
             clusters::clusters(
                 &self.positions,
                 &self.triangles,
@@ -648,7 +648,7 @@ mod tests {
                         || {
                             mesh.edge_neighbours();
                             mesh.outline_hints();
-                            mesh.outline_clusters().clone()
+                            mesh.traced_clusters().clone()
                         },
                         || mesh.intersections().len(),
                     );
@@ -663,7 +663,7 @@ mod tests {
                 })
                 .collect();
             for (clusters, crossings) in &results {
-                assert_eq!(clusters, mesh.outline_clusters());
+                assert_eq!(clusters, mesh.traced_clusters());
                 assert_eq!(*crossings, mesh.intersections().len());
             }
         }

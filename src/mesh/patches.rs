@@ -3,14 +3,14 @@
 //! crease a few sub-pixel triangles away), never to a triangle beyond a drawn edge of it, so
 //! the patch bounds the search for it. Small patches (polygons: a quad is two triangles) are
 //! searched per pixel by the edge pass; the drawn edges of large ones (the faces of a
-//! tessellated CAD part in feature mode) are drawn by the outline pass into every pixel in
+//! tessellated CAD part in feature mode) are drawn by the trace pass into every pixel in
 //! reach, like outlines, and so are those of patches that cross another surface
 //! ([`super::crossings`]), whose lines may be hidden next to their visible pixels.
 
 use super::adjacency::NO_NEIGHBOUR;
 
 /// Most triangles in a patch that the edge pass searches per pixel: a polygon of up to 18
-/// sides. Larger patches have their drawn edges drawn by the outline pass. Twin of
+/// sides. Larger patches have their drawn edges drawn by the trace pass. Twin of
 /// `PATCH_TRIANGLES` in edge_pass.wgsl.
 pub const PATCH_TRIANGLES: usize = 16;
 
@@ -18,16 +18,16 @@ pub const PATCH_TRIANGLES: usize = 16;
 #[derive(Clone, Debug, Default)]
 pub struct Patches {
     /// Per triangle, whether its patch has more than [`PATCH_TRIANGLES`] triangles or is
-    /// [`Patches::crossed`]: its drawn edges are drawn by the outline pass.
+    /// [`Patches::crossed`]: its drawn edges are drawn by the trace pass.
     pub large: Vec<bool>,
     /// Per triangle, whether a triangle of its patch crosses another surface of the mesh: its
-    /// pixels take no line of their own, only the outline pass's, drawn where visible.
+    /// pixels take no line of their own, only the trace pass's, drawn where visible.
     pub crossed: Vec<bool>,
     /// Per triangle, how many triangles its patch has (the triangles joined to it across
     /// undrawn edges, an edge counting as undrawn when either side leaves it out), counted
     /// up to [`PATCH_TRIANGLES`] + 1.
     pub size: Vec<u8>,
-    /// Per triangle, the drawn edges the outline pass draws ([`splat_edges`]).
+    /// Per triangle, the drawn edges the trace pass draws ([`splat_edges`]).
     pub splat: Vec<u8>,
 }
 
@@ -100,9 +100,9 @@ fn patch_roots(neighbours: &[[u32; 3]], mask: &[u8]) -> Vec<u32> {
     (0..n as u32).map(|t| root(&mut parent, t)).collect()
 }
 
-/// Per triangle, the drawn edges (bit `i` for edge `i`) that the outline pass draws because a
+/// Per triangle, the drawn edges (bit `i` for edge `i`) that the trace pass draws because a
 /// large patch lies on one side: each such edge once, from side `t` where `before(t, u)`
-/// when both sides draw it. The GPU's outline pass orders triangles as it stores them, so
+/// when both sides draw it. The GPU's trace pass orders triangles as it stores them, so
 /// that an edge that is also a silhouette is drawn once, by the side that draws the
 /// silhouette.
 pub fn splat_edges(
@@ -222,7 +222,7 @@ mod tests {
             [true, true, true, true, false, false, false, false]
         );
         assert_eq!(p.large, p.crossed);
-        // The crossed patch's drawn edges go to the outline pass, the drawn join once.
+        // The crossed patch's drawn edges go to the trace pass, the drawn join once.
         assert!(p.splat[..4].iter().all(|&b| b & 0b001 != 0));
         assert_eq!(p.splat[3], 0b011);
         assert_eq!(p.splat[4], 0b000);

@@ -283,7 +283,7 @@ pub fn builtin_mesh() -> Mesh {
         weld: Default::default(),
         neighbours: Default::default(),
         outline_hints: Default::default(),
-        outline_clusters: Default::default(),
+        traced_clusters: Default::default(),
         crossings: Default::default(),
     }
 }

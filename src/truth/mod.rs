@@ -8,9 +8,9 @@
 //! it uses it.
 
 pub mod accuracy;
-pub mod outline;
 pub mod raycast;
 pub mod rays;
+pub mod traced;
 
 pub use raycast::{draw_raycast, draw_raycast_over};
 pub use rays::{HostOccluders, RayCaster};

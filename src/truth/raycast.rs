@@ -54,7 +54,7 @@ fn line_class(visible: LineClass, i: f64, h: f64) -> LineClass {
     }
 }
 
-/// The class of a line of the outline map.
+/// The class of a line of the traced map.
 fn class_of(l: &Line) -> LineClass {
     if l.outline {
         LineClass::Outline
@@ -120,7 +120,7 @@ pub fn draw_raycast_over(shot: &Shot<'_>, host: Option<&HostOccluders<'_>>) -> R
         .iter()
         .map(|o| edge_math::local_eye(o.transform, shot.view.eye()))
         .collect();
-    let outline = crate::truth::outline::outline_map(
+    let outline = crate::truth::traced::traced_map(
         &caster,
         &rays,
         shot,
@@ -258,7 +258,7 @@ struct Truth<'a> {
 }
 
 impl Truth<'_> {
-    /// The colour of a line of the outline map: its object's outline or line colour.
+    /// The colour of a line of the traced map: its object's outline or line colour.
     fn line_color(&self, l: &Line) -> [f64; 4] {
         let st = &self.styles[l.object as usize];
         if l.outline {
@@ -273,7 +273,7 @@ impl Truth<'_> {
     }
 
     /// The ground truth at one pixel centre; `outline` and `hidden` are the pixel's lines from
-    /// the outline map, `host` the host's reverse depth there (−1 for none).
+    /// the traced map, `host` the host's reverse depth there (−1 for none).
     fn sample(
         &self,
         pixel: DVec2,

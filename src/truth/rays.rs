@@ -195,7 +195,7 @@ impl<'a> RayCaster<'a> {
 
     /// The outward normal of global triangle `id`, not unit: its world winding, turned where
     /// its object's transform mirrors, so a mirrored instance keeps its mesh's outside (twin
-    /// of `faces_away` in outline.wgsl).
+    /// of `faces_away` in trace.wgsl).
     pub fn outward(&self, id: u32) -> DVec3 {
         let (object, _) = self.world.locate(&self.first_ids, id);
         let mirror = self.world.objects[object].transform.determinant().signum();
@@ -381,7 +381,7 @@ fn crossed_objects(
 }
 
 impl ObjectStyle {
-    /// Whether the object's drawn edges are in the outline map (dashed or dotted, cut by
+    /// Whether the object's drawn edges are in the traced map (dashed or dotted, cut by
     /// section planes, or crossed by another object), not measured from each pixel's
     /// own triangle.
     pub fn listed_edges(&self) -> bool {

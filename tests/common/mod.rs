@@ -309,7 +309,7 @@ pub fn cylinder(n: u32) -> Mesh {
 
 /// Per pixel of an image of `size` through `camera`, whether it lies within `radius` pixels
 /// of a drawn edge (under `edges`) of a patch that crosses another surface of the mesh: the
-/// lines of such patches are drawn by the outline pass where visible, over their neighbours
+/// lines of such patches are drawn by the trace pass where visible, over their neighbours
 /// and the background too, not by the own-triangle definition the forward methods share
 /// (`wirepass::mesh::patches::Patches::crossed`; `tests/crossings.rs` holds them to the
 /// ground truth).

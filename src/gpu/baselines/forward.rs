@@ -50,7 +50,7 @@ struct Pipelines {
 /// of what the comparison with the deferred pass and the ground truth measures. So is its
 /// reliance on `noperspective` varyings surviving clipping: on Mesa's lavapipe and llvmpipe
 /// some clipped triangles get NaN distances and lose their lines (tests/forward.rs pins how
-/// many on two hard cameras). It draws no outline pass: outlines get half their width.
+/// many on two hard cameras). It draws no trace pass: outlines get half their width.
 ///
 /// Use: [`new`](Self::new) once, [`prepare`](Self::prepare) each frame, then
 /// [`encode`](Self::encode) (colour only) into the host's encoder; with the `diagnostics`

@@ -6,7 +6,7 @@ use super::run::{same_shot, switch, Run, Stats};
 use crate::error::{Error, Result};
 use crate::gpu::GpuContext;
 
-/// A markdown table of the deferred method's edge and outline passes under each edge
+/// A markdown table of the deferred method's edge and trace passes under each edge
 /// selection timed (`Timing::edges`), relative to the world's own selection (`deferred`) of
 /// the same scene and size; empty when only one was timed.
 pub fn edges_markdown(runs: &[Run]) -> String {
@@ -81,13 +81,13 @@ pub fn markdown(runs: &[Run]) -> String {
             .collect();
         if let Some(w) = r.edge_work {
             other.push(format!(
-                "tiles {:.1} %, outlined tiles {:.1} %, refined {:.2} % of pixels, {} outline \
-                 clusters, {} outline pieces",
+                "tiles {:.1} %, traced tiles {:.1} %, refined {:.2} % of pixels, {} outline \
+                 clusters, {} traced pieces",
                 100.0 * w.tiles,
-                100.0 * w.outlined_tiles,
+                100.0 * w.traced_tiles,
                 100.0 * w.refined,
-                w.outline_clusters,
-                w.outline_pieces
+                w.traced_clusters,
+                w.traced_pieces
             ));
         }
         out += &format!(
@@ -392,7 +392,7 @@ mod plot {
     /// and one line per method, `group` (the variable held fixed along the line, named in
     /// the legend) and `family` (scenes whose points a line may join: the spheres of
     /// `sphere:N`, say; a mesh file is a point of its own), and thinner lines for the
-    /// deferred method's edge and outline passes. The deferred methods timed without
+    /// deferred method's edge and trace passes. The deferred methods timed without
     /// outlines are fainter lines of their own.
     pub fn time_against(
         path: &Path,

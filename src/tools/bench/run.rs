@@ -58,8 +58,8 @@ pub struct Run {
     pub outlines: bool,
     /// GPU time of each pass, and of each group of passes: `edge` is the sum of its
     /// dispatches (`edge.classify`, `edge.border`, `edge.clear` or `edge.background`,
-    /// `edge.outlined`, `edge.tiles`, `edge.refine`; the floor's `edge.floor`),
-    /// `outline` of `outline.cull`, `outline.draw` and `outline.pieces`.
+    /// `edge.traced`, `edge.tiles`, `edge.refine`; the floor's `edge.floor`),
+    /// `outline` of `trace.cull`, `trace.list` and `trace.pieces`.
     pub passes: BTreeMap<String, Stats>,
     /// Median over frames of the sum of the passes.
     pub total_median_ms: f64,
@@ -85,15 +85,15 @@ pub struct Run {
 pub struct EdgeShares {
     /// Tiles with foreground among all 8×8 output tiles.
     pub tiles: f64,
-    /// Tiles the outline pass's lines reach among all 8×8 output tiles.
-    pub outlined_tiles: f64,
+    /// Tiles the trace pass's lines reach among all 8×8 output tiles.
+    pub traced_tiles: f64,
     /// Pixels refined among all output pixels.
     pub refined: f64,
-    /// Clusters of 64 triangles the outline pass's cull listed for its triangle dispatch.
-    pub outline_clusters: u32,
-    /// Pieces of outline edges the outline pass's piece dispatch drew (or found beyond its
+    /// Clusters of 64 triangles the trace pass's cull listed for its triangle dispatch.
+    pub traced_clusters: u32,
+    /// Pieces of outline edges the trace pass's piece dispatch drew (or found beyond its
     /// list's room).
-    pub outline_pieces: u32,
+    pub traced_pieces: u32,
 }
 
 /// A method being measured: its pass, prepared frame and output.
@@ -295,7 +295,7 @@ pub enum Timed {
     /// The floor: the visibility pass and a compute pass that reads the id and writes a
     /// flat colour.
     Floor,
-    /// The deferred method (visibility, outline and edge passes) into a storage texture.
+    /// The deferred method (visibility, trace and edge passes) into a storage texture.
     Deferred,
     /// The deferred method as a host draws it into its own render pass: the passes write
     /// the frame's result, which a draw composites (`Composite::Shaded`) into the host's
@@ -595,7 +595,7 @@ fn time_frames(
 }
 
 /// The deferred subjects' share of tiles and pixels their edge pass worked on, and their
-/// outline pass's work.
+/// trace pass's work.
 fn edge_shares(ctx: &GpuContext, subject: &Subject) -> Result<Option<EdgeShares>> {
     let frame = match subject {
         Subject::Deferred(_, frame, _)
@@ -607,10 +607,10 @@ fn edge_shares(ctx: &GpuContext, subject: &Subject) -> Result<Option<EdgeShares>
     let all_tiles = f64::from(w.all_tiles.max(1));
     Ok(Some(EdgeShares {
         tiles: f64::from(w.tiles) / all_tiles,
-        outlined_tiles: f64::from(w.outlined_tiles) / all_tiles,
+        traced_tiles: f64::from(w.traced_tiles) / all_tiles,
         refined: f64::from(w.refined) / f64::from(w.pixels.max(1)),
-        outline_clusters: w.outline_clusters,
-        outline_pieces: w.outline_pieces,
+        traced_clusters: w.traced_clusters,
+        traced_pieces: w.traced_pieces,
     }))
 }
 

@@ -1,6 +1,7 @@
-//! The outline pass (compute, `shaders/outline.wgsl`): outlines (silhouettes and
-//! boundaries) and the drawn edges of large patches, drawn from the triangles into every
-//! pixel within reach of their visible runs. Three dispatches: a cull of the clusters that
+//! The trace pass (compute, `shaders/trace.wgsl`): the lines the edge pass cannot find
+//! from the ids around a pixel, traced along the geometry and drawn into every pixel within
+//! reach of their visible runs: outlines (silhouettes and boundaries), the drawn edges of
+//! large patches, hidden lines, patterned or cut edges, cut lines and intersection lines. Three dispatches: a cull of the clusters that
 //! may hold such an edge, one invocation per listed triangle listing the edges' pieces, one
 //! per piece drawing it; before them, for dashed or dotted lines, one invocation per chain
 //! of drawn edges finding where the patterns stand along it; with intersection lines, one
@@ -17,13 +18,13 @@ use crate::error::{Error, Result};
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, OnceLock};
 
-/// Workgroup size of the outline pass.
+/// Workgroup size of the trace pass.
 const GROUP: u32 = 64;
 
-struct OutlinePipelines {
+struct TracePipelines {
     cull: Compute,
-    /// Lists the pieces of the listed clusters' outline edges.
-    draw: Compute,
+    /// Lists the pieces of the listed clusters' traced edges.
+    list: Compute,
     /// Draws the listed pieces, one a lane.
     pieces: Compute,
     /// Finds the patterns' positions along every chain (PATTERNS).
@@ -47,17 +48,17 @@ pub(crate) fn piece_size_at(data: &FrameData) -> u64 {
     LIST_HEADER + 8 * u64::from(data.uniforms_clusters().max(1))
 }
 
-/// The outline pass's pipelines, built for each variant on first use.
-pub(crate) struct OutlinePass {
+/// The trace pass's pipelines, built for each variant on first use.
+pub(crate) struct TracePass {
     /// The format the pipelines' layouts name for the (unused) colour output.
     format: wgpu::TextureFormat,
     /// Whether outline edges are drawn in pieces of 1 px, not as long as a software
     /// rasterizer's loop cap allows ([`Tuning`](super::Tuning)).
     short_pieces: bool,
-    cache: Mutex<HashMap<Variant, Arc<OutlinePipelines>>>,
+    cache: Mutex<HashMap<Variant, Arc<TracePipelines>>>,
 }
 
-impl OutlinePass {
+impl TracePass {
     /// Builds the pipelines of variant `v` now (with `intersections`, the intersection
     /// lines' too), if they are not built yet.
     pub(crate) fn warm_up(
@@ -77,7 +78,7 @@ impl OutlinePass {
     fn intersections<'p>(
         &self,
         device: &wgpu::Device,
-        p: &'p OutlinePipelines,
+        p: &'p TracePipelines,
     ) -> Result<&'p Intersections> {
         if let Some(c) = p.intersections.get() {
             return Ok(c);
@@ -118,7 +119,7 @@ impl OutlinePass {
         }
     }
 
-    fn pipelines(&self, device: &wgpu::Device, v: Variant) -> Result<Arc<OutlinePipelines>> {
+    fn pipelines(&self, device: &wgpu::Device, v: Variant) -> Result<Arc<TracePipelines>> {
         let mut cache = self
             .cache
             .lock()
@@ -127,15 +128,15 @@ impl OutlinePass {
             return Ok(p.clone());
         }
         let scope = crate::gpu::validation::Validation::begin(device);
-        let source = shaders::outline_source(&v.outline_flags(self.short_pieces));
+        let source = shaders::trace_source(&v.trace_flags(self.short_pieces));
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("wirepass outline pass"),
+            label: Some("wirepass trace list"),
             source: wgpu::ShaderSource::Wgsl(source.into()),
         });
         let cull = Compute::new(
             device,
             &module,
-            "outline_cull",
+            "trace_cull",
             vec![
                 Res::Frame,
                 bindings::instances(v.uniform_instances),
@@ -147,21 +148,21 @@ impl OutlinePass {
         // Both the listing and the piece dispatch read the cluster list (the pieces for the
         // overflow list's clusters), and the pieces and the intersection lines' listing the
         // intersection segments.
-        let mut draw_res = store_resources(v.split, true, v.uniform_instances);
-        draw_res.extend([Res::Ids, Res::AccRw, Res::Cull]);
+        let mut list_res = store_resources(v.split, true, v.uniform_instances);
+        list_res.extend([Res::Ids, Res::AccRw, Res::Cull]);
         if v.host {
-            draw_res.push(Res::HostDepth);
+            list_res.push(Res::HostDepth);
         }
-        let mut resources = draw_res.clone();
+        let mut resources = list_res.clone();
         resources.push(Res::Intersections);
         let pieces = Compute::new(
             device,
             &module,
-            "outline_pieces_main",
+            "trace_pieces_main",
             resources.clone(),
             self.format,
         )?;
-        let draw = Compute::new(device, &module, "outline_main", draw_res, self.format)?;
+        let list = Compute::new(device, &module, "trace_list_main", list_res, self.format)?;
         let phases = if v.patterns {
             let mut res = vec![
                 Res::Frame,
@@ -183,11 +184,11 @@ impl OutlinePass {
             None
         };
         if let Some(e) = scope.end() {
-            return Err(Error::Device(format!("building the outline pass: {e}")));
+            return Err(Error::Device(format!("building the trace pass: {e}")));
         }
-        let p = Arc::new(OutlinePipelines {
+        let p = Arc::new(TracePipelines {
             cull,
-            draw,
+            list,
             pieces,
             phases,
             intersections: OnceLock::new(),
@@ -198,11 +199,11 @@ impl OutlinePass {
         Ok(p)
     }
 
-    /// The outline pass: `outline_cull` lists the (instance, cluster) pairs that may hold
+    /// The trace pass: `trace_cull` lists the (instance, cluster) pairs that may hold
     /// an outline edge, on a 2D grid of workgroups (huge scenes need more than one dimension
-    /// allows); `outline_main` then visits their triangles, dispatched indirectly with the
+    /// allows); `trace_list_main` then visits their triangles, dispatched indirectly with the
     /// size the cull leaves, and lists the pieces of their outline edges (and
-    /// `intersection_main` those of the intersection segments); `outline_pieces_main` draws
+    /// `intersection_main` those of the intersection segments); `trace_pieces_main` draws
     /// those, one a lane.
     pub(crate) fn encode(
         &self,
@@ -215,7 +216,7 @@ impl OutlinePass {
     ) -> Result<()> {
         let p = self.pipelines(device, variant)?;
         let cull = p.cull.bind(device, sources)?;
-        let draw = p.draw.bind(device, sources)?;
+        let listing = p.list.bind(device, sources)?;
         let data = sources.frame;
         encoder.clear_buffer(&t.acc, 0, Some(t.acc_phases));
         encoder.copy_buffer_to_buffer(reset, 0, &t.acc, t.acc_tiles, LIST_HEADER);
@@ -230,7 +231,7 @@ impl OutlinePass {
         let chains = data.chain_phases().1;
         if let (Some(phases), true) = (&p.phases, chains > 0) {
             let group = phases.bind(device, sources)?;
-            let names = ("wirepass chain phases", "outline.chains");
+            let names = ("wirepass chain phases", "trace.chains");
             dispatch(
                 encoder,
                 timer.as_deref_mut(),
@@ -239,19 +240,19 @@ impl OutlinePass {
                 grid(chains),
             );
         }
-        let names = ("wirepass outline cull", "outline.cull");
+        let names = ("wirepass trace cull", "trace.cull");
         let size = grid(data.uniforms_clusters());
         dispatch(encoder, timer.as_deref_mut(), names, (&p.cull, &cull), size);
-        let names = ("wirepass outline pass", "outline.draw");
+        let names = ("wirepass trace list", "trace.list");
         let size = Size::Indirect(list, 0);
-        dispatch(encoder, timer.as_deref_mut(), names, (&p.draw, &draw), size);
+        dispatch(encoder, timer.as_deref_mut(), names, (&p.list, &listing), size);
         // With intersection lines, their segments' pieces join the list, and the piece
         // dispatch draws both kinds.
         let segments = data.intersections();
         if segments > 0 {
             let crossing = self.intersections(device, &p)?;
             let group = crossing.list.bind(device, sources)?;
-            let names = ("wirepass intersection lines", "outline.intersections");
+            let names = ("wirepass intersection lines", "trace.intersections");
             let pipeline = (&crossing.list, &group);
             dispatch(
                 encoder,
@@ -265,7 +266,7 @@ impl OutlinePass {
         // The piece dispatch's size, where no pass binding `acc` for writing reads it.
         let size_at = piece_size_at(data);
         encoder.copy_buffer_to_buffer(&t.acc, t.acc_pieces, list, size_at, LIST_HEADER);
-        let names = ("wirepass outline pieces", "outline.pieces");
+        let names = ("wirepass trace pieces", "trace.pieces");
         let size = Size::Indirect(list, size_at);
         dispatch(encoder, timer, names, (&p.pieces, &group), size);
         Ok(())

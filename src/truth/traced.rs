@@ -1,4 +1,5 @@
-//! Outlines for the ground truth, in f64: the definition `shaders/outline.wgsl` draws.
+//! The traced lines for the ground truth, in f64: the definition `shaders/trace.wgsl`
+//! draws (outlines, and the hidden, listed, cut and intersection lines below).
 //!
 //! An outline edge is a boundary edge (no neighbour, or more than one) or a silhouette
 //! ([`edge_math::is_silhouette`]) of an object that draws its outline, among the edges its
@@ -53,7 +54,7 @@ const BISECTIONS: u32 = 30;
 
 /// Per pixel, the outline line that colours it most, if any is within reach, and the hidden
 /// line ([`Style::hidden`](crate::Style::hidden)) likewise.
-pub struct OutlineMap {
+pub struct TracedMap {
     /// Pixels, row-major.
     pub line: Vec<Option<Line>>,
     /// Pixels, row-major; all `None` without hidden lines.
@@ -109,16 +110,16 @@ enum Cap {
     Inside,
 }
 
-/// The outline map of `caster`'s world for `shot`, seen along `rays`; `masks` are each
+/// The traced map of `caster`'s world for `shot`, seen along `rays`; `masks` are each
 /// mesh's drawn edges.
-pub(crate) fn outline_map(
+pub(crate) fn traced_map(
     caster: &RayCaster<'_>,
     rays: &Rays,
     shot: &Shot<'_>,
     styles: &[ObjectStyle],
     (patches, masks): (&[Patches], &[Vec<u8>]),
     host: Option<&HostMap>,
-) -> OutlineMap {
+) -> TracedMap {
     let world = caster.world();
     let view = RayVisibility {
         caster,
@@ -151,7 +152,7 @@ pub(crate) fn outline_map(
     let line = splat(&visible, shot.size, fade, host);
     let stretches: Vec<Stretch> = hidden_stretches.into_iter().flatten().collect();
     let hidden = splat(&stretches, shot.size, fade, host);
-    OutlineMap { line, hidden }
+    TracedMap { line, hidden }
 }
 
 /// Every line of object `o` (style `style`) the map draws, each once, with all that its
@@ -400,7 +401,7 @@ impl RayVisibility<'_> {
 
 // Whether one point comes before another in (x, y, z) order (in the mesh's own
 // coordinates): the end of an edge that anchors its line pattern. `comes_first` in
-// outline.wgsl compares the store's rebased coordinates (the same order, but where rebasing
+// trace.wgsl compares the store's rebased coordinates (the same order, but where rebasing
 // rounds two coordinates together).
 use crate::mesh::chains::comes_first;
 
@@ -795,7 +796,7 @@ impl RayVisibility<'_> {
     /// [`HostMap::hides_point`] says so hidden by the host (`behind_host`: counted as hidden,
     /// else neither drawn), hidden by a triangle other than `t` and `n` (global ids `first + t`
     /// and `first_n + n`) that covers `x` nearer than that point, else visible (twin of `class_at`
-    /// in outline.wgsl).
+    /// in trace.wgsl).
     ///
     /// In a frame with section planes (`cap` not [`Cap::None`]) a point that the eye's ray
     /// reaches from inside a cut solid lies behind its section face, and is hidden too: where
@@ -845,7 +846,7 @@ impl RayVisibility<'_> {
 /// In a frame with section planes, back faces stand for the section face of a cut solid,
 /// and a line point that the eye's ray reaches from inside the solid lies behind that face
 /// (see [`RayVisibility::class`]). Where no other surface lies just in front of the point, the
-/// line's own triangles tell (twin of `capped` in outline.wgsl): the ray reaches from inside
+/// line's own triangles tell (twin of `capped` in trace.wgsl): the ray reaches from inside
 /// a line between two back faces (global triangle `t` and its neighbour `n`), a back face's
 /// boundary (`n` is `None`), and a silhouette where the surface folds inwards (concave);
 /// facing by [`RayCaster::faces_away`], from the eye `eye` (homogeneous world).
@@ -874,7 +875,7 @@ fn capped(caster: &RayCaster<'_>, (t, n): (u32, Option<u32>), eye: DVec4) -> Cap
 
 /// Where section plane `plane` meets a triangle (world corners `c`) that it crosses (corners
 /// cut away, and kept): the points where its side changes sign on the two edges it crosses
-/// (twin of `cut_segment` in outline.wgsl); `None` where it does not cross it.
+/// (twin of `cut_segment` in trace.wgsl); `None` where it does not cross it.
 fn cut_segment(c: [DVec3; 3], plane: &crate::SectionPlane) -> Option<(DVec3, DVec3)> {
     let s = c.map(|p| plane.side(p));
     let mut ends = Vec::with_capacity(2);
@@ -1012,8 +1013,8 @@ mod tests {
         assert!(!edges.contains(&(0, 2)));
     }
 
-    /// The outline pass skips a triangle seen further from edge-on than its edges fold
-    /// (`Mesh::outline_hints`, outline.wgsl); no skipped triangle may have a silhouette edge.
+    /// The trace pass skips a triangle seen further from edge-on than its edges fold
+    /// (`Mesh::outline_hints`, trace.wgsl); no skipped triangle may have a silhouette edge.
     #[test]
     fn outline_hints_never_skip_a_silhouette() {
         let meshes = [
@@ -1057,7 +1058,7 @@ mod tests {
         assert!(skipped * 2 > total, "only {skipped} of {total} skipped");
     }
 
-    /// The outline pass skips a whole cluster when `clusters::may_fold` says none of its
+    /// The trace pass skips a whole cluster when `clusters::may_fold` says none of its
     /// triangles can have an outline edge; no skipped cluster may hold one, whatever order
     /// the triangles come in (a sphere with its triangles shuffled clusters as well).
     #[test]
@@ -1080,7 +1081,7 @@ mod tests {
             crate::mesh::Procedural::Grid(8000).build().unwrap(),
         ];
         for (m, mesh) in meshes.iter().enumerate() {
-            let clusters = mesh.outline_clusters();
+            let clusters = mesh.traced_clusters();
             let mut sorted = clusters.order.clone();
             sorted.sort_unstable();
             assert!(sorted.iter().copied().eq(0..mesh.triangle_count() as u32));
@@ -1170,8 +1171,8 @@ mod tests {
         assert!(hinge(DVec3::new(5.0, 0.0, 0.5)));
     }
 
-    /// The outline map of one mesh seen by `camera` at `size`.
-    fn map_of(mesh: Mesh, camera: Camera, style: &Style, size: (u32, u32)) -> OutlineMap {
+    /// The traced map of one mesh seen by `camera` at `size`.
+    fn map_of(mesh: Mesh, camera: Camera, style: &Style, size: (u32, u32)) -> TracedMap {
         let world = World::single(mesh, EdgeSelection::All);
         let caster = RayCaster::new(&world);
         let shot = Shot {
@@ -1189,7 +1190,7 @@ mod tests {
             &masks[0],
             mesh.crossed_triangles(),
         )];
-        outline_map(&caster, &rays, &shot, &styles, (&patches, &masks), None)
+        traced_map(&caster, &rays, &shot, &styles, (&patches, &masks), None)
     }
 
     #[test]

@@ -1,5 +1,7 @@
-// The outline pass, after common.wgsl and scene.wgsl. It runs between the visibility pass
-// and the edge pass, which reads what it leaves in `acc`.
+// The trace pass, after common.wgsl and scene.wgsl. It runs between the visibility pass
+// and the edge pass, which reads what it leaves in `acc`: every line the edge pass cannot
+// find from the ids around a pixel is traced here along the geometry (outlines, edges of
+// large patches, hidden lines, listed edges, cut and intersection lines).
 //
 // A triangle only colours its own pixels, so the edge pass alone draws an outline edge (a
 // boundary, or a silhouette: see `is_silhouette`) at half width. Outline triangles are nearly
@@ -8,12 +10,12 @@
 // (`piece_px`), and then one invocation per piece finds its visible runs (points every
 // 1/4 px tested, changes bisected) and writes into every pixel within the line's reach the
 // key (`line_key`) of the nearest visible run. Only triangles of the clusters that
-// `outline_cull` lists are visited, so the pass reads few triangles beyond those near an
-// outline. Definition (src/outline.rs implements it in f64 for the ground truth): pixel p is
-// at distance d from an outline when d is the distance from p's centre to the visible part of
-// the edge's projection (in front of the near plane, not beyond the far plane, within the
-// line's reach of the image, not hidden by another surface; the targets' guard band holds
-// the ids of that reach). No depth test at p is needed: a nearer surface
+// `trace_cull` lists are visited, so the pass reads few triangles beyond those near an
+// outline. Definition (src/truth/traced.rs implements it in f64 for the ground truth):
+// pixel p is at distance d from an outline when d is the distance from p's centre to the
+// visible part of the edge's projection (in front of the near plane, not beyond the far
+// plane, within the line's reach of the image, not hidden by another surface; the targets'
+// guard band holds the ids of that reach). No depth test at p is needed: a nearer surface
 // between p and a farther edge has its own outline between them, which is nearer to p and
 // wins. Each pixel keeps the line that colours it most (the greatest key) by an atomic max,
 // so nothing is drawn twice.
@@ -44,35 +46,35 @@
 // PATTERNS (a line is dashed or dotted: phase tables, and dashes in `splat_runs`).
 
 @group(0) @binding(9) var<storage, read> clusters: array<Cluster>;
-// The outline buffer (`outline_tile_marks` in scene.wgsl): the lines, and the output tiles
+// The trace buffer (`traced_tile_marks` in scene.wgsl): the lines, and the output tiles
 // they reach, which the edge pass visits for their background.
 @group(0) @binding(11) var<storage, read_write> acc_rw: array<atomic<u32>>;
 
-// The (instance, cluster) pairs that `outline_cull` finds may hold an outline edge, and the
+// The (instance, cluster) pairs that `trace_cull` finds may hold an outline edge, and the
 // indirect dispatch size for visiting them; starts as (0, 1, 1, 0).
-struct OutlineList {
+struct TraceList {
     x: atomic<u32>,
     y: atomic<u32>,
     z: u32,
     count: atomic<u32>,
     items: array<vec2<u32>>,
 }
-@group(0) @binding(13) var<storage, read_write> cull_rw: OutlineList;
+@group(0) @binding(13) var<storage, read_write> cull_rw: TraceList;
 
-struct OutlineListRead {
+struct TraceListRead {
     x: u32,
     y: u32,
     z: u32,
     count: u32,
     items: array<vec2<u32>>,
 }
-@group(0) @binding(14) var<storage, read> cull: OutlineListRead;
+@group(0) @binding(14) var<storage, read> cull: TraceListRead;
 
 // After the lines and the tiles in `acc_rw`, the phase tables, then the overflow list, then
-// the pieces of outline edges that `outline_main` lists for `outline_pieces_main`: a header
+// the pieces of outline edges that `trace_list_main` lists for `trace_pieces_main`: a header
 // (indirect dispatch size x, y, z, then the count; the encoder copies it to where the piece
 // dispatch reads its size) and PIECE_WORDS words per piece. A lane of the piece dispatch
-// draws one piece, where a lane of `outline_main` would draw every piece of its triangle's
+// draws one piece, where a lane of `trace_list_main` would draw every piece of its triangle's
 // outline edges while the other lanes of its cluster, most of them without any, wait for it.
 //
 // Where the piece list has no room for all of a cluster's pieces (or all of a group of 64
@@ -93,7 +95,7 @@ const OVERFLOW_SEGMENTS: u32 = 0x80000000u;
 
 // Word offset of the phase tables (`chain_phases`), after the tile list.
 fn phase_tables() -> u32 {
-    return outline_tile_list() + 4u + outline_tile_count();
+    return traced_tile_list() + 4u + traced_tile_count();
 }
 
 // A listed piece's words (PIECE_WORDS, from targets.rs): instance slot, triangle, edge, and
@@ -122,7 +124,7 @@ fn instance_of_cluster(f: u32) -> u32 {
 // (`cluster_may_fold`), so that the triangles of the others, usually nearly all, are never
 // read.
 @compute @workgroup_size(64)
-fn outline_cull(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+fn trace_cull(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     // Dispatched as a 2D grid: huge scenes have more clusters than one dimension allows.
     let f = gid.x + gid.y * groups.x * CLUSTER_TRIANGLES;
     if f >= frame.clusters {
@@ -208,7 +210,7 @@ fn cut_planes(inst: u32, p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>) -> u32 {
 
 // Where section plane k meets a triangle that crosses it (local corners p): the points
 // where its side changes sign on the two edges it crosses (twin of `cut_segment` in
-// src/truth/outline.rs).
+// src/truth/traced.rs).
 fn cut_segment(inst: u32, p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>, k: u32) -> array<vec3<f32>, 2> {
     let clip = instances[slot(inst)].clip;
     let p = array<vec3<f32>, 3>(p0, p1, p2);
@@ -241,7 +243,7 @@ fn faces_away(inst: u32, p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>) -> bool {
 // `class_at`). Where no other surface lies just in front of the point, its own triangles
 // tell: the ray reaches from inside a line between two back faces (edge i of triangle t, its
 // neighbour's too), a back face's boundary, and a silhouette where the surface folds inwards
-// (concave). Returns the line's CAP_ value (twin of `capped` in src/truth/outline.rs); cut
+// (concave). Returns the line's CAP_ value (twin of `capped` in src/truth/traced.rs); cut
 // lines are on the face.
 const CAP_NONE: u32 = 0u;
 const CAP_OUTSIDE: u32 = 1u;
@@ -279,7 +281,7 @@ var<workgroup> overflowed: atomic<u32>;
 
 // One invocation per triangle of each listed cluster: lists the pieces of its outline edges.
 @compute @workgroup_size(64)
-fn outline_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+fn trace_list_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
     let k = list_group(group);
     if k < cull.count {
         let item = cull.items[k];
@@ -321,7 +323,7 @@ struct Listed {
 }
 
 // Lists pieces range.x..range.y of an edge (`item` names the edge, its mode and its piece
-// count) for outline_pieces_main to draw, with one reservation in
+// count) for trace_pieces_main to draw, with one reservation in
 // the list for all of them; returns how many it listed, fewer where the list is full (the
 // caller draws the rest itself, `draw_unlisted`).
 fn list_pieces(item: Listed, range: vec2<u32>) -> u32 {
@@ -511,7 +513,7 @@ fn draw_lane(w: LaneWork) {
 
 // One invocation per listed piece (and 64 per overflow entry): draws it.
 @compute @workgroup_size(64)
-fn outline_pieces_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+fn trace_pieces_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
     draw_lane(lane_work(group, lane));
 }
 
@@ -582,7 +584,7 @@ fn pieces_in_reach(c: Clipped, reach: f32) -> vec2<u32> {
     return vec2<u32>(first, max(end, first + 1u));
 }
 
-// The lines of a triangle the outline pass draws: up to 3 edges and a cut line a section
+// The lines of a triangle the trace pass draws: up to 3 edges and a cut line a section
 // plane, each i | mode << 2 (edge i, DRAW_* bits).
 struct Found {
     count: u32,
@@ -601,7 +603,7 @@ fn list_triangle(inst: u32, t: u32) -> bool {
     return all;
 }
 
-// Finds the lines of triangle t of instance `inst` that the outline pass draws.
+// Finds the lines of triangle t of instance `inst` that the trace pass draws.
 fn outline_lines(inst: u32, t: u32) -> Found {
     var found: Found;
     let base = instances[slot(inst)].triangle_base;
@@ -1022,7 +1024,7 @@ fn line_reach_of(inst: u32, mode: u32) -> f32 {
 
 // Lists the pieces of line `word` (i | mode << 2: edge i, or a cut line) of triangle t of
 // `inst` (local corners p) that lie within reach of the targets (of a tile) for
-// outline_pieces_main, to draw as `mode` says (DRAW_VISIBLE, DRAW_HIDDEN): false where the
+// trace_pieces_main, to draw as `mode` says (DRAW_VISIBLE, DRAW_HIDDEN): false where the
 // list had no room for them all.
 fn list_outline(inst: u32, t: u32, p: array<vec3<f32>, 3>, word: u32) -> bool {
     let i = word & 3u;
@@ -1183,7 +1185,7 @@ fn splat_runs(seg: Segment, k0: f32, k1: f32, runs: ptr<function, array<vec2<f32
     let last_m = min(i32(ceil(max(q0[major], q1[major]) + reach - origin[major])), last[major]);
     let first_o = max(i32(floor(min(q0[minor], q1[minor]) - band - origin[minor])), 0);
     let last_o = min(i32(ceil(max(q0[minor], q1[minor]) + band - origin[minor])), last[minor]);
-    mark_outline_tiles(first_m, last_m, first_o, last_o, major);
+    mark_traced_tiles(first_m, last_m, first_o, last_o, major);
     for (var m = first_m; m <= last_m; m++) {
         var f = 0.0;
         if span[major] != 0.0 {
@@ -1264,7 +1266,7 @@ fn splat_runs(seg: Segment, k0: f32, k1: f32, runs: ptr<function, array<vec2<f32
 // Lists the output tiles that pixels [first_m, last_m] along axis `major` and
 // [first_o, last_o] across it (target pixels) fall in, each once a frame (its mark is
 // cleared with the lines).
-fn mark_outline_tiles(first_m: i32, last_m: i32, first_o: i32, last_o: i32, major: u32) {
+fn mark_traced_tiles(first_m: i32, last_m: i32, first_o: i32, last_o: i32, major: u32) {
     var lo = vec2<i32>(first_m, first_o);
     var hi = vec2<i32>(last_m, last_o);
     if major == 1u {
@@ -1276,8 +1278,8 @@ fn mark_outline_tiles(first_m: i32, last_m: i32, first_o: i32, last_o: i32, majo
     let tiles = vec2<i32>(i32(columns), i32((u32(frame.output_size.y) + 7u) / 8u)) - 1;
     let t0 = clamp((lo - offset) / 8, vec2<i32>(0), tiles);
     let t1 = clamp((hi - offset) / 8, vec2<i32>(0), tiles);
-    let marks = outline_tile_marks();
-    let list = outline_tile_list();
+    let marks = traced_tile_marks();
+    let list = traced_tile_list();
     for (var y = t0.y; y <= t1.y; y++) {
         for (var x = t0.x; x <= t1.x; x++) {
             if atomicExchange(&acc_rw[marks + u32(y) * columns + u32(x)], 1u) == 0u {
