@@ -95,6 +95,16 @@ pub fn is_silhouette(a: DVec3, b: DVec3, c: DVec3, d: DVec3, eye: DVec4) -> bool
     edge_on || !(side_c * side_d < 0.0)
 }
 
+/// Whether the triangle with corners `c` is seen from `eye` (homogeneous) within
+/// [`EDGE_ON`] of edge-on, taken at its centroid; one without area, or with NaN, counts as
+/// edge-on. Such a triangle draws as a line: it hides nothing, and no pixel's ray meets it.
+#[allow(clippy::neg_cmp_op_on_partial_ord)] // NaN counts as edge-on
+pub fn is_edge_on(c: [DVec3; 3], eye: DVec4) -> bool {
+    let n = (c[1] - c[0]).cross(c[2] - c[0]);
+    let towards = towards_eye((c[0] + c[1] + c[2]) / 3.0, eye);
+    !(n.dot(towards).abs() > EDGE_ON * n.length() * towards.length())
+}
+
 /// Twin of `EDGE_ON` in common.wgsl: the sine of the angle between the direction to the eye
 /// and a triangle's plane within which [`is_silhouette`] takes the triangle as edge-on. The
 /// eye in a face's plane (a box seen along a face, an axis-aligned orthographic view) puts

@@ -452,6 +452,23 @@ impl SectionPlane {
         (p - self.point).dot(self.normal) / self.normal.length()
     }
 
+    /// Where the plane crosses the triangle with corners `c`: the points where its
+    /// [`side`](Self::side) changes sign along the two sides it crosses (twin of
+    /// `cut_segment` in trace.wgsl); `None` where all corners lie on one side.
+    pub fn cut_triangle(&self, c: [DVec3; 3]) -> Option<(DVec3, DVec3)> {
+        let s = c.map(|p| self.side(p));
+        let mut ends = [DVec3::ZERO; 2];
+        let mut found = 0;
+        for j in 0..3 {
+            let (a, b) = (s[j], s[(j + 1) % 3]);
+            if (a < 0.0) != (b < 0.0) {
+                ends[found.min(1)] = c[j].lerp(c[(j + 1) % 3], a / (a - b));
+                found += 1;
+            }
+        }
+        (found == 2).then_some((ends[0], ends[1]))
+    }
+
     /// The plane as the coefficients `(n, −n · point)` of a unit normal n.
     pub fn coefficients(&self) -> glam::DVec4 {
         let n = self.normal / self.normal.length();

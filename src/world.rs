@@ -261,6 +261,21 @@ pub struct Shot<'a> {
     pub size: (u32, u32),
 }
 
+impl Shot<'_> {
+    /// Checks the view, the style, the world and every object's transform and style (not
+    /// the size: each consumer has its own limits).
+    pub fn validate(&self) -> Result<()> {
+        self.view.validate()?;
+        self.style.validate()?;
+        self.world.validate()?;
+        for (i, o) in self.world.objects.iter().enumerate() {
+            crate::scene::check_transform(&o.transform, i)?;
+            o.style.validate(i)?;
+        }
+        Ok(())
+    }
+}
+
 /// What one method drew of a shot, on the CPU. Maps are row-major, row 0 at the top.
 #[derive(Clone, Debug)]
 pub struct Rendering {
@@ -293,3 +308,17 @@ pub struct Rendering {
 }
 
 pub use crate::style::LineClass;
+
+/// Narrows `range` to the parameters s where f0 + s (f1 − f0) ≥ 0 (empty where either is
+/// NaN): a segment clipped to a plane's kept side, given its two ends' values.
+pub(crate) fn keep_positive(range: &mut (f64, f64), f0: f64, f1: f64) {
+    if f0 < 0.0 && f1 < 0.0 {
+        *range = (1.0, 0.0);
+    } else if f0 < 0.0 {
+        range.0 = range.0.max(f0 / (f0 - f1));
+    } else if f1 < 0.0 {
+        range.1 = range.1.min(f0 / (f0 - f1));
+    } else if f0.is_nan() || f1.is_nan() {
+        *range = (1.0, 0.0);
+    }
+}

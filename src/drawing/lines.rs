@@ -10,7 +10,7 @@
 
 use super::occlusion::{Frame, JOIN};
 use super::{Path, PathClass};
-use crate::edge_math::{local_eye, towards_eye, EDGE_ON};
+use crate::edge_math::{is_edge_on, local_eye};
 use crate::mesh::adjacency::NO_NEIGHBOUR;
 use crate::mesh::chains::{chains, Chains};
 use crate::mesh::par::*;
@@ -156,12 +156,8 @@ fn list(frame: &Frame<'_>, style: &Style, looks: &[Look]) -> Vec<Chain> {
         let first = frame.first(o);
         let positions = frame.positions(o);
         // Seen edge-on (within the silhouettes' EDGE_ON): such a triangle draws as a line.
-        let edge_on = |t: u32| {
-            let c = tris[t as usize].map(|v| positions[v as usize]);
-            let n = (c[1] - c[0]).cross(c[2] - c[0]);
-            let towards = towards_eye((c[0] + c[1] + c[2]) / 3.0, frame.eye);
-            n.dot(towards).abs() <= EDGE_ON * n.length() * towards.length()
-        };
+        let edge_on =
+            |t: u32| is_edge_on(tris[t as usize].map(|v| positions[v as usize]), frame.eye);
         // The outline edges, but those between two triangles seen edge-on: such an edge lies
         // on the projection of the edge-on part, which the part's own outline covers (a
         // box's side in a front view is drawn by its edges with the front and back, not
@@ -246,7 +242,7 @@ fn list(frame: &Frame<'_>, style: &Style, looks: &[Look]) -> Vec<Chain> {
                 .into_par_iter()
                 .filter_map(|t| {
                     let corners = tris[t as usize].map(|v| positions[v as usize]);
-                    let ends = cut_segment(corners, plane)?;
+                    let ends = plane.cut_triangle(corners)?;
                     Some(Chain {
                         object: o as u32,
                         segments: vec![Segment {
@@ -356,25 +352,6 @@ fn inside_cut_solid(frame: &Frame<'_>, [t, n]: [u32; 2]) -> bool {
         (false, false) => false,
         _ => concave,
     }
-}
-
-/// Where section plane `plane` crosses a triangle (world corners `c`): the points where its
-/// side changes sign on the two sides it crosses.
-fn cut_segment(c: [DVec3; 3], plane: &crate::SectionPlane) -> Option<(DVec3, DVec3)> {
-    let s = c.map(|p| plane.side(p));
-    let mut ends = [DVec3::ZERO; 2];
-    let mut found = 0;
-    for j in 0..3 {
-        let (a, b) = (s[j], s[(j + 1) % 3]);
-        if (a < 0.0) != (b < 0.0) {
-            if found == 2 {
-                return None;
-            }
-            ends[found] = c[j].lerp(c[(j + 1) % 3], a / (a - b));
-            found += 1;
-        }
-    }
-    (found == 2).then_some((ends[0], ends[1]))
 }
 
 /// A chain's paths: each run of one class (visible in the segment's class, or hidden),

@@ -146,14 +146,8 @@ impl Drawing {
                 "drawing size {width}x{height}: each side must be 1 to {MAX_SIZE} pixels"
             )));
         }
-        shot.view.validate()?;
-        shot.style.validate()?;
+        shot.validate()?;
         let world = shot.world;
-        world.validate()?;
-        for (i, o) in world.objects.iter().enumerate() {
-            crate::scene::check_transform(&o.transform, i)?;
-            o.style.validate(i)?;
-        }
         let start = Instant::now();
         let rows = shot.view.clip_rows(glam::DMat4::IDENTITY);
         let frame = occlusion::Frame::new(world, rows, shot.view.eye(), shot.size);

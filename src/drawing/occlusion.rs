@@ -16,16 +16,16 @@
 //! So each triangle hides one interval of s or two, found in closed form in f64, and a
 //! line's hidden parts are their union. Which triangles to ask comes from a grid over the
 //! image of the cut triangles' screen boxes. A triangle seen edge-on (within the
-//! silhouettes' [`EDGE_ON`]) hides nothing: no pixel's ray meets it.
+//! silhouettes' [`EDGE_ON`](crate::edge_math::EDGE_ON)) hides nothing: no pixel's ray meets it.
 
 // `!(a > b)` is deliberate: NaN must take the rejecting branch.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 use crate::camera::ClipRows;
-use crate::edge_math::{is_silhouette, towards_eye, EDGE_ON, HIDDEN_MARGIN};
+use crate::edge_math::{is_edge_on, is_silhouette, towards_eye, HIDDEN_MARGIN};
 use crate::mesh::adjacency::NO_NEIGHBOUR;
 use crate::mesh::par::*;
-use crate::world::World;
+use crate::world::{keep_positive, World};
 use glam::{DVec2, DVec3, DVec4};
 
 /// The most corners a triangle has once cut by the near and far planes and every section
@@ -242,9 +242,7 @@ impl<'a> Frame<'a> {
                 // Seen edge-on (within the silhouettes' EDGE_ON), a surface hides nothing:
                 // no pixel's ray meets it, and a line lying in its plane is not behind it.
                 let c = self.corners(id);
-                let n = (c[1] - c[0]).cross(c[2] - c[0]);
-                let towards = towards_eye((c[0] + c[1] + c[2]) / 3.0, self.eye);
-                if !(n.dot(towards).abs() > EDGE_ON * n.length() * towards.length()) {
+                if is_edge_on(c, self.eye) {
                     return None;
                 }
                 let polygon = clip(c, &self.keep)?;
@@ -509,19 +507,6 @@ impl<'a> Frame<'a> {
         let (p1, p2) = (product(nn, h), product(m, d));
         let q = [0, 1, 2].map(|i| sign * (p1[i] + p2[i]));
         negative_parts(q, s, out);
-    }
-}
-
-/// Narrows `range` to the parameters s where f0 + s (f1 − f0) ≥ 0.
-pub(crate) fn keep_positive(range: &mut (f64, f64), f0: f64, f1: f64) {
-    if f0 < 0.0 && f1 < 0.0 {
-        *range = (1.0, 0.0);
-    } else if f0 < 0.0 {
-        range.0 = range.0.max(f0 / (f0 - f1));
-    } else if f1 < 0.0 {
-        range.1 = range.1.min(f0 / (f0 - f1));
-    } else if f0.is_nan() || f1.is_nan() {
-        *range = (1.0, 0.0);
     }
 }
 

@@ -84,14 +84,8 @@ pub fn draw_raycast_over(shot: &Shot<'_>, host: Option<&HostOccluders<'_>>) -> R
             "image size {width}x{height} has a zero side"
         )));
     }
-    shot.view.validate()?;
-    shot.style.validate()?;
+    shot.validate()?;
     let world = shot.world;
-    world.validate()?;
-    for (i, o) in world.objects.iter().enumerate() {
-        crate::scene::check_transform(&o.transform, i)?;
-        o.style.validate(i)?;
-    }
     let caster = RayCaster::new(world);
     let rays = Rays::new(&shot.view, shot.size, world)?;
     let masks: Vec<Vec<u8>> = world

@@ -42,7 +42,7 @@ use crate::mesh::patches::Patches;
 use crate::style::{depth_fade, line_intensity, line_key, line_reach};
 use crate::truth::rays::{HostMap, Line, ObjectStyle, RayCaster, Rays};
 pub use crate::world::outline_edges;
-use crate::world::Shot;
+use crate::world::{keep_positive, Shot};
 use glam::{DVec2, DVec3, DVec4};
 use rayon::prelude::*;
 use std::collections::HashMap;
@@ -232,7 +232,7 @@ fn listed_lines(
         edges.extend((0..tris.len() as u32).flat_map(|t| {
             let corners = caster.corners(first + t);
             (0..sections.len())
-                .filter(move |&k| cut_segment(corners, &sections[k]).is_some())
+                .filter(move |&k| sections[k].cut_triangle(corners).is_some())
                 .map(move |k| {
                     let draw = Draw {
                         visible: true,
@@ -336,7 +336,7 @@ impl RayVisibility<'_> {
                 }
                 if let Some(k) = draw.cut {
                     let corners = caster.corners(first + t);
-                    let ends = cut_segment(corners, &world.sections[k]).unwrap_or_default();
+                    let ends = world.sections[k].cut_triangle(corners).unwrap_or_default();
                     let lines = (([0.0; 2], (0.0, true)), (0.0, true));
                     let edge = (t, NO_NEIGHBOUR, ends);
                     return view.stretches(
@@ -873,24 +873,6 @@ fn capped(caster: &RayCaster<'_>, (t, n): (u32, Option<u32>), eye: DVec4) -> Cap
     }
 }
 
-/// Where section plane `plane` meets a triangle (world corners `c`) that it crosses (corners
-/// cut away, and kept): the points where its side changes sign on the two edges it crosses
-/// (twin of `cut_segment` in trace.wgsl); `None` where it does not cross it.
-fn cut_segment(c: [DVec3; 3], plane: &crate::SectionPlane) -> Option<(DVec3, DVec3)> {
-    let s = c.map(|p| plane.side(p));
-    let mut ends = Vec::with_capacity(2);
-    for j in 0..3 {
-        let (a, b) = (s[j], s[(j + 1) % 3]);
-        if (a < 0.0) != (b < 0.0) {
-            ends.push(c[j].lerp(c[(j + 1) % 3], a / (a - b)));
-        }
-    }
-    match ends[..] {
-        [a, b] => Some((a, b)),
-        _ => None,
-    }
-}
-
 /// The dashes of the pattern (dash, period; period 0 for solid) within the run `(k0, k1)` of
 /// an edge's parameter, where the whole (clipped) edge is `full` pixels long on screen and
 /// the pattern stands at `start` at parameter 0 (`a_first`) or 1 and runs towards the other
@@ -953,17 +935,6 @@ impl Projected {
             near_w: mix(self.near_w, other.near_w),
             depth_w: mix(self.depth_w, other.depth_w),
         }
-    }
-}
-
-/// Narrows `range` to the parameters s where f0 + s (f1 − f0) ≥ 0.
-fn keep_positive(range: &mut (f64, f64), f0: f64, f1: f64) {
-    if f0 < 0.0 && f1 < 0.0 {
-        *range = (1.0, 0.0);
-    } else if f0 < 0.0 {
-        range.0 = range.0.max(f0 / (f0 - f1));
-    } else if f1 < 0.0 {
-        range.1 = range.1.min(f0 / (f0 - f1));
     }
 }
 
