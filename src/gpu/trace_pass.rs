@@ -245,7 +245,13 @@ impl TracePass {
         dispatch(encoder, timer.as_deref_mut(), names, (&p.cull, &cull), size);
         let names = ("wirepass trace list", "trace.list");
         let size = Size::Indirect(list, 0);
-        dispatch(encoder, timer.as_deref_mut(), names, (&p.list, &listing), size);
+        dispatch(
+            encoder,
+            timer.as_deref_mut(),
+            names,
+            (&p.list, &listing),
+            size,
+        );
         // With intersection lines, their segments' pieces join the list, and the piece
         // dispatch draws both kinds.
         let segments = data.intersections();
