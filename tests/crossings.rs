@@ -433,7 +433,7 @@ fn intersection_lines_follow_moving_instances() {
     use wirepass::gpu::Canvas;
     use wirepass::gpu::{DeferredPass, PassOptions};
     use wirepass::tools::offline::draw_deferred_on;
-    use wirepass::world::offscreen::Uploaded;
+    use wirepass::tools::offline::Uploaded;
     use wirepass::world::Shot;
     let ctx = common::gpu();
     let crossed = boxes_as_instances(DVec3::new(0.9, 0.45, 0.35), EdgeSelection::Polygon);
@@ -519,7 +519,7 @@ fn crossed_instances_draw_the_same_frame_every_time() {
     use wirepass::gpu::Canvas;
     use wirepass::gpu::{DeferredPass, PassOptions};
     use wirepass::tools::offline::draw_deferred_on;
-    use wirepass::world::offscreen::Uploaded;
+    use wirepass::tools::offline::Uploaded;
     use wirepass::world::Shot;
     let world = crossed_instances();
     let ctx = common::gpu();

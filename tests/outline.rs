@@ -258,7 +258,7 @@ fn within_bounds(name: &str, scene: &TestScene) -> Rendering {
 fn pieces_beyond_the_lists_room_are_drawn_all_the_same() {
     use wirepass::gpu::{Canvas, DeferredPass, PassOptions};
     use wirepass::tools::offline::draw_deferred_on;
-    use wirepass::world::offscreen::Uploaded;
+    use wirepass::tools::offline::Uploaded;
     let ctx = common::gpu();
     let hidden = Style {
         hidden: Some(wirepass::HiddenLines::default()),

@@ -14,8 +14,8 @@ use wirepass::gpu::{
     read_texture, texture_2d, Canvas, DeferredPass, HostDepth, PassOptions, PickView, Picked,
     PreparedFrame,
 };
+use wirepass::tools::offline::{encode_shaded, Uploaded};
 use wirepass::truth::draw_raycast;
-use wirepass::world::offscreen::{encode_shaded, Uploaded};
 use wirepass::world::{Object, Shot, World, WorldMesh, BACKGROUND};
 use wirepass::{wgpu, Camera, EdgeSelection, Error, Scene, Style};
 

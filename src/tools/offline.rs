@@ -1,5 +1,8 @@
 //! Offscreen frames for the CLI, tools and tests: a [`Shot`] of a world drawn with any
 //! [`Method`] into a [`Rendering`] (CPU image and maps, global triangle ids), and its dumps.
+//! The one offscreen module natively: it waits on the futures of
+//! [`world::offscreen`](crate::world::offscreen), their non-blocking core, which the browser
+//! tests await on the page's event loop instead.
 
 use crate::camera::View;
 use crate::error::{Error, Result};
@@ -12,7 +15,7 @@ use crate::world::{Rendering, Shot};
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-pub use crate::world::offscreen::Uploaded;
+pub use crate::world::offscreen::{encode_shaded, Uploaded};
 
 /// A way of drawing the wireframe.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -195,7 +198,7 @@ pub fn draw_deferred_on(
     canvas: Canvas<'_>,
 ) -> Result<Rendering> {
     let (device, queue) = (&ctx.device, &ctx.queue);
-    let drawn = pollster::block_on(offscreen::draw_deferred(
+    let drawn = pollster::block_on(offscreen::draw_deferred_on_async(
         device, queue, shot, up, &mut pass, canvas,
     ));
     // A device error makes whatever was read back meaningless: it comes first.

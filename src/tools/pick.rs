@@ -5,7 +5,7 @@
 
 use crate::error::Result;
 use crate::gpu::{Canvas, DeferredPass, GpuContext, PassOptions, PickView, Picked};
-use crate::world::offscreen::{encode_shaded, Uploaded};
+use crate::tools::offline::{encode_shaded, Uploaded};
 use crate::world::Shot;
 use serde::Serialize;
 

@@ -77,8 +77,9 @@ impl Uploaded {
 
 /// Renders `shot` with the deferred pass (made `with_diagnostics`) onto `canvas` (the
 /// shot's whole image, a region of it, or over the host's depth) into a storage texture,
-/// and reads back the image and all maps.
-pub async fn draw_deferred(
+/// and reads back the image and all maps: what
+/// [`tools::offline::draw_deferred_on`](crate::tools::offline::draw_deferred_on) waits on.
+pub async fn draw_deferred_on_async(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     shot: &Shot<'_>,

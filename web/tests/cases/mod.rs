@@ -15,7 +15,7 @@ use wirepass::camera::{Camera, View};
 use wirepass::glam::{DMat4, DQuat, DVec3};
 use wirepass::gpu::{texture_2d, Canvas, Composite, HostDepth, OutputTarget, RenderTarget};
 use wirepass::truth::{draw_raycast, draw_raycast_over, HostOccluders};
-use wirepass::world::offscreen::{draw_deferred, read_deferred, Uploaded};
+use wirepass::world::offscreen::{draw_deferred_on_async, read_deferred, Uploaded};
 use wirepass::world::{default_world, Object, Rendering, Shot, World, WorldMesh};
 use wirepass::{
     wgpu, DeferredPass, DepthRange, EdgeSelection, InstanceStyle, Mesh, PassOptions, PreparedFrame,
@@ -212,7 +212,7 @@ pub async fn draw(device: &wgpu::Device, queue: &wgpu::Queue, case: &Case) -> Re
     match (&case.output, &case.host) {
         (Output::Storage, None) => {
             let mut pass = DeferredPass::new(device, PassOptions::default())?.with_diagnostics();
-            draw_deferred(device, queue, &shot, &up, &mut pass, Canvas::new(SIZE)).await
+            draw_deferred_on_async(device, queue, &shot, &up, &mut pass, Canvas::new(SIZE)).await
         }
         (Output::Storage, Some((scene, _))) => {
             let formats = HostFormats {
@@ -238,7 +238,7 @@ pub async fn draw(device: &wgpu::Device, queue: &wgpu::Queue, case: &Case) -> Re
                 matrices: case.view,
             });
             let mut pass = DeferredPass::new(device, PassOptions::default())?.with_diagnostics();
-            draw_deferred(device, queue, &shot, &up, &mut pass, canvas).await
+            draw_deferred_on_async(device, queue, &shot, &up, &mut pass, canvas).await
         }
         (Output::RenderPass(format), _) => {
             let mut pass = DeferredPass::new(device, canvas_pass(*format))?.with_diagnostics();
