@@ -100,7 +100,9 @@ pub(crate) struct StoredCrossing {
 impl MeshData {
     /// The records of `mesh` drawing the edges `edges`, and what each step of making them
     /// took (the upload's fields stay empty). The mesh's crossings are found while its
-    /// adjacency, outline hints and clusters are made, one after the other, beside them.
+    /// adjacency, outline hints and clusters are made, one after the other, beside them;
+    /// where the surface is star-shaped, the adjacency then shows in a moment whether it is
+    /// closed, which proves that it crosses nowhere (`crossings::star_centre`).
     pub(crate) fn new(mesh: &Mesh, edges: EdgeSelection) -> (MeshData, UploadReport) {
         let timed = |f: &dyn Fn()| {
             let start = Instant::now();
@@ -123,10 +125,17 @@ impl MeshData {
             },
             || {
                 timed(&|| {
-                    mesh.intersections();
+                    // Not beside the adjacency where it would ask for it (computing it twice).
+                    if mesh.star_centre().is_none() {
+                        mesh.intersections();
+                    }
                 })
             },
         );
+        let crossings = crossings
+            + timed(&|| {
+                mesh.intersections();
+            });
         let start = Instant::now();
         let (lo, hi) = mesh.bounds_f64();
         let origin = (lo + hi) * 0.5;

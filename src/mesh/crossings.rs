@@ -74,6 +74,102 @@ pub fn crossings(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Crossing> {
     find(triangles.len(), &corners, &apart, TOLERANCE * size)
 }
 
+/// Whether a closed surface certainly passes nowhere through itself, by a test linear in
+/// its size: a point `o` lies strictly on one side of every triangle's plane, all of them
+/// facing it alike (all away, or all towards), and the triangles' solid angles seen from `o`
+/// add up to one sphere (4π, not 8π or more). The caller adds that the surface is closed and
+/// oriented ([`closed_and_oriented`]). Then the triangles, projected from `o` onto a sphere
+/// around it, cover each direction exactly once (the cover's degree is the solid angle over
+/// 4π, and no triangle counts negatively), whereas two triangles that meet beyond their
+/// shared edges and vertices would cover the directions near where they meet twice. Spheres,
+/// convex parts and other star-shaped surfaces pass, seen from their centre or their
+/// vertices' mean; `None` says nothing about the rest. Returns the point it was seen from.
+pub fn star_centre(positions: &[Vec3], triangles: &[[u32; 3]]) -> Option<DVec3> {
+    if triangles.len() < 4 {
+        return None;
+    }
+    let corners = |t: &[u32; 3]| t.map(|v| positions[v as usize].as_dvec3());
+    let (lo, hi) = triangles
+        .par_iter()
+        .map(|t| {
+            let [a, b, c] = corners(t);
+            (a.min(b).min(c), a.max(b).max(c))
+        })
+        .reduce(
+            || (DVec3::INFINITY, DVec3::NEG_INFINITY),
+            |x, y| (x.0.min(y.0), x.1.max(y.1)),
+        );
+    let sum = triangles
+        .par_iter()
+        .map(|t| corners(t).iter().sum::<DVec3>())
+        .reduce(|| DVec3::ZERO, |x, y| x + y);
+    let mean = sum / (3 * triangles.len()) as f64;
+    [(lo + hi) / 2.0, mean]
+        .into_iter()
+        .find(|&o| covers_once_from(o, triangles, &corners))
+}
+
+/// Whether every triangle faces `o` alike, with `o` off its plane by more than rounding,
+/// and their solid angles from `o` add up to 4π ([`star_centre`]).
+fn covers_once_from(
+    o: DVec3,
+    triangles: &[[u32; 3]],
+    corners: &(impl Fn(&[u32; 3]) -> [DVec3; 3] + Sync),
+) -> bool {
+    // (solid angle, or NaN where the triangle's plane passes too near o) per triangle; the
+    // sign says which way it faces.
+    let (angle, sides) = triangles
+        .par_iter()
+        .map(|t| {
+            let [a, b, c] = corners(t).map(|p| p - o);
+            let (la, lb, lc) = (a.length(), b.length(), c.length());
+            // The triple product, 6 × the volume of the tetrahedron (o, a, b, c), and the
+            // Van Oosterom–Strackee solid angle.
+            let volume = a.dot(b.cross(c));
+            let scale = la * lb * lc;
+            // Off the plane by far more than f64 rounds the product (about 1e-15 of it);
+            // false for NaN too.
+            let off_the_plane = volume.abs() > 1e-12 * scale;
+            if !off_the_plane {
+                return (f64::NAN, [0u64, 0]);
+            }
+            let den = scale + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
+            let side = if volume > 0.0 { [1, 0] } else { [0, 1] };
+            (2.0 * volume.atan2(den), side)
+        })
+        .reduce(
+            || (0.0, [0, 0]),
+            |x, y| (x.0 + y.0, [x.1[0] + y.1[0], x.1[1] + y.1[1]]),
+        );
+    let alike = sides[0] == 0 || sides[1] == 0;
+    let sphere = 4.0 * std::f64::consts::PI;
+    alike && (angle.abs() - sphere).abs() < 0.5 * sphere
+}
+
+/// Whether every edge of the mesh (vertices welded by position: `welded`, `neighbours` as
+/// [`Mesh::edge_neighbours`](crate::Mesh::edge_neighbours) finds them) is shared by exactly
+/// two triangles that run it in opposite directions: a closed, oriented surface.
+pub fn closed_and_oriented(
+    triangles: &[[u32; 3]],
+    welded: &[u32],
+    neighbours: &[[u32; 3]],
+) -> bool {
+    let ends = |t: usize, i: usize| {
+        let tri = triangles[t];
+        (welded[tri[i] as usize], welded[tri[(i + 1) % 3] as usize])
+    };
+    (0..triangles.len()).into_par_iter().all(|t| {
+        (0..3).all(|i| {
+            let u = neighbours[t][i];
+            if u == super::adjacency::NO_NEIGHBOUR {
+                return false;
+            }
+            let (a, b) = ends(t, i);
+            (0..3).any(|j| ends(u as usize, j) == (b, a))
+        })
+    })
+}
+
 /// Where the triangles of one surface cross those of another (world corners `a` and `b`,
 /// each a part of a surface, such as the triangles of two instances near where their bounds
 /// meet): crossing `t` is an index into `a`, `u` into `b`, sorted. Triangles sharing two
@@ -329,6 +425,103 @@ mod tests {
         let base = positions.len() as u32;
         positions.extend(cube.positions().iter().map(|&p| centre + half * p));
         triangles.extend(cube.triangles().iter().map(|t| t.map(|v| v + base)));
+    }
+
+    /// Whether the linear test proves `mesh` free of crossings.
+    fn proved_apart(mesh: &crate::Mesh) -> bool {
+        mesh.star_centre().is_some()
+            && closed_and_oriented(mesh.triangles(), mesh.welded(), mesh.edge_neighbours())
+    }
+
+    /// `mesh` with its positions moved by `f` (same triangles).
+    fn moved(mesh: &crate::Mesh, f: impl Fn(usize, Vec3) -> Vec3) -> crate::Mesh {
+        let positions = mesh
+            .positions()
+            .iter()
+            .enumerate()
+            .map(|(i, &p)| f(i, p))
+            .collect();
+        crate::Mesh::new(positions, None, mesh.triangles().to_vec(), None).unwrap()
+    }
+
+    #[test]
+    fn closed_star_shaped_surfaces_are_proved_not_to_cross_themselves() {
+        let sphere = crate::mesh::sphere(2000).unwrap();
+        // Lumpy: every vertex's radius changed, still seen whole from the centre.
+        let lumpy = moved(&sphere, |i, p| {
+            p * (1.0 + 0.3 * ((i * 7919 % 101) as f32 / 101.0))
+        });
+        // Inside out: every triangle wound the other way.
+        let flipped = crate::Mesh::new(
+            sphere.positions().to_vec(),
+            None,
+            sphere
+                .triangles()
+                .iter()
+                .map(|&[a, b, c]| [a, c, b])
+                .collect(),
+            None,
+        )
+        .unwrap();
+        let cube = crate::mesh::cube(1200).unwrap();
+        // Stretched far off the origin: seen from its own centre.
+        let far = moved(&cube, |_, p| {
+            p * Vec3::new(3.0, 0.2, 1.0) + Vec3::splat(1e3)
+        });
+        for (name, mesh) in [
+            ("sphere", &sphere),
+            ("lumpy", &lumpy),
+            ("flipped", &flipped),
+            ("cube", &cube),
+            ("far", &far),
+        ] {
+            assert!(proved_apart(mesh), "{name}");
+            // The pairwise search agrees.
+            assert!(
+                crossings(mesh.positions(), mesh.triangles()).is_empty(),
+                "{name}"
+            );
+            assert!(mesh.intersections().is_empty(), "{name}");
+        }
+    }
+
+    #[test]
+    fn the_linear_test_proves_nothing_it_cannot() {
+        let sphere = crate::mesh::sphere(2000).unwrap();
+        // Two spheres, one inside the other: apart, but each direction is covered twice.
+        let (mut positions, mut triangles) =
+            (sphere.positions().to_vec(), sphere.triangles().to_vec());
+        let base = positions.len() as u32;
+        positions.extend(sphere.positions().iter().map(|&p| 0.5 * p));
+        triangles.extend(sphere.triangles().iter().map(|t| t.map(|v| v + base)));
+        let nested = crate::Mesh::new(positions, None, triangles, None).unwrap();
+        assert!(nested.star_centre().is_none());
+        assert!(nested.intersections().is_empty());
+        // A pole pushed through the far side: the surface crosses itself, and the faces
+        // around the pole turn to face the centre.
+        let top = (0..sphere.positions().len())
+            .max_by(|&a, &b| sphere.positions()[a].y.total_cmp(&sphere.positions()[b].y))
+            .unwrap();
+        let pushed = moved(&sphere, |i, p| {
+            if i == top {
+                Vec3::new(0.0, -1.5, 0.0)
+            } else {
+                p
+            }
+        });
+        assert!(!proved_apart(&pushed));
+        assert!(!pushed.intersections().is_empty());
+        // Open (a triangle taken out): not closed, whatever it is seen from.
+        let open = crate::Mesh::new(
+            sphere.positions().to_vec(),
+            None,
+            sphere.triangles()[1..].to_vec(),
+            None,
+        )
+        .unwrap();
+        assert!(open.star_centre().is_some() && !proved_apart(&open));
+        // A torus: no point sees every face alike.
+        assert!(crate::mesh::torus(2000).unwrap().star_centre().is_none());
     }
 
     #[test]

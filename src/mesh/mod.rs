@@ -152,6 +152,9 @@ pub struct Mesh {
     /// The crossing pairs, and per triangle whether it crosses another: see
     /// [`Mesh::crossed_triangles`].
     crossings: std::sync::OnceLock<(Vec<crossings::Crossing>, Vec<bool>)>,
+    /// A point the surface is star-shaped from, if one was found: see
+    /// [`crossings::star_centre`].
+    star: std::sync::OnceLock<Option<glam::DVec3>>,
 }
 
 /// The value in `cell`, computed by `compute` if no thread has stored one yet.
@@ -255,6 +258,7 @@ impl Mesh {
             outline_hints: Default::default(),
             traced_clusters: Default::default(),
             crossings: Default::default(),
+            star: Default::default(),
         })
     }
 
@@ -445,9 +449,31 @@ impl Mesh {
         &self.crossing_pairs().0
     }
 
+    // What the pass computes from the mesh: for the ground truth and the tests.
+    #[cfg_attr(not(feature = "truth"), doc(hidden))]
+    /// A point every triangle faces alike and from which they cover each direction once,
+    /// if one was found (`crossings::star_centre`): with a closed, oriented surface, the
+    /// proof that the mesh does not cross itself. Computed once, on first use.
+    pub fn star_centre(&self) -> Option<glam::DVec3> {
+        *computed_once(&self.star, || {
+            crossings::star_centre(&self.positions, &self.triangles)
+        })
+    }
+
     fn crossing_pairs(&self) -> &(Vec<crossings::Crossing>, Vec<bool>) {
         computed_once(&self.crossings, || {
-            let pairs = crossings::crossings(&self.positions, &self.triangles);
+            // A closed star-shaped surface cannot cross itself: a test linear in its size.
+            let star = self.star_centre().is_some()
+                && crossings::closed_and_oriented(
+                    &self.triangles,
+                    self.welded(),
+                    self.edge_neighbours(),
+                );
+            let pairs = if star {
+                Vec::new()
+            } else {
+                crossings::crossings(&self.positions, &self.triangles)
+            };
             let flags = crossings::flag_crossing(self.triangles.len(), &pairs);
             (pairs, flags)
         })

@@ -285,6 +285,7 @@ pub fn builtin_mesh() -> Mesh {
         outline_hints: Default::default(),
         traced_clusters: Default::default(),
         crossings: Default::default(),
+        star: Default::default(),
     }
 }
 
