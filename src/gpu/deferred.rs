@@ -163,7 +163,7 @@ pub struct DeferredPass {
     format: wgpu::TextureFormat,
     visibility: Visibility,
     host: HostImport,
-    outline: TracePass,
+    trace: TracePass,
     edge: EdgePass,
     composite: Option<(CompositePipeline, Composite)>,
     /// Counts the encodes that write a result for [`render`](Self::render).
@@ -236,7 +236,7 @@ impl DeferredPass {
             format,
             visibility,
             host: HostImport::new(),
-            outline: TracePass::new(format, software),
+            trace: TracePass::new(format, software),
             edge: EdgePass::new(device, format, software)?,
             composite,
             results: AtomicU64::new(0),
@@ -427,7 +427,7 @@ impl DeferredPass {
             let variant = self.variant(frame);
             if variant.traced {
                 let intersections = frame.data.intersections() > 0;
-                self.outline.warm_up(device, variant, intersections)?;
+                self.trace.warm_up(device, variant, intersections)?;
             }
             self.edge.pipelines(device, mode, variant)?;
         }
@@ -443,7 +443,7 @@ impl DeferredPass {
         self.visibility.built()
             + self.host.built()
             + usize::from(self.composite.is_some())
-            + self.outline.built()
+            + self.trace.built()
             + self.edge.built()
     }
 
@@ -589,7 +589,7 @@ impl DeferredPass {
         if variant.traced {
             let buffers = (t, &frame.cull, &self.reset);
             let timer = timer.as_deref_mut();
-            self.outline
+            self.trace
                 .encode(device, encoder, buffers, &sources, variant, timer)?;
         }
         let edge = self.edge.pipelines(device, mode, variant)?;
