@@ -791,3 +791,57 @@ fn gpu_tuning_draws_what_the_software_tuning_draws() {
         "pieces {pieces:?}"
     );
 }
+
+#[test]
+fn a_pipeline_cache_changes_nothing_drawn() {
+    let ctx = gpu();
+    if !ctx
+        .device
+        .features()
+        .contains(wgpu::Features::PIPELINE_CACHE)
+    {
+        println!(
+            "{}: no pipeline cache (wgpu has one on Vulkan)",
+            ctx.describe()
+        );
+        return;
+    }
+    // SAFETY: made from no data: an empty cache.
+    let cache = unsafe {
+        ctx.device
+            .create_pipeline_cache(&wgpu::PipelineCacheDescriptor {
+                label: None,
+                data: None,
+                fallback: true,
+            })
+    };
+    let fandisk = load("fandisk.obj");
+    let size = (200, 150);
+    let style = Style {
+        hidden: Some(HiddenLines {
+            pattern: LinePattern::Dashed {
+                dash: 6.0,
+                gap: 4.0,
+            },
+            ..HiddenLines::default()
+        }),
+        ..Style::default()
+    };
+    let edges = EdgeSelection::Feature(30.0);
+    let scene = common::TestScene::new(&fandisk, framing(&fandisk, size), style, size, edges);
+    let shot = scene.shot();
+    let up = Uploaded::new(&ctx.device, &ctx.queue, shot.world).unwrap();
+    let frames = [None, Some(cache.clone())].map(|pipeline_cache| {
+        let options = PassOptions {
+            pipeline_cache,
+            ..PassOptions::default()
+        };
+        let pass = DeferredPass::new(&ctx.device, options)
+            .unwrap()
+            .with_diagnostics();
+        draw_deferred_on(ctx, &shot, &up, pass, Canvas::new(shot.size)).unwrap()
+    });
+    assert!(frames[0].rgba == frames[1].rgba && frames[0].ids == frames[1].ids);
+    // What a host saves for the next run.
+    assert!(cache.get_data().is_some_and(|d| !d.is_empty()));
+}

@@ -12,6 +12,7 @@ use wirepass::tools::load::{load_world, parse_size, parse_vec3, CameraPlacement,
 use wirepass::tools::offline::{
     draw, draw_deferred_image, draw_deferred_timed, FirstImage, Method,
 };
+use wirepass::tools::pipeline_cache::CacheUse;
 use wirepass::tools::regression::save_rgba_png;
 use wirepass::world::{Shot, World};
 use wirepass::{Color, EdgeSelection, HiddenLines, Highlight, LinePattern, Result, Style, View};
@@ -418,6 +419,18 @@ fn print_timings(
         first.warm_up.elapsed,
     );
     line("first frame (shader compilation)", first.frame);
+    match &first.pipeline_cache {
+        CacheUse::Used {
+            path,
+            loaded,
+            saved,
+        } => eprintln!(
+            "{:<44}{loaded} bytes read, {saved} written ({})",
+            "pipeline cache",
+            path.display()
+        ),
+        CacheUse::Unused(why) => eprintln!("{:<44}none: {why}", "pipeline cache"),
+    }
     line("read back", first.readback);
     line("total, with the PNG", total);
     if let Some(peak) = peak_memory() {

@@ -78,6 +78,46 @@ fn a_render_without_a_display_says_only_what_it_wrote() {
     assert!(said.starts_with("wrote "), "{said}");
 }
 
+/// `render` keeps wgpu's pipeline cache in the user's cache folder where the device has
+/// one (Vulkan), makes the next run's from it, and says so in `--timings`; elsewhere it says
+/// why there is none and writes nothing.
+#[test]
+fn render_keeps_the_pipeline_cache_between_runs() {
+    let folder = temp("xdg-cache");
+    let image = temp("cached.png");
+    let run = || {
+        let out = Command::new(env!("CARGO_BIN_EXE_wirepass"))
+            .args(["render", "--size", "32x24", "--timings", "-o"])
+            .arg(&image)
+            .env("XDG_CACHE_HOME", &folder)
+            .env_remove("WIREPASS_PIPELINE_CACHE")
+            .output()
+            .expect("the wirepass binary runs");
+        let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+        assert!(out.status.success(), "{stderr}");
+        let line = stderr.lines().find(|l| l.starts_with("pipeline cache"));
+        line.unwrap_or_else(|| panic!("no pipeline cache line in:\n{stderr}"))
+            .to_owned()
+    };
+    let (first, second) = (run(), run());
+    let kept = folder.join("wirepass");
+    if first.contains("none: ") {
+        assert!(second.contains("none: ") && !kept.exists(), "{second}");
+        return;
+    }
+    assert!(first.contains("0 bytes read"), "{first}");
+    let files: Vec<_> = std::fs::read_dir(&kept)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    assert_eq!(files.len(), 1, "{files:?}");
+    let size = std::fs::metadata(&files[0]).unwrap().len();
+    assert!(
+        size > 0 && second.contains(&format!("{size} bytes read")),
+        "{second}"
+    );
+}
+
 /// `render` without `--dump` draws the image alone, without the maps: the same image as a
 /// render that dumps them. `--timings` says where the time went, a line a step.
 #[test]

@@ -221,6 +221,7 @@ impl Compute {
         entry: &str,
         resources: Vec<Res>,
         color: wgpu::TextureFormat,
+        cache: Option<&wgpu::PipelineCache>,
     ) -> Result<Compute> {
         let label = format!("wirepass {entry}");
         let layout = layout(
@@ -241,7 +242,7 @@ impl Compute {
             module,
             entry_point: Some(entry),
             compilation_options: Default::default(),
-            cache: None,
+            cache,
         });
         Ok(Compute {
             pipeline,

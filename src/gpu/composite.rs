@@ -131,7 +131,11 @@ pub(crate) struct HostSamples<'a> {
 
 impl CompositePipeline {
     /// Checks `target` against the device and builds its pipelines.
-    pub fn new(device: &wgpu::Device, target: &RenderTarget) -> Result<Self> {
+    pub fn new(
+        device: &wgpu::Device,
+        target: &RenderTarget,
+        compiled: Option<&wgpu::PipelineCache>,
+    ) -> Result<Self> {
         let features = target.format.guaranteed_format_features(device.features());
         if !features
             .allowed_usages
@@ -166,14 +170,24 @@ impl CompositePipeline {
             }
         }
         let scope = crate::gpu::validation::Validation::begin(device);
-        let plain = Draw::new(device, target, None);
+        let plain = Draw::new(device, target, None, compiled);
         let tested = target
             .depth_stencil
             .filter(|f| f.has_depth_aspect())
             .map(|_| {
                 [
-                    Draw::new(device, target, Some(wgpu::CompareFunction::LessEqual)),
-                    Draw::new(device, target, Some(wgpu::CompareFunction::GreaterEqual)),
+                    Draw::new(
+                        device,
+                        target,
+                        Some(wgpu::CompareFunction::LessEqual),
+                        compiled,
+                    ),
+                    Draw::new(
+                        device,
+                        target,
+                        Some(wgpu::CompareFunction::GreaterEqual),
+                        compiled,
+                    ),
                 ]
             });
         if let Some(e) = scope.end() {
@@ -258,6 +272,7 @@ impl Draw {
         device: &wgpu::Device,
         target: &RenderTarget,
         compare: Option<wgpu::CompareFunction>,
+        compiled: Option<&wgpu::PipelineCache>,
     ) -> Draw {
         let stage = wgpu::ShaderStages::FRAGMENT;
         // The vertex stage reads the result's size.
@@ -328,7 +343,7 @@ impl Draw {
                 })],
             }),
             multiview_mask: None,
-            cache: None,
+            cache: compiled,
         });
         Draw { pipeline, layout }
     }

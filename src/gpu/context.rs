@@ -19,7 +19,8 @@ pub struct GpuContext {
 pub(crate) const OPTIONAL_FEATURES: wgpu::Features = wgpu::Features::PRIMITIVE_INDEX
     .union(wgpu::Features::TIMESTAMP_QUERY)
     .union(wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS)
-    .union(wgpu::Features::POLYGON_MODE_LINE);
+    .union(wgpu::Features::POLYGON_MODE_LINE)
+    .union(wgpu::Features::PIPELINE_CACHE);
 
 impl GpuContext {
     /// Opens a device. `WGPU_BACKEND` (e.g. `vulkan`, `gl`) restricts the backends and

@@ -218,9 +218,13 @@ impl DeferredPass {
         }
         let software = options.tuning.software(device);
         let scope = crate::gpu::validation::Validation::begin(device);
-        let visibility = Visibility::new(device, pulled)?;
+        let compiled = options.pipeline_cache;
+        let visibility = Visibility::new(device, pulled, compiled.clone())?;
         let composite = match &options.render_target {
-            Some(t) => Some((CompositePipeline::new(device, t)?, t.content)),
+            Some(t) => Some((
+                CompositePipeline::new(device, t, compiled.as_ref())?,
+                t.content,
+            )),
             None => None,
         };
         let reset = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -235,9 +239,9 @@ impl DeferredPass {
             id: NEXT.fetch_add(1, Ordering::Relaxed),
             format,
             visibility,
-            host: HostImport::new(),
-            trace: TracePass::new(format, software),
-            edge: EdgePass::new(device, format, software)?,
+            host: HostImport::new(compiled.clone()),
+            trace: TracePass::new(format, software, compiled.clone()),
+            edge: EdgePass::new(device, format, software, compiled)?,
             composite,
             results: AtomicU64::new(0),
             reset,

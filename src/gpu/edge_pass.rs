@@ -34,6 +34,8 @@ pub(crate) struct EdgePass {
     /// Whether a clear lays the background down where it can ([`Tuning`](super::Tuning)).
     clear: bool,
     cache: Mutex<HashMap<(Mode, Variant), Arc<EdgePipelines>>>,
+    /// The host's cache of compiled pipelines ([`PassOptions::pipeline_cache`](super::PassOptions)).
+    compiled: Option<wgpu::PipelineCache>,
     /// The benchmark floor's pipeline ([`OutputTarget::Floor`](super::OutputTarget::Floor)).
     #[cfg(feature = "diagnostics")]
     floor: Compute,
@@ -57,6 +59,7 @@ impl EdgePass {
         device: &wgpu::Device,
         format: wgpu::TextureFormat,
         clear: bool,
+        compiled: Option<wgpu::PipelineCache>,
     ) -> Result<Self> {
         Ok(Self {
             format,
@@ -69,7 +72,9 @@ impl EdgePass {
                 "floor_main",
                 vec![Res::Frame, Res::Ids, Res::OutColor],
                 format,
+                compiled.as_ref(),
             )?,
+            compiled,
         })
     }
 
@@ -123,6 +128,7 @@ impl EdgePass {
             Mode::Diagnostic => (vec![Res::OutDiagnostic, Res::OutIds], self.format),
         };
         let scope = crate::gpu::validation::Validation::begin(device);
+        let compiled = self.compiled.as_ref();
         let module = edge_module(device, self.format, &flags);
         let mut common = store_resources(v.split, false, v.uniform_instances);
         common.push(Res::Ids);
@@ -138,7 +144,14 @@ impl EdgePass {
             r.extend_from_slice(&out);
             r
         };
-        let background = Compute::new(device, &module, "background_main", with(&[]), color)?;
+        let background = Compute::new(
+            device,
+            &module,
+            "background_main",
+            with(&[]),
+            color,
+            compiled,
+        )?;
         let mut classify_res = vec![Res::Frame, Res::Ids, Res::TilesRw, Res::WorkRw];
         if let Mode::Result { .. } = mode {
             // It lists the tiles the composite draws, the trace pass's among them.
@@ -147,7 +160,14 @@ impl EdgePass {
                 classify_res.push(Res::Acc);
             }
         }
-        let classify = Compute::new(device, &module, "classify_main", classify_res, color)?;
+        let classify = Compute::new(
+            device,
+            &module,
+            "classify_main",
+            classify_res,
+            color,
+            compiled,
+        )?;
         let traced = if v.traced {
             Some(Compute::new(
                 device,
@@ -155,11 +175,19 @@ impl EdgePass {
                 "traced_main",
                 with(&[]),
                 color,
+                compiled,
             )?)
         } else {
             None
         };
-        let border = Compute::new(device, &module, "border_main", with(&[Res::WorkRw]), color)?;
+        let border = Compute::new(
+            device,
+            &module,
+            "border_main",
+            with(&[Res::WorkRw]),
+            color,
+            compiled,
+        )?;
         let mut tile_res = vec![Res::Tiles, Res::WorkRw];
         let mut neighbours = vec![Res::Neighbours];
         if v.split {
@@ -169,10 +197,17 @@ impl EdgePass {
             // A quad's search crosses its diagonal.
             tile_res.extend_from_slice(&neighbours);
         }
-        let tiles = Compute::new(device, &module, "tile_main", with(&tile_res), color)?;
+        let tiles = Compute::new(
+            device,
+            &module,
+            "tile_main",
+            with(&tile_res),
+            color,
+            compiled,
+        )?;
         let mut refine_res = with(&[Res::Work]);
         refine_res.extend_from_slice(&neighbours);
-        let refine = Compute::new(device, &module, "refine_main", refine_res, color)?;
+        let refine = Compute::new(device, &module, "refine_main", refine_res, color, compiled)?;
         if let Some(e) = scope.end() {
             return Err(Error::Device(format!("building the edge pass: {e}")));
         }

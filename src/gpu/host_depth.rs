@@ -42,6 +42,8 @@ struct HostParams {
 pub(crate) struct HostImport {
     resolve: [Option<(wgpu::ComputePipeline, wgpu::BindGroupLayout)>; 2],
     seed: Option<(wgpu::RenderPipeline, wgpu::BindGroupLayout)>,
+    /// The host's cache of compiled pipelines ([`PassOptions::pipeline_cache`](super::PassOptions)).
+    compiled: Option<wgpu::PipelineCache>,
 }
 
 impl HostImport {
@@ -77,10 +79,11 @@ impl HostFrame {
 }
 
 impl HostImport {
-    pub fn new() -> Self {
+    pub fn new(compiled: Option<wgpu::PipelineCache>) -> Self {
         HostImport {
             resolve: [None, None],
             seed: None,
+            compiled,
         }
     }
 
@@ -134,10 +137,10 @@ impl HostImport {
         }
         let slot = usize::from(multisampled);
         if self.resolve[slot].is_none() {
-            self.resolve[slot] = Some(build_resolve(device, multisampled)?);
+            self.resolve[slot] = Some(build_resolve(device, multisampled, self.compiled.as_ref())?);
         }
         if self.seed.is_none() {
-            self.seed = Some(build_seed(device)?);
+            self.seed = Some(build_seed(device, self.compiled.as_ref())?);
         }
         let same = host.matrices.view == scene_view.view
             && host.matrices.projection == scene_view.projection;
@@ -311,6 +314,7 @@ pub fn depth_quantum(format: wgpu::TextureFormat, depth: DepthRange) -> f64 {
 fn build_resolve(
     device: &wgpu::Device,
     multisampled: bool,
+    compiled: Option<&wgpu::PipelineCache>,
 ) -> Result<(wgpu::ComputePipeline, wgpu::BindGroupLayout)> {
     let scope = crate::gpu::validation::Validation::begin(device);
     let cs = wgpu::ShaderStages::COMPUTE;
@@ -349,7 +353,7 @@ fn build_resolve(
         module: &module,
         entry_point: Some("resolve_main"),
         compilation_options: Default::default(),
-        cache: None,
+        cache: compiled,
     });
     if let Some(e) = scope.end() {
         return Err(Error::Device(format!("building the host depth pass: {e}")));
@@ -357,7 +361,10 @@ fn build_resolve(
     Ok((pipeline, layout))
 }
 
-fn build_seed(device: &wgpu::Device) -> Result<(wgpu::RenderPipeline, wgpu::BindGroupLayout)> {
+fn build_seed(
+    device: &wgpu::Device,
+    compiled: Option<&wgpu::PipelineCache>,
+) -> Result<(wgpu::RenderPipeline, wgpu::BindGroupLayout)> {
     let scope = crate::gpu::validation::Validation::begin(device);
     let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("wirepass host seed"),
@@ -397,7 +404,7 @@ fn build_seed(device: &wgpu::Device) -> Result<(wgpu::RenderPipeline, wgpu::Bind
             targets: &[Some(ID_FORMAT.into())],
         }),
         multiview_mask: None,
-        cache: None,
+        cache: compiled,
     });
     if let Some(e) = scope.end() {
         return Err(Error::Device(format!("building the host seed pass: {e}")));

@@ -3,7 +3,7 @@
 use super::composite::RenderTarget;
 
 /// Construction options.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct PassOptions {
     /// Format of the storage texture that [`OutputTarget::Shaded`] and
     /// [`OutputTarget::Overlay`] write: `Rgba8Unorm` (written sRGB-encoded), `Rgba16Float`
@@ -19,6 +19,12 @@ pub struct PassOptions {
     pub triangle_ids: TriangleIds,
     /// Which kind of device the passes split their work for.
     pub tuning: Tuning,
+    /// wgpu's cache of what the driver compiled, given to every pipeline the pass builds:
+    /// saved by the host ([`wgpu::PipelineCache::get_data`]) and made from that data on the
+    /// next run, it spares the driver's compilation where the driver keeps none of its own
+    /// (Vulkan only: `Features::PIPELINE_CACHE`; lavapipe's holds no code, as it compiles
+    /// on first use and keeps Mesa's own disk cache).
+    pub pipeline_cache: Option<wgpu::PipelineCache>,
 }
 
 impl Default for PassOptions {
@@ -28,6 +34,7 @@ impl Default for PassOptions {
             render_target: None,
             triangle_ids: TriangleIds::Auto,
             tuning: Tuning::Auto,
+            pipeline_cache: None,
         }
     }
 }

@@ -56,6 +56,8 @@ pub(crate) struct TracePass {
     /// rasterizer's loop cap allows ([`Tuning`](super::Tuning)).
     short_pieces: bool,
     cache: Mutex<HashMap<Variant, Arc<TracePipelines>>>,
+    /// The host's cache of compiled pipelines ([`PassOptions::pipeline_cache`](super::PassOptions)).
+    compiled: Option<wgpu::PipelineCache>,
 }
 
 impl TracePass {
@@ -84,8 +86,17 @@ impl TracePass {
             return Ok(c);
         }
         let scope = crate::gpu::validation::Validation::begin(device);
-        let build =
-            |entry| Compute::new(device, &p.module, entry, p.resources.clone(), self.format);
+        let build = |entry| {
+            let resources = p.resources.clone();
+            Compute::new(
+                device,
+                &p.module,
+                entry,
+                resources,
+                self.format,
+                self.compiled.as_ref(),
+            )
+        };
         let c = Intersections {
             list: build("intersection_main")?,
         };
@@ -111,11 +122,16 @@ impl TracePass {
 
     /// The pass, drawing outline edges in pieces for a software rasterizer (`software`) or
     /// for a GPU.
-    pub(crate) fn new(format: wgpu::TextureFormat, software: bool) -> Self {
+    pub(crate) fn new(
+        format: wgpu::TextureFormat,
+        software: bool,
+        compiled: Option<wgpu::PipelineCache>,
+    ) -> Self {
         Self {
             format,
             short_pieces: !software,
             cache: Mutex::default(),
+            compiled,
         }
     }
 
@@ -144,6 +160,7 @@ impl TracePass {
                 Res::CullRw,
             ],
             self.format,
+            self.compiled.as_ref(),
         )?;
         // Both the listing and the piece dispatch read the cluster list (the pieces for the
         // overflow list's clusters), and the pieces and the intersection lines' listing the
@@ -161,8 +178,17 @@ impl TracePass {
             "trace_pieces_main",
             resources.clone(),
             self.format,
+            self.compiled.as_ref(),
         )?;
-        let list = Compute::new(device, &module, "trace_list_main", list_res, self.format)?;
+        let compiled = self.compiled.as_ref();
+        let list = Compute::new(
+            device,
+            &module,
+            "trace_list_main",
+            list_res,
+            self.format,
+            compiled,
+        )?;
         let phases = if v.patterns {
             let mut res = vec![
                 Res::Frame,
@@ -179,6 +205,7 @@ impl TracePass {
                 "chain_phases",
                 res,
                 self.format,
+                compiled,
             )?)
         } else {
             None

@@ -14,6 +14,8 @@ use crate::error::Result;
 pub(crate) struct Visibility {
     pulled: bool,
     pipelines: [Option<Raster>; 4],
+    /// The host's cache of compiled pipelines ([`PassOptions::pipeline_cache`](super::PassOptions)).
+    compiled: Option<wgpu::PipelineCache>,
 }
 
 fn index(split: bool, sections: bool) -> usize {
@@ -72,10 +74,15 @@ fn instance_layout() -> wgpu::VertexBufferLayout<'static> {
 }
 
 impl Visibility {
-    pub fn new(device: &wgpu::Device, pulled: bool) -> Result<Visibility> {
+    pub fn new(
+        device: &wgpu::Device,
+        pulled: bool,
+        compiled: Option<wgpu::PipelineCache>,
+    ) -> Result<Visibility> {
         let mut v = Visibility {
             pulled,
             pipelines: [None, None, None, None],
+            compiled,
         };
         v.pipelines[0] = Some(v.build(device, false, false)?);
         Ok(v)
@@ -141,7 +148,7 @@ impl Visibility {
                 targets: &[Some(ID_FORMAT.into())],
             }),
             multiview_mask: None,
-            cache: None,
+            cache: self.compiled.as_ref(),
         });
         Ok(Raster {
             pipeline,

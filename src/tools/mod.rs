@@ -18,6 +18,8 @@ pub mod load;
 pub mod offline;
 #[cfg(feature = "tools")]
 pub mod pick;
+#[cfg(feature = "tools")]
+pub mod pipeline_cache;
 #[cfg(feature = "regression")]
 pub mod regression;
 #[cfg(feature = "tools")]

@@ -10,6 +10,7 @@ use crate::gpu::{
     texture_2d, Canvas, DeferredPass, EncodeOptions, ForwardPass, GpuContext, PassOptions, TwoPass,
     UploadReport, WarmUp,
 };
+use crate::tools::pipeline_cache::CacheUse;
 use crate::world::offscreen;
 use crate::world::{Rendering, Shot};
 use std::path::Path;
@@ -108,6 +109,9 @@ pub struct FirstImage {
     pub frame: Duration,
     /// Reading the image and maps back.
     pub readback: Duration,
+    /// What the pass's pipelines were built with: wgpu's pipeline cache from an earlier
+    /// run ([`pipeline_cache`](crate::tools::pipeline_cache)), or why none.
+    pub pipeline_cache: CacheUse,
 }
 
 /// [`draw_deferred`], timing each step ([`FirstImage`]).
@@ -148,7 +152,12 @@ fn first_image(ctx: &GpuContext, shot: &Shot<'_>, maps: bool) -> Result<(Drawn, 
         .map(|&id| up.store.upload_report(id))
         .collect::<Result<Vec<_>>>()?;
     let start = Instant::now();
-    let mut pass = DeferredPass::new(device, PassOptions::default())?;
+    let stored = crate::tools::pipeline_cache::open(ctx);
+    let options = PassOptions {
+        pipeline_cache: stored.as_ref().ok().map(|s| s.cache.clone()),
+        ..PassOptions::default()
+    };
+    let mut pass = DeferredPass::new(device, options)?;
     if maps {
         pass = pass.with_diagnostics();
     }
@@ -173,6 +182,11 @@ fn first_image(ctx: &GpuContext, shot: &Shot<'_>, maps: bool) -> Result<(Drawn, 
         Drawn::Image(pollster::block_on(rgba)?)
     };
     ctx.finish()?;
+    let readback = start.elapsed();
+    let pipeline_cache = match stored {
+        Ok(file) => file.used(file.save()?),
+        Err(why) => CacheUse::Unused(why),
+    };
     let timings = FirstImage {
         uploads,
         upload,
@@ -180,7 +194,8 @@ fn first_image(ctx: &GpuContext, shot: &Shot<'_>, maps: bool) -> Result<(Drawn, 
         prepare,
         warm_up,
         frame: frame_time,
-        readback: start.elapsed(),
+        readback,
+        pipeline_cache,
     };
     Ok((drawn, timings))
 }
