@@ -347,7 +347,7 @@ impl FrameRecords {
             ))
         })?;
         needs.traced |= !intersections.is_empty();
-        // The edge pass must know whose line, and of which class, each outline-pass pixel
+        // The edge pass must know whose line, and of which class, each trace-pass pixel
         // holds where colours differ between instances or between an outline and its edges.
         // Likewise for hidden lines whose colours differ between instances.
         let mixed_colors = !scene.sections.is_empty()

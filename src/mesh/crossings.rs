@@ -10,7 +10,7 @@
 //! Two that each lie on one side of the other's plane (touching only within the tolerance),
 //! and coplanar ones, never cross. The test is in f64 with a tolerance of
 //! 1e-9 of the mesh's size, so it errs towards "crossing" only for contacts far below a pixel,
-//! which costs the exact (outline-pass) path, never a wrong line.
+//! which costs the exact (trace-pass) path, never a wrong line.
 //!
 //! Where two triangles cross, they meet along a segment: together, the segments are the
 //! mesh's intersection lines ([`Style::intersection_lines`](crate::Style::intersection_lines)),
