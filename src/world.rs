@@ -322,3 +322,24 @@ pub(crate) fn keep_positive(range: &mut (f64, f64), f0: f64, f1: f64) {
         *range = (1.0, 0.0);
     }
 }
+
+/// Whether the eye sees a line on a cut solid's surface from inside the solid, where no
+/// other surface tells (twin of `capped` in trace.wgsl, for the ground truth and the
+/// drawings): a line between two back faces, a back face's boundary (`beyond` is `None`),
+/// a silhouette where the surface folds inwards. `own`: the line's triangle (its corners,
+/// its outward normal, whether it faces away from the eye); `beyond`: the neighbour across
+/// the line (its corners, whether it faces away).
+pub(crate) fn seen_from_inside(
+    (corners, outward, away): ([DVec3; 3], DVec3, bool),
+    beyond: Option<([DVec3; 3], bool)>,
+) -> bool {
+    let Some((other, other_away)) = beyond else {
+        return away;
+    };
+    match (away, other_away) {
+        (true, true) => true,
+        (false, false) => false,
+        // A silhouette: inside where the neighbour lies on the outward side (concave).
+        _ => outward.dot((other[0] + other[1] + other[2]) / 3.0 - corners[0]) > 0.0,
+    }
+}

@@ -341,17 +341,9 @@ fn listed_edges(mesh: &crate::Mesh, drawn: impl Fn(u32, u8) -> bool) -> Vec<(u32
 /// face's boundary, a silhouette where the surface folds inwards (the pass's and the ground
 /// truth's rule).
 fn inside_cut_solid(frame: &Frame<'_>, [t, n]: [u32; 2]) -> bool {
-    if n == u32::MAX {
-        return frame.faces_away(t);
-    }
-    let beyond = frame.corners(n);
-    let centroid = (beyond[0] + beyond[1] + beyond[2]) / 3.0;
-    let concave = frame.outward(t).dot(centroid - frame.corners(t)[0]) > 0.0;
-    match (frame.faces_away(t), frame.faces_away(n)) {
-        (true, true) => true,
-        (false, false) => false,
-        _ => concave,
-    }
+    let own = (frame.corners(t), frame.outward(t), frame.faces_away(t));
+    let beyond = (n != u32::MAX).then(|| (frame.corners(n), frame.faces_away(n)));
+    crate::world::seen_from_inside(own, beyond)
 }
 
 /// A chain's paths: each run of one class (visible in the segment's class, or hidden),

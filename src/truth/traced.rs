@@ -851,22 +851,10 @@ impl RayVisibility<'_> {
 /// boundary (`n` is `None`), and a silhouette where the surface folds inwards (concave);
 /// facing by [`RayCaster::faces_away`], from the eye `eye` (homogeneous world).
 fn capped(caster: &RayCaster<'_>, (t, n): (u32, Option<u32>), eye: DVec4) -> Cap {
-    let own = caster.corners(t);
     let away = |id: u32| caster.faces_away(id, caster.corners(id)[0], eye);
-    let inside = match n {
-        None => away(t),
-        Some(n) => {
-            let beyond = caster.corners(n);
-            let centroid = (beyond[0] + beyond[1] + beyond[2]) / 3.0;
-            let concave = caster.outward(t).dot(centroid - own[0]) > 0.0;
-            match (away(t), away(n)) {
-                (true, true) => true,
-                (false, false) => false,
-                _ => concave,
-            }
-        }
-    };
-    if inside {
+    let own = (caster.corners(t), caster.outward(t), away(t));
+    let beyond = n.map(|n| (caster.corners(n), away(n)));
+    if crate::world::seen_from_inside(own, beyond) {
         Cap::Inside
     } else {
         Cap::Outside
