@@ -167,12 +167,14 @@ fn listed_lines(
     (patches, masks): (&[Patches], &[Vec<u8>]),
 ) -> Vec<((u32, u32), Draw)> {
     let world = caster.world();
-    let object = &world.objects[o];
-    let hidden = style.hidden;
-    let hidden_edges = hidden.is_some_and(|h| h.edges);
-    let mesh = &world.meshes[object.mesh].mesh;
-    let first = caster.first_ids()[o];
-    let listed = style.listed_edges();
+    let ObjectLines {
+        object,
+        mesh,
+        first,
+        hidden,
+        hidden_edges,
+        listed,
+    } = ObjectLines::new(caster, o, style);
     let tris = mesh.triangles();
     let neighbours = mesh.edge_neighbours();
     let eye = shot.view.eye();
@@ -277,6 +279,34 @@ fn listed_lines(
     merged
 }
 
+/// What [`listed_lines`] and [`RayVisibility::object_stretches`] read of object `o`: the
+/// object, its mesh, its first global triangle id, and what its style asks of the lines.
+struct ObjectLines<'a> {
+    object: &'a crate::world::Object,
+    mesh: &'a crate::Mesh,
+    first: u32,
+    hidden: Option<crate::HiddenLines>,
+    /// Its drawn edges' hidden parts are drawn.
+    hidden_edges: bool,
+    /// Its drawn edges are all listed ([`ObjectStyle::listed_edges`]).
+    listed: bool,
+}
+
+impl<'a> ObjectLines<'a> {
+    fn new(caster: &'a RayCaster<'a>, o: usize, style: &ObjectStyle) -> ObjectLines<'a> {
+        let world = caster.world();
+        let object = &world.objects[o];
+        ObjectLines {
+            object,
+            mesh: &world.meshes[object.mesh].mesh,
+            first: caster.first_ids()[o],
+            hidden: style.hidden,
+            hidden_edges: style.hidden.is_some_and(|h| h.edges),
+            listed: style.listed_edges(),
+        }
+    }
+}
+
 impl RayVisibility<'_> {
     /// The visible and hidden stretches of each of object `o`'s `lines` ([`listed_lines`]),
     /// its patterns anchored along its chains of drawn edges (`masks`: each mesh's).
@@ -290,12 +320,14 @@ impl RayVisibility<'_> {
     ) -> Vec<(Vec<Stretch>, Vec<Stretch>)> {
         let (view, caster) = (self, self.caster);
         let world = caster.world();
-        let object = &world.objects[o];
-        let hidden = style.hidden;
-        let hidden_edges = hidden.is_some_and(|h| h.edges);
-        let mesh = &world.meshes[object.mesh].mesh;
-        let first = caster.first_ids()[o];
-        let listed = style.listed_edges();
+        let ObjectLines {
+            object,
+            mesh,
+            first,
+            hidden,
+            hidden_edges,
+            listed,
+        } = ObjectLines::new(caster, o, style);
         let tris = mesh.triangles();
         let neighbours = mesh.edge_neighbours();
         let eye = self.eye;
