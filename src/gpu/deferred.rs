@@ -429,11 +429,27 @@ impl DeferredPass {
         // The floor's pipeline is built with the pass.
         if let Some(mode) = self.mode(target)? {
             let variant = self.variant(frame);
-            if variant.traced {
-                let intersections = frame.data.intersections() > 0;
-                self.trace.warm_up(device, variant, intersections)?;
+            let intersections = frame.data.intersections() > 0;
+            let trace = || match variant.traced {
+                true => self.trace.warm_up(device, variant, intersections),
+                false => Ok(()),
+            };
+            let edge = || self.edge.pipelines(device, mode, variant).map(|_| ());
+            // The two passes' pipelines on two threads where there are threads (wgpu's
+            // error scopes, which each build opens, are per thread).
+            #[cfg(not(target_arch = "wasm32"))]
+            std::thread::scope(|s| {
+                let traced = s.spawn(trace);
+                edge()?;
+                traced
+                    .join()
+                    .map_err(|_| Error::Device("building the trace pass panicked".into()))?
+            })?;
+            #[cfg(target_arch = "wasm32")]
+            {
+                trace()?;
+                edge()?;
             }
-            self.edge.pipelines(device, mode, variant)?;
         }
         Ok(WarmUp {
             pipelines: self.pipelines_built() - before,
