@@ -89,25 +89,30 @@ pub fn star_centre(positions: &[Vec3], triangles: &[[u32; 3]]) -> Option<DVec3> 
         return None;
     }
     let corners = |t: &[u32; 3]| t.map(|v| positions[v as usize].as_dvec3());
-    let (lo, hi) = triangles
-        .par_iter()
-        .map(|t| {
-            let [a, b, c] = corners(t);
-            (a.min(b).min(c), a.max(b).max(c))
-        })
-        .reduce(
-            || (DVec3::INFINITY, DVec3::NEG_INFINITY),
-            |x, y| (x.0.min(y.0), x.1.max(y.1)),
-        );
-    let sum = triangles
-        .par_iter()
-        .map(|t| corners(t).iter().sum::<DVec3>())
-        .reduce(|| DVec3::ZERO, |x, y| x + y);
+    // The corners' bounds and sum, chunk by chunk.
+    let start = (DVec3::INFINITY, DVec3::NEG_INFINITY, DVec3::ZERO);
+    let add = |(lo, hi, sum): (DVec3, DVec3, DVec3), t: &[u32; 3]| {
+        let [a, b, c] = corners(t);
+        (
+            lo.min(a.min(b).min(c)),
+            hi.max(a.max(b).max(c)),
+            sum + a + b + c,
+        )
+    };
+    let (lo, hi, sum) = triangles
+        .par_chunks(CHUNK)
+        .map(|chunk| chunk.iter().fold(start, add))
+        .collect::<Vec<_>>()
+        .into_iter()
+        .fold(start, |x, y| (x.0.min(y.0), x.1.max(y.1), x.2 + y.2));
     let mean = sum / (3 * triangles.len()) as f64;
     [(lo + hi) / 2.0, mean]
         .into_iter()
         .find(|&o| covers_once_from(o, triangles, &corners))
 }
+
+/// Triangles a task of the linear test adds up.
+const CHUNK: usize = 1 << 14;
 
 /// Whether every triangle faces `o` alike, with `o` off its plane by more than rounding,
 /// and their solid angles from `o` add up to 4π ([`star_centre`]).
@@ -116,31 +121,33 @@ fn covers_once_from(
     triangles: &[[u32; 3]],
     corners: &(impl Fn(&[u32; 3]) -> [DVec3; 3] + Sync),
 ) -> bool {
-    // (solid angle, or NaN where the triangle's plane passes too near o) per triangle; the
-    // sign says which way it faces.
+    // The solid angle (NaN where the triangle's plane passes too near o) and which way it
+    // faces, per triangle, added up chunk by chunk.
+    let seen = |t: &[u32; 3]| {
+        let [a, b, c] = corners(t).map(|p| p - o);
+        let (la, lb, lc) = (a.length(), b.length(), c.length());
+        // The triple product, 6 × the volume of the tetrahedron (o, a, b, c), and the
+        // Van Oosterom–Strackee solid angle.
+        let volume = a.dot(b.cross(c));
+        let scale = la * lb * lc;
+        // Off the plane by far more than f64 rounds the product (about 1e-15 of it);
+        // false for NaN too.
+        let off_the_plane = volume.abs() > 1e-12 * scale;
+        if !off_the_plane {
+            return (f64::NAN, [0u64, 0]);
+        }
+        let den = scale + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
+        let side = if volume > 0.0 { [1, 0] } else { [0, 1] };
+        (2.0 * volume.atan2(den), side)
+    };
+    let add =
+        |x: (f64, [u64; 2]), y: (f64, [u64; 2])| (x.0 + y.0, [x.1[0] + y.1[0], x.1[1] + y.1[1]]);
     let (angle, sides) = triangles
-        .par_iter()
-        .map(|t| {
-            let [a, b, c] = corners(t).map(|p| p - o);
-            let (la, lb, lc) = (a.length(), b.length(), c.length());
-            // The triple product, 6 × the volume of the tetrahedron (o, a, b, c), and the
-            // Van Oosterom–Strackee solid angle.
-            let volume = a.dot(b.cross(c));
-            let scale = la * lb * lc;
-            // Off the plane by far more than f64 rounds the product (about 1e-15 of it);
-            // false for NaN too.
-            let off_the_plane = volume.abs() > 1e-12 * scale;
-            if !off_the_plane {
-                return (f64::NAN, [0u64, 0]);
-            }
-            let den = scale + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
-            let side = if volume > 0.0 { [1, 0] } else { [0, 1] };
-            (2.0 * volume.atan2(den), side)
-        })
-        .reduce(
-            || (0.0, [0, 0]),
-            |x, y| (x.0 + y.0, [x.1[0] + y.1[0], x.1[1] + y.1[1]]),
-        );
+        .par_chunks(CHUNK)
+        .map(|chunk| chunk.iter().map(seen).fold((0.0, [0, 0]), add))
+        .collect::<Vec<_>>()
+        .into_iter()
+        .fold((0.0, [0, 0]), add);
     let alike = sides[0] == 0 || sides[1] == 0;
     let sphere = 4.0 * std::f64::consts::PI;
     alike && (angle.abs() - sphere).abs() < 0.5 * sphere
