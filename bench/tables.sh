@@ -61,7 +61,8 @@ run's ratios against it and flags those that worsened by more than 15 %.
   stages there), by its timestamps on a GPU.
 - \`bench/scenes/side-by-side.json\`: Spot, and Suzanne beside it, their bounds meeting but
   not their surfaces; \`through-each-other.json\`: Suzanne passing through Spot, whose
-  lines the trace pass draws where visible, in one-pixel pieces tested over 9×9 windows.
+  lines near the crossings the trace pass draws where visible, in one-pixel pieces tested
+  over 9×9 windows.
 - Ratios: \`deferred ÷ gs\` and \`÷ forward\`, the whole frame; \`edge ÷ floor\`, the edge
   pass's dispatches against the floor's one compute pass; \`edge ÷ edge at sphere:20000\`,
   the edge pass against its time on the sphere of fewest triangles (flat is 1).

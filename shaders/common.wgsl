@@ -115,6 +115,14 @@ struct Instance {
     // (`dash_nearest`): the drawn edges', the outline's.
     edge_pattern: vec2<f32>,
     outline_pattern: vec2<f32>,
+    // With INSTANCE_CROSSED, the image pixels (min x, min y, max x, max y) round the
+    // crossings, where its lines are drawn the crossing way (`near_crossing`).
+    cross_box: vec4<f32>,
+}
+
+// Whether image point x lies in the box `b` (min x, min y, max x, max y).
+fn in_box(b: vec4<f32>, x: vec2<f32>) -> bool {
+    return all(x >= b.xy) && all(x <= b.zw);
 }
 
 // A colour packed as two pairs of f16 (src/gpu/frame.rs, pack_color).

@@ -422,11 +422,13 @@ struct Own {
     info: u32,
 }
 
-fn own_lines(s: Sample) -> Own {
+fn own_lines(s: Sample, point: vec2<f32>) -> Own {
     let flags = instances[slot(s.inst)].flags;
     let bits = info[instances[slot(s.inst)].triangle_base + s.tri];
-    // Patterned edges and those of crossed patches are drawn by the trace pass.
-    let edges = (flags & (INSTANCE_EDGES | INSTANCE_LISTED_EDGES)) == INSTANCE_EDGES && (bits & INFO_CROSSED) == 0u;
+    // Patterned edges, those of crossed patches and those near where another instance
+    // crosses this one are drawn by the trace pass.
+    let crossed = (flags & INSTANCE_CROSSED) != 0u && in_box(instances[slot(s.inst)].cross_box, point);
+    let edges = (flags & (INSTANCE_EDGES | INSTANCE_LISTED_EDGES)) == INSTANCE_EDGES && (bits & INFO_CROSSED) == 0u && !crossed;
     let mask = select(0u, bits & 7u, edges);
     let near = vec3<f32>(s.clip0.z, s.clip1.z, s.clip2.z);
     let d = drawn_distances(s.lines, near, mask);
@@ -782,7 +784,7 @@ fn tile_main(@builtin(local_invocation_id) local: vec3<u32>, @builtin(workgroup_
         let certain = foreground && s.covers && s.margin >= COVERAGE_MARGIN;
         var own = Own(NO_EDGE, false, false, 0u);
         if certain {
-            own = own_lines(s);
+            own = own_lines(s, pixel_centre(xy));
 #if PATCHES
             // Near a quad's diagonal the other triangle's edges count too; larger polygons
             // (rarer, and the search's queue would slow every quad) are searched by
@@ -810,7 +812,7 @@ fn tile_main(@builtin(local_invocation_id) local: vec3<u32>, @builtin(workgroup_
 // BACKGROUND_ID or HOST_ID for none).
 fn finish(xy: vec2<u32>, s: Sample) -> Pixel {
     if s.inst < HOST_ID {
-        var own = own_lines(s);
+        var own = own_lines(s, pixel_centre(xy));
 #if PATCHES
         // A loop, not an `if`: a software rasterizer skips a loop no lane enters, but runs
         // the body of an `if` for every lane.

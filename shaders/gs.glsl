@@ -62,6 +62,7 @@ struct Instance {
     uint pad2;
     vec2 edge_pattern;
     vec2 outline_pattern;
+    vec4 cross_box;
 };
 
 // The records of one instanced draw's instances, gl_InstanceID first.

@@ -136,8 +136,11 @@ fn trace_cull(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
     let cluster = clusters[instances[slot(inst)].cluster_base + c];
     let outlines = (flags & INSTANCE_OUTLINES) != 0u && cluster_may_fold(cluster, instances[slot(inst)].eye);
     let splats = (flags & INSTANCE_EDGES) != 0u && cluster_splats(cluster);
-    // Every drawn edge in view has a hidden part to find (HIDDEN), or a pattern to draw.
-    var listed = (flags & INSTANCE_LISTED_EDGES) != 0u;
+    // Every drawn edge in view has a hidden part to find (HIDDEN), or a pattern to draw;
+    // another instance passes through this one near it (`crossing_reach_box`).
+    let crossed = INSTANCE_CROSSED | INSTANCE_EDGES;
+    var listed = (flags & INSTANCE_LISTED_EDGES) != 0u
+        || ((flags & crossed) == crossed && cluster_meets(instances[slot(inst)].clip, cluster, crossing_reach_box(inst)));
 #if HIDDEN
     let hidden_edges = INSTANCE_EDGES | INSTANCE_HIDDEN | INSTANCE_HIDDEN_EDGES;
     listed = listed || (flags & hidden_edges) == hidden_edges;
@@ -163,15 +166,14 @@ fn trace_cull(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
 // Whether a cluster's bounding sphere reaches the view volume (local -> clip rows x, y,
 // near, w: `clip`), widened by the targets' guard band.
 fn cluster_in_view(clip: mat4x4<f32>, c: Cluster) -> bool {
-    let m = 1.0 + 2.0 * frame.output_offset / frame.image_size;
-    var planes = array<vec4<f32>, 5>(
-        vec4<f32>(1.0, 0.0, 0.0, m.x),
-        vec4<f32>(-1.0, 0.0, 0.0, m.x),
-        vec4<f32>(0.0, 1.0, 0.0, m.y),
-        vec4<f32>(0.0, -1.0, 0.0, m.y),
-        vec4<f32>(0.0, 0.0, 1.0, 0.0),
-    );
-    var inside = true;
+    return cluster_meets(clip, c, vec4<f32>(-frame.output_offset, frame.image_size + frame.output_offset));
+}
+
+// Whether a cluster's bounding sphere reaches what projects into the box `b` of image
+// pixels (min x, min y, max x, max y), in front of the near plane.
+fn cluster_meets(clip: mat4x4<f32>, c: Cluster, b: vec4<f32>) -> bool {
+    let planes = box_planes(b.xy, b.zw);
+    var inside = b.x <= b.z && b.y <= b.w;
     for (var k = 0u; k < 5u; k++) {
         // The plane's function of a local point, dot(plane, clip * (p, 1)).
         let r = planes[k] * clip;
@@ -385,7 +387,7 @@ fn triangle_corners(inst: u32, t: u32) -> array<vec3<f32>, 3> {
 fn listed_edge(item: Listed) -> Clipped {
     let e = edge_ends(item.inst, item.t, triangle_corners(item.inst, item.t), item.i, item.mode);
     let anchor = pattern_anchor(item.inst, item.t, item.i, e.a, e.b, item.mode);
-    var c = clip_outline(On(item.inst, item.t, item.inst, e.n, false), e.a, e.b, anchor, cut_plane(item.mode));
+    var c = clip_outline(On(item.inst, item.t, item.inst, e.n, false, false), e.a, e.b, anchor, cut_plane(item.mode));
     c.seg.cap = capped(item.inst, item.t, item.i, item.mode);
     return c;
 }
@@ -458,7 +460,7 @@ fn lane_line(item: Listed, segment: bool) -> Clipped {
     // A segment's item names no triangle: the edge's part reads triangle 0 instead.
     let t = select(item.t, 0u, segment);
     let e = edge_ends(item.inst, t, triangle_corners(item.inst, t), item.i, item.mode);
-    var on = On(item.inst, t, item.inst, e.n, false);
+    var on = On(item.inst, t, item.inst, e.n, false, false);
     var a = e.a;
     var b = e.b;
     var anchor = pattern_anchor(item.inst, t, item.i, e.a, e.b, item.mode);
@@ -466,7 +468,7 @@ fn lane_line(item: Listed, segment: bool) -> Clipped {
 #if CROSSINGS
     if segment {
         let s = intersections[min(item.t, max(frame.intersections, 1u) - 1u)];
-        on = On(s.slot, s.t, s.other, s.u, true);
+        on = On(s.slot, s.t, s.other, s.u, true, false);
         a = s.a;
         b = s.b;
         anchor = vec4<f32>(0.0, 1.0, 0.0, 1.0);
@@ -534,7 +536,7 @@ struct Intersection {
 // Intersection segment k on screen.
 fn clip_intersection(k: u32) -> Clipped {
     let s = intersections[k];
-    return clip_outline(On(s.slot, s.t, s.other, s.u, true), s.a, s.b, vec4<f32>(0.0, 1.0, 0.0, 1.0), NO_PLANE);
+    return clip_outline(On(s.slot, s.t, s.other, s.u, true, false), s.a, s.b, vec4<f32>(0.0, 1.0, 0.0, 1.0), NO_PLANE);
 }
 
 // One invocation per intersection segment: lists its pieces that reach the targets, after
@@ -617,8 +619,10 @@ fn outline_lines(inst: u32, t: u32) -> Found {
     let boundary = outlines && (bits & 8u) != 0u;
     let allowed = select(0u, (bits >> 8u) & 7u, outlines);
     // Drawn edges of a large patch, drawn here like outlines (mesh_store::EdgeData); all
-    // drawn edges where they are patterned.
-    let patterned = select(0u, bits & 7u, (flags & INSTANCE_LISTED_EDGES) != 0u);
+    // drawn edges where they are patterned, and near where another instance crosses this one.
+    let crossed = INSTANCE_CROSSED | INSTANCE_EDGES;
+    let crossed_edges = (flags & crossed) == crossed && triangle_meets(inst, p, crossing_reach_box(inst));
+    let patterned = select(0u, bits & 7u, (flags & INSTANCE_LISTED_EDGES) != 0u || crossed_edges);
     let splat = select(0u, (bits >> INFO_SPLAT_SHIFT) & 7u, (flags & INSTANCE_EDGES) != 0u && patterned == 0u);
 #if HIDDEN
     // Drawn edges: their hidden parts, wherever they are, where the instance draws them.
@@ -883,6 +887,9 @@ struct On {
     other: u32,
     n: u32,
     crossing: bool,
+    // The line's image reaches the box round where the instance crosses another
+    // (`near_crossing`, set by clip_outline).
+    near_crossing: bool,
 }
 
 // The screen segment of a line, clipped to the view and the targets, and the triangles
@@ -1005,8 +1012,64 @@ fn clip_outline(on: On, a: vec3<f32>, b: vec3<f32>, anchor: vec4<f32>, skip: u32
     c.seg.hidden_phase = anchor.z + select((1.0 - u.x) * full, u.x * full, anchor.w > 0.0);
     c.seg.hidden_dir = anchor.w;
     c.length_px = length(c.seg.end.xy - c.seg.start.xy);
-    c.pieces = max(u32(ceil(c.length_px / piece_px(line_window(on).r))), 1u);
+    c.seg.on.near_crossing = near_crossing(on, c.seg.start.xy, c.seg.end.xy);
+    c.pieces = max(u32(ceil(c.length_px / piece_px(line_window(c.seg.on).r))), 1u);
     return c;
+}
+
+// Whether the image segment p -> q of a line on `on` reaches the box round the crossings of
+// an instance it lies on that another passes through (`Instance.cross_box`): only there do
+// its visibility and its drawn edges need the crossing way.
+fn near_crossing(on: On, p: vec2<f32>, q: vec2<f32>) -> bool {
+    let lo = min(p, q);
+    let hi = max(p, q);
+    var near = false;
+    for (var j = 0u; j < 2u; j++) {
+        let inst = instances[slot(select(on.other, on.inst, j == 0u))];
+        let b = inst.cross_box;
+        near = near || ((inst.flags & INSTANCE_CROSSED) != 0u && all(lo <= b.zw) && all(hi >= b.xy));
+    }
+    return near;
+}
+
+// The planes (of clip points: rows x, y, near, w) bounding what lies in front of the near
+// plane and projects into the box of image pixels `lo`..`hi`, that box cut to the image
+// and its guard band first (unbounded boxes stay finite).
+fn box_planes(lo_px: vec2<f32>, hi_px: vec2<f32>) -> array<vec4<f32>, 5> {
+    let lo = 2.0 * max(lo_px, -frame.output_offset) / frame.image_size - 1.0;
+    let hi = 2.0 * min(hi_px, frame.image_size + frame.output_offset) / frame.image_size - 1.0;
+    // Image y runs down, clip y up.
+    return array<vec4<f32>, 5>(
+        vec4<f32>(1.0, 0.0, 0.0, -lo.x),
+        vec4<f32>(-1.0, 0.0, 0.0, hi.x),
+        vec4<f32>(0.0, -1.0, 0.0, -lo.y),
+        vec4<f32>(0.0, 1.0, 0.0, hi.y),
+        vec4<f32>(0.0, 0.0, 1.0, 0.0),
+    );
+}
+
+// The box round the crossings of `inst` (`Instance.cross_box`) grown by its drawn edges'
+// reach and a pixel: the edge pass leaves the edges of a triangle whose pixel lies in the
+// box, so every triangle with an edge within reach of the box has its edges drawn here.
+fn crossing_reach_box(inst: u32) -> vec4<f32> {
+    let grow = line_reach(instances[slot(inst)].line_width) + 1.0;
+    return instances[slot(inst)].cross_box + vec4<f32>(-grow, -grow, grow, grow);
+}
+
+// Whether triangle p (local corners of `inst`) may reach the box `b` of image pixels: no
+// plane of the box has all three corners outside it.
+fn triangle_meets(inst: u32, p: array<vec3<f32>, 3>, b: vec4<f32>) -> bool {
+    let planes = box_planes(b.xy, b.zw);
+    let clip = instances[slot(inst)].clip;
+    let c0 = clip * vec4<f32>(p[0], 1.0);
+    let c1 = clip * vec4<f32>(p[1], 1.0);
+    let c2 = clip * vec4<f32>(p[2], 1.0);
+    var meets = b.x <= b.z && b.y <= b.w;
+    for (var k = 0u; k < 5u; k++) {
+        let r = planes[k];
+        meets = meets && !(dot(r, c0) < 0.0 && dot(r, c1) < 0.0 && dot(r, c2) < 0.0);
+    }
+    return meets;
 }
 
 // The reach of a line of `inst` drawn as `mode` says: of its visible line and, with
@@ -1032,7 +1095,7 @@ fn list_outline(inst: u32, t: u32, p: array<vec3<f32>, 3>, word: u32) -> bool {
     let e = edge_ends(inst, t, p, i, mode);
     // The pattern's anchor only matters where a piece is drawn (the piece pass finds it for
     // the pieces it draws): looking it up for every listed edge would cost every lane.
-    let c = clip_outline(On(inst, t, inst, e.n, false), e.a, e.b, vec4<f32>(0.0, 1.0, 0.0, 1.0), cut_plane(mode));
+    let c = clip_outline(On(inst, t, inst, e.n, false, false), e.a, e.b, vec4<f32>(0.0, 1.0, 0.0, 1.0), cut_plane(mode));
     let item = Listed(inst, t, i, mode, 0u, c.pieces);
     return list_all(item, pieces_in_reach(c, line_reach_of(inst, mode)));
 }
@@ -1378,9 +1441,9 @@ fn line_window(on: On) -> Window {
     // front of an interior silhouette thins out near a fold of its own: look two pixels
     // round for it there.
     // Where surfaces cross, the surface a line passes into may show only a few pixels away
-    // (where those in front of it end): look four pixels round (frame::CROSSING_BAND).
+    // (where those in front of it end): look four pixels round (instance_crossings::CROSSING_BAND).
     let bits = info[instances[slot(on.inst)].triangle_base + on.t] | select(0u, info[instances[slot(on.other)].triangle_base + on.n], on.n != BACKGROUND_ID);
-    let crossed = (bits & INFO_CROSSED) != 0u || ((instances[slot(on.inst)].flags | instances[slot(on.other)].flags) & INSTANCE_CROSSED) != 0u;
+    let crossed = (bits & INFO_CROSSED) != 0u || on.near_crossing;
     let wide = frame.sections_on != 0u || crossed;
     // An intersection line lies on both surfaces that cross there, so no surface passes
     // into view beyond it: it takes a section's window.

@@ -170,13 +170,31 @@ fn hidden_off_draws_todays_image() {
     let view = perspective(&world, DVec3::new(2.5, 1.8, 3.2));
     let plain = shoot_world(&world, view, &Style::default(), SIZE, Method::Deferred);
     assert!(plain.hidden_distance.iter().all(|d| d.is_infinite()));
-    // Hidden lines of no opacity change nothing but the hidden-line map.
+    // Hidden lines of no opacity change the hidden-line map, and the visible lines only to
+    // rounding (below).
     let mut clear = style(LinePattern::Solid, 2.0);
     clear.hidden.as_mut().unwrap().color = Color([0.8, 0.1, 0.1, 0.0]);
     let faint = shoot_world(&world, view, &clear, SIZE, Method::Deferred);
     assert_eq!(plain.ids, faint.ids);
-    assert_eq!(plain.rgba, faint.rgba);
-    assert_eq!(plain.edge_distance, faint.edge_distance);
+    // The torus passes through the cube. With hidden lines their lines are drawn the wide
+    // way everywhere, without them only near the crossings, so elsewhere a visible line comes
+    // from the trace pass in one frame and the edge pass in the other: the same to rounding.
+    let worst_channel = plain
+        .rgba
+        .iter()
+        .zip(&faint.rgba)
+        .map(|(a, b)| a.abs_diff(*b))
+        .max();
+    assert!(worst_channel <= Some(1), "{worst_channel:?}");
+    let reach = 2.0;
+    let mut compared = 0;
+    for (a, b) in plain.edge_distance.iter().zip(&faint.edge_distance) {
+        if *a < reach || *b < reach {
+            assert!((a - b).abs() <= 0.01, "line distance {a} against {b}");
+            compared += 1;
+        }
+    }
+    assert!(compared > 1000, "{compared}");
     assert!(faint.hidden_distance.iter().any(|d| d.is_finite()));
 }
 

@@ -243,9 +243,16 @@ fn moving_one_instance_changes_only_its_pixels() {
             }
         }
     }
+    // The torus passes through a sphere, whose lines near the crossings the trace pass
+    // draws, elsewhere the edge pass: where the crossings' image moves, a line of the sphere
+    // may change passes, and so its colour by rounding (one level).
     let mut changed = 0;
     for (i, &near) in near_torus.iter().enumerate() {
+        let rounding = (0..4).all(|k| a.rgba[4 * i + k].abs_diff(b.rgba[4 * i + k]) <= 1);
         let differs = a.ids[i] != b.ids[i] || a.rgba[4 * i..4 * i + 4] != b.rgba[4 * i..4 * i + 4];
+        if differs && !near && a.ids[i] == b.ids[i] && rounding {
+            continue;
+        }
         if differs {
             changed += 1;
             assert!(

@@ -4,7 +4,9 @@
 //! same scene the same way.
 
 use super::canvas::Region;
-use super::instance_crossings::{PairCache, PairCrossing};
+use super::instance_crossings::{
+    crossing_box, union_box, PairCache, PairCrossing, CROSSING_BAND, NO_BOX, WHOLE_IMAGE,
+};
 use super::mesh_store::{MeshRecord, MeshStore, StoreBuffers};
 use crate::camera::View;
 use crate::error::{Error, Result};
@@ -82,6 +84,9 @@ pub(crate) struct InstanceRecord {
     /// edges', then the outline's.
     edge_pattern: [f32; 2],
     outline_pattern: [f32; 2],
+    /// With [`INSTANCE_CROSSED`], the box of image pixels (min x, min y, max x, max y)
+    /// where its lines are drawn the crossing way ([`Crossings`]).
+    cross_box: [f32; 4],
 }
 
 /// `Instance.flags`: the instance's edges are drawn.
@@ -94,21 +99,15 @@ pub(crate) const INSTANCE_HIDDEN: u32 = 4;
 pub(crate) const INSTANCE_BEHIND_HOST: u32 = 8;
 /// `Instance.flags`: the hidden parts of its drawn edges are drawn, not only its outline's.
 pub(crate) const INSTANCE_HIDDEN_EDGES: u32 = 16;
-/// `Instance.flags`: its drawn edges are patterned, cut by section planes or crossed by
-/// another instance, so the trace pass draws them (their visible runs) and the edge pass
-/// leaves them.
+/// `Instance.flags`: its drawn edges are patterned or cut by section planes, so the trace
+/// pass draws them (their visible runs) and the edge pass leaves them.
 pub(crate) const INSTANCE_LISTED_EDGES: u32 = 32;
 /// `Instance.flags`: it has a phase table (`chain_phases`).
 pub(crate) const INSTANCE_PHASES: u32 = 64;
-/// `Instance.flags`: another instance passes through it (`instance_pair_crossings`), so its
-/// lines' visibility is tested over a wider window ([`CROSSING_BAND`]).
+/// `Instance.flags`: another instance passes through it (`instance_pair_crossings`), so
+/// within its `cross_box` the trace pass draws its edges and tests its lines' visibility
+/// over a wider window ([`CROSSING_BAND`]), and the edge pass leaves its edges.
 pub(crate) const INSTANCE_CROSSED: u32 = 128;
-
-/// Pixels the guard band grows by in a frame where surfaces may cross: the trace pass
-/// tests the visibility of their lines against the ids up to four pixels around each point
-/// (the surface that a line passes into may be visible only a few pixels away, where the
-/// surfaces in front of it end), not one.
-const CROSSING_BAND: u32 = 3;
 
 /// A linear RGBA colour as WGSL's `unpack2x16float` reads it from two words.
 fn pack_color(c: [f32; 4]) -> [u32; 2] {
@@ -118,9 +117,9 @@ fn pack_color(c: [f32; 4]) -> [u32; 2] {
 
 /// Instance records a uniform buffer holds (`scene.wgsl`, `UNIFORM_INSTANCES`): frames with
 /// up to this many bind them as uniforms, which software rasterizers read many times faster
-/// than storage buffers; 240 records fit in 64 KiB, `Limits::default()`'s largest uniform
+/// than storage buffers: as many as fit in 64 KiB, `Limits::default()`'s largest uniform
 /// binding.
-pub(crate) const UNIFORM_INSTANCE_CAPACITY: u32 = 240;
+pub(crate) const UNIFORM_INSTANCE_CAPACITY: u32 = (65536 / INSTANCE_BYTES) as u32;
 
 /// Byte offset of `InstanceRecord::index`, read as an instance-rate vertex attribute.
 pub(crate) const INSTANCE_INDEX_OFFSET: u64 = 220;
@@ -300,7 +299,7 @@ impl FrameRecords {
         super::targets::check_size(device, region.size)?;
         // Where the device's largest texture leaves no room for the whole band, a narrower one.
         let room = device.limits().max_texture_dimension_2d - region.size.0.max(region.size.1);
-        let crossings = Crossings::new(store, scene, style, pairs)?;
+        let crossings = Crossings::new(store, scene, style, region.image, pairs)?;
         let guard = if guarded {
             let band = guard_band(scene, style);
             let band = band + if crossings.any { CROSSING_BAND } else { 0 };
@@ -323,8 +322,9 @@ impl FrameRecords {
             let mesh = store.record(instance.mesh)?;
             let placed = (slot as u32, clusters as u32);
             let crossed = crossings.instances[i as usize];
-            let (record, hidden, asks) =
+            let (mut record, hidden, asks) =
                 instance_entry(scene, style, look, instance, mesh, crossed, placed);
+            record.cross_box = crossings.boxes[i as usize];
             needs = needs.and(asks);
             records.push(record);
             hidden_styles.push(hidden);
@@ -447,15 +447,20 @@ struct Crossings {
     /// passes through another where it draws outlines (without, a line may reach past the
     /// silhouette only so), or it or the other draws hidden lines.
     instances: Vec<bool>,
+    /// Per instance: the image pixels where it does (`InstanceRecord::cross_box`): round
+    /// the crossings' image, or everywhere where hidden lines are drawn.
+    boxes: Vec<[f32; 4]>,
     /// Whether any instance does, or any mesh passes through itself.
     any: bool,
 }
 
 impl Crossings {
+    /// `image`: the size of the image the view projects onto.
     fn new(
         store: &MeshStore,
         scene: &Scene<'_>,
         style: &Style,
+        image: (u32, u32),
         pairs: Option<&mut PairCache>,
     ) -> Result<Crossings> {
         let mut placed = Vec::with_capacity(scene.instances.len());
@@ -474,16 +479,28 @@ impl Crossings {
         // of a hidden run where the other's surface in front of it ends beside it.
         let hides = |i: usize| scene.instances[i].style.hidden_in(style).is_some();
         let mut instances = vec![false; scene.instances.len()];
+        let mut boxes = vec![NO_BOX; scene.instances.len()];
         for ((a, b), found) in &pairs {
             if !found.is_empty() || hides(*a) || hides(*b) {
                 instances[*a] = outlines_of(*a);
                 instances[*b] = outlines_of(*b);
+                let area = if hides(*a) || hides(*b) {
+                    WHOLE_IMAGE
+                } else {
+                    let first = &scene.instances[*a];
+                    let model = first.transform * store.record(first.mesh)?.local_to_mesh();
+                    crossing_box(&scene.view, image, model, found)
+                };
+                for i in [*a, *b] {
+                    boxes[i] = union_box(boxes[i], area);
+                }
             }
         }
         any |= instances.contains(&true);
         Ok(Crossings {
             pairs,
             instances,
+            boxes,
             any,
         })
     }
@@ -576,9 +593,9 @@ fn instance_entry(
     let edge_pattern = s.edge_pattern_in(style).dash_period();
     let outline_pattern = s.outline_pattern_in(style).dash_period();
     let patterned_edges = draws_edges && edge_pattern[1] > 0.0;
-    // Section planes cut the drawn edges short, and another instance may cross them: the
-    // trace pass draws them where they are visible.
-    let listed_edges = patterned_edges || (draws_edges && (sections || crossed));
+    // Section planes cut the drawn edges short: the trace pass draws them where they are
+    // visible (and, where another instance crosses this one, those near the crossings).
+    let listed_edges = patterned_edges || (draws_edges && sections);
     let needs = Needs {
         // The trace pass also draws the edges of large patches, and cut lines: every
         // instance has them where a section plane crosses it.
@@ -965,6 +982,7 @@ fn instance_record(
         _pad: 0,
         edge_pattern: [0.0; 2],
         outline_pattern: [0.0; 2],
+        cross_box: NO_BOX,
     }
 }
 

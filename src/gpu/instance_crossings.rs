@@ -12,6 +12,7 @@
 //! instances keep their mesh and transform, so a still scene seen from a moving camera finds
 //! them once.
 
+use super::loop_budget::WINDOW_RADII;
 use super::mesh_store::{MeshId, MeshRecord};
 use crate::mesh::clusters::CLUSTER_TRIANGLES;
 use crate::mesh::crossings::{crossings_between, pair_tolerance};
@@ -74,6 +75,70 @@ impl PairCache {
         entry.0 = now;
         entry.1.clone()
     }
+}
+
+/// Pixels the guard band grows by in a frame where surfaces may cross: the trace pass
+/// tests the visibility of their lines against the ids up to four pixels around each point
+/// (the surface that a line passes into may be visible only a few pixels away, where the
+/// surfaces in front of it end), not one.
+pub(crate) const CROSSING_BAND: u32 = 3;
+
+/// A box of image pixels (min x, min y, max x, max y) that holds none.
+pub(crate) const NO_BOX: [f32; 4] = [f32::MAX, f32::MAX, f32::MIN, f32::MIN];
+/// A box that holds every pixel.
+pub(crate) const WHOLE_IMAGE: [f32; 4] = [f32::MIN, f32::MIN, f32::MAX, f32::MAX];
+
+/// Pixels round the image of the crossings within which the trace pass draws a crossed
+/// instance's lines the crossing way: where a line passes into another surface, that
+/// surface may show no nearer than the widest window's radius to the point
+/// (`WINDOW_RADII`), in targets grown by `CROSSING_BAND`; a pixel more for rounding.
+pub(crate) const CROSSING_MARGIN: f32 = (WINDOW_RADII[2] + CROSSING_BAND + 1) as f32;
+
+/// The smallest box holding both.
+pub(crate) fn union_box(a: [f32; 4], b: [f32; 4]) -> [f32; 4] {
+    [
+        a[0].min(b[0]),
+        a[1].min(b[1]),
+        a[2].max(b[2]),
+        a[3].max(b[3]),
+    ]
+}
+
+/// The image pixels (of an image `image` pixels in size) within [`CROSSING_MARGIN`] of the
+/// image of `crossings` (in the stored coordinates that `model` places in the world), as a
+/// box; the whole image where one of them reaches behind the near plane, whose image is
+/// unbounded.
+pub(crate) fn crossing_box(
+    view: &crate::View,
+    image: (u32, u32),
+    model: DMat4,
+    crossings: &[PairCrossing],
+) -> [f32; 4] {
+    let clip = view.clip_rows(model).clip;
+    let size = glam::DVec2::new(f64::from(image.0), f64::from(image.1));
+    let mut lo = glam::DVec2::splat(f64::INFINITY);
+    let mut hi = -lo;
+    for p in crossings.iter().flat_map(|c| c.ends) {
+        // Clip rows x, y, near, w: in front of the near plane exactly where near >= 0.
+        let c = clip * DVec3::from_array(p.map(f64::from)).extend(1.0);
+        if !(c.z >= 0.0 && c.w > 0.0) {
+            return WHOLE_IMAGE;
+        }
+        let ndc = c.truncate().truncate() / c.w;
+        let px = glam::DVec2::new(0.5 * (ndc.x + 1.0), 0.5 * (1.0 - ndc.y)) * size;
+        lo = lo.min(px);
+        hi = hi.max(px);
+    }
+    if !(lo.cmple(hi).all() && hi.is_finite() && lo.is_finite()) {
+        return if crossings.is_empty() {
+            NO_BOX
+        } else {
+            WHOLE_IMAGE
+        };
+    }
+    let m = f64::from(CROSSING_MARGIN);
+    let (lo, hi) = ((lo - m).floor(), (hi + m).ceil());
+    [lo.x as f32, lo.y as f32, hi.x as f32, hi.y as f32]
 }
 
 /// Where mesh `a` placed by `ta` and mesh `b` placed by `tb` cross, sorted by triangle.
@@ -231,6 +296,39 @@ mod tests {
                 assert!(p.distance(*q) < 1e-5, "{p} {q}");
             }
         }
+    }
+
+    /// The box round the crossings' image: an orthographic view 4 units high onto an image
+    /// 400×400 maps a crossing from (-1, 0, 0) to (1, 0.5, 0) to pixels (100, 150)..(300,
+    /// 200), grown by the margin; one behind the near plane takes the whole image; none, no
+    /// box.
+    #[test]
+    fn the_crossing_box_holds_the_crossings_image() {
+        let view = crate::View::orthographic(
+            (DVec3::new(0.0, 0.0, 5.0), DVec3::ZERO, DVec3::Y),
+            4.0,
+            1.0,
+            (1.0, 10.0),
+        );
+        let segment = |z: f32| PairCrossing {
+            t: 0,
+            u: 0,
+            ends: [[-1.0, 0.0, 0.0], [1.0, 0.5, z]],
+        };
+        let m = CROSSING_MARGIN;
+        let found = crossing_box(&view, (400, 400), DMat4::IDENTITY, &[segment(0.0)]);
+        assert_eq!(found, [100.0 - m, 150.0 - m, 300.0 + m, 200.0 + m]);
+        // The mesh's stored coordinates placed by the model matrix.
+        let moved = DMat4::from_translation(DVec3::new(0.5, 0.0, 0.0));
+        let found = crossing_box(&view, (400, 400), moved, &[segment(0.0)]);
+        assert_eq!(found, [150.0 - m, 150.0 - m, 350.0 + m, 200.0 + m]);
+        let behind = crossing_box(&view, (400, 400), DMat4::IDENTITY, &[segment(4.5)]);
+        assert_eq!(behind, WHOLE_IMAGE);
+        assert_eq!(
+            crossing_box(&view, (400, 400), DMat4::IDENTITY, &[]),
+            NO_BOX
+        );
+        assert_eq!(union_box(NO_BOX, found), found);
     }
 
     /// A pair's crossings are found once while both keep their placement, again when one
