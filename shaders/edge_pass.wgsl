@@ -427,7 +427,13 @@ fn own_lines(s: Sample, point: vec2<f32>) -> Own {
     let bits = info[instances[slot(s.inst)].triangle_base + s.tri];
     // Patterned edges, those of crossed patches and those near where another instance
     // crosses this one are drawn by the trace pass.
-    let crossed = (flags & INSTANCE_CROSSED) != 0u && in_box(instances[slot(s.inst)].cross_box, point);
+    var crossed = false;
+#if CROSSINGS
+    // A loop, not an `if` (see `finish`).
+    for (var near = (flags & INSTANCE_CROSSED) != 0u; near; near = false) {
+        crossed = in_box(instances[slot(s.inst)].cross_box, point);
+    }
+#endif
     let edges = (flags & (INSTANCE_EDGES | INSTANCE_LISTED_EDGES)) == INSTANCE_EDGES && (bits & INFO_CROSSED) == 0u && !crossed;
     let mask = select(0u, bits & 7u, edges);
     let near = vec3<f32>(s.clip0.z, s.clip1.z, s.clip2.z);

@@ -138,9 +138,13 @@ fn trace_cull(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
     let splats = (flags & INSTANCE_EDGES) != 0u && cluster_splats(cluster);
     // Every drawn edge in view has a hidden part to find (HIDDEN), or a pattern to draw;
     // another instance passes through this one near it (`crossing_reach_box`).
+    var listed = (flags & INSTANCE_LISTED_EDGES) != 0u;
+#if CROSSINGS
     let crossed = INSTANCE_CROSSED | INSTANCE_EDGES;
-    var listed = (flags & INSTANCE_LISTED_EDGES) != 0u
-        || ((flags & crossed) == crossed && cluster_meets(instances[slot(inst)].clip, cluster, crossing_reach_box(inst)));
+    for (var near = (flags & crossed) == crossed; near; near = false) {
+        listed = listed || cluster_meets(instances[slot(inst)].clip, cluster, crossing_reach_box(inst));
+    }
+#endif
 #if HIDDEN
     let hidden_edges = INSTANCE_EDGES | INSTANCE_HIDDEN | INSTANCE_HIDDEN_EDGES;
     listed = listed || (flags & hidden_edges) == hidden_edges;
@@ -620,9 +624,14 @@ fn outline_lines(inst: u32, t: u32) -> Found {
     let allowed = select(0u, (bits >> 8u) & 7u, outlines);
     // Drawn edges of a large patch, drawn here like outlines (mesh_store::EdgeData); all
     // drawn edges where they are patterned, and near where another instance crosses this one.
+    var listed = (flags & INSTANCE_LISTED_EDGES) != 0u;
+#if CROSSINGS
     let crossed = INSTANCE_CROSSED | INSTANCE_EDGES;
-    let crossed_edges = (flags & crossed) == crossed && triangle_meets(inst, p, crossing_reach_box(inst));
-    let patterned = select(0u, bits & 7u, (flags & INSTANCE_LISTED_EDGES) != 0u || crossed_edges);
+    for (var near = (flags & crossed) == crossed; near; near = false) {
+        listed = listed || triangle_meets(inst, p, crossing_reach_box(inst));
+    }
+#endif
+    let patterned = select(0u, bits & 7u, listed);
     let splat = select(0u, (bits >> INFO_SPLAT_SHIFT) & 7u, (flags & INSTANCE_EDGES) != 0u && patterned == 0u);
 #if HIDDEN
     // Drawn edges: their hidden parts, wherever they are, where the instance draws them.
@@ -1024,11 +1033,17 @@ fn near_crossing(on: On, p: vec2<f32>, q: vec2<f32>) -> bool {
     let lo = min(p, q);
     let hi = max(p, q);
     var near = false;
+#if CROSSINGS
+    // Loops, not `if`s: a software rasterizer skips a loop no lane enters, and runs the
+    // body of an `if` for every lane.
     for (var j = 0u; j < 2u; j++) {
-        let inst = instances[slot(select(on.other, on.inst, j == 0u))];
-        let b = inst.cross_box;
-        near = near || ((inst.flags & INSTANCE_CROSSED) != 0u && all(lo <= b.zw) && all(hi >= b.xy));
+        let inst = select(on.other, on.inst, j == 0u);
+        for (var crossed = (instances[slot(inst)].flags & INSTANCE_CROSSED) != 0u; crossed; crossed = false) {
+            let b = instances[slot(inst)].cross_box;
+            near = near || (all(lo <= b.zw) && all(hi >= b.xy));
+        }
     }
+#endif
     return near;
 }
 

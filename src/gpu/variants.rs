@@ -67,7 +67,8 @@ pub(crate) struct Variant {
     /// (the edge pass's section colour is a select on the frame's value).
     pub sections: bool,
     /// Surfaces may cross ([`FrameData::crossing`](super::frame::FrameData)); only with
-    /// `traced`, and only the trace pass reads it.
+    /// `traced`. The edge pass reads it too: near where instances cross, it leaves their
+    /// edges to the trace pass.
     pub crossing: bool,
     pub host: bool,
     /// The instance records are bound as a uniform array.
@@ -83,7 +84,6 @@ impl Variant {
         Variant {
             patterns: false,
             sections: false,
-            crossing: false,
             ..self
         }
     }
