@@ -34,7 +34,9 @@
 // Listed edges (INSTANCE_LISTED_EDGES): an instance whose drawn edges are dashed or dotted,
 // or cut by section planes, has all of them in view listed here too, their visible runs
 // drawn (in dashes); the edge pass then leaves its own triangles' edges. Every line ends
-// where a section plane cuts it (`edge_span`).
+// where a section plane cuts it (`edge_span`). So are, where another instance passes
+// through one (INSTANCE_CROSSED), the drawn edges of its triangles that reach the box round
+// the crossings' image (`crossing_reach_box`), whose lines are tested over a wider window.
 //
 // Intersection lines (`frame.intersections` > 0): where two triangles of an instance's mesh
 // cross (src/mesh/crossings.rs found the pairs and their segments at upload), one invocation
