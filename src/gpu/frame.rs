@@ -1037,7 +1037,7 @@ mod tests {
 
     #[test]
     fn records_match_their_wgsl_layout() {
-        assert_eq!(std::mem::size_of::<InstanceRecord>(), 272);
+        assert_eq!(std::mem::size_of::<InstanceRecord>(), 288);
         assert!(u64::from(UNIFORM_INSTANCE_CAPACITY) * INSTANCE_BYTES <= 65536);
         assert_eq!(std::mem::size_of::<FrameUniforms>(), 336);
         assert_eq!(std::mem::size_of::<IntersectionRecord>(), 48);
