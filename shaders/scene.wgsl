@@ -375,10 +375,16 @@ fn nearer_than_cap(a_near: f32, b_near: f32, b_w: f32) -> bool {
 // way than the last one that faced it either way): the triangle beyond a silhouette edge
 // lies on screen on this side of the edge, so it cannot cover a point beyond it, and the
 // walk would only wander over the surface's far side (a walk from the mesh towards a
-// background point does that for all its steps). One `sample_corners` in one loop, so a
-// shader holds one copy of it; a step reads only the next triangle's corner off the crossed
-// edge (`beyond_edge`), so the corners of the returned sample that it shares with the
-// triangle before it carry that one's normal bits (w) where a seam splits their vertices.
+// background point does that for all its steps). In the trace pass of a frame with hidden
+// lines (TURNS) it first turns about the silhouette edge's end nearer the point, up to
+// FOLD_TURNS times a walk: where a surface folds back and forth within a pixel (the rim of a
+// scanned or noisy mesh), the sheet past the fold goes on beyond the edge, hiding the line
+// there, and it is reached round that end's fan of triangles (the ones facing away, then the
+// first facing the eye again, from which the walk goes on). One
+// `sample_corners` in one loop, so a shader holds one copy of it; a step reads only the next
+// triangle's corner off the crossed edge (`beyond_edge`), so the corners of the returned
+// sample that it shares with the triangle before it carry that one's normal bits (w) where a
+// seam splits their vertices.
 fn locate(inst: u32, tri: u32, point: vec2<f32>, steps: u32, stop_at_fold: bool) -> Sample {
     var t = tri;
     var s: Sample;
@@ -388,9 +394,41 @@ fn locate(inst: u32, tri: u32, point: vec2<f32>, steps: u32, stop_at_fold: bool)
     var q1 = vertex_at(v.y);
     var q2 = vertex_at(v.z);
     var facing = 0.0;
+#if TURNS
+    // Turning about `pivot` (a corner's position) through triangles that face away; `off`,
+    // the corner of the current triangle off the edge it was entered by.
+    var turning = false;
+    var turns_left = FOLD_TURNS;
+    var pivot = vec4<f32>(0.0);
+    var off = 0u;
+    // The end of the last crossed edge nearer the point, and how far beyond that edge the
+    // point lies (px).
+    var nearer_end = vec4<f32>(0.0);
+    var crossed_by = 0.0;
+#endif
     for (var step = 0u; step <= steps; step++) {
         let next_s = sample_corners(inst, t, q0, q1, q2, point);
         let side = dot(towards_eye(next_s.v0.xyz, eye), cross(next_s.v1.xyz - next_s.v0.xyz, next_s.v2.xyz - next_s.v0.xyz));
+#if TURNS
+        let folds = side * facing < 0.0;
+        if stop_at_fold && folds && !turning {
+            // A point on the fold's edge (a point of an outline there) lies on no sheet
+            // beyond it.
+            if turns_left == 0u || crossed_by < COVERAGE_MARGIN {
+                break;
+            }
+            turns_left -= 1u;
+            turning = true;
+            pivot = nearer_end;
+        }
+        // Back on the side the walk faced: it goes on from here.
+        turning = turning && folds;
+        s = next_s;
+        // Edge-on and degenerate triangles (side 0) face neither way.
+        if side != 0.0 && !turning {
+            facing = side;
+        }
+#else
         if stop_at_fold && side * facing < 0.0 {
             break;
         }
@@ -399,6 +437,7 @@ fn locate(inst: u32, tri: u32, point: vec2<f32>, steps: u32, stop_at_fold: bool)
         if side != 0.0 {
             facing = side;
         }
+#endif
         let b = s.bary;
         let lowest = min(b.x, min(b.y, b.z));
         // Covered, or inside but beyond the near or far plane, or degenerate: stop.
@@ -406,13 +445,27 @@ fn locate(inst: u32, tri: u32, point: vec2<f32>, steps: u32, stop_at_fold: bool)
             break;
         }
         // Corner k's weight is negative beyond the opposite edge k + 1 (mod 3).
-        let edge = select(select(0u, 2u, b.y == lowest), 1u, b.x == lowest);
+        var edge = select(select(0u, 2u, b.y == lowest), 1u, b.x == lowest);
+#if TURNS
+        // Turning, the walk crosses the edge from the pivot to the corner off the edge it
+        // entered by (edge `off` where the pivot is corner off + 1, else edge off + 2).
+        let after = select(select(q0, q2, off == 1u), q1, off == 0u);
+        edge = select(edge, select((off + 2u) % 3u, off, all(after == pivot)), turning);
+#endif
         let word = neighbour_word(instances[slot(inst)].triangle_base + t, edge);
         if word == BACKGROUND_ID {
             break;
         }
         let start = select(select(q2, q1, edge == 1u), q0, edge == 0u);
         let end = select(select(q0, q2, edge == 1u), q1, edge == 0u);
+#if TURNS
+        // The edge's ends are corners edge and edge + 1: the greater weight is the nearer.
+        let w_start = select(select(b.z, b.y, edge == 1u), b.x, edge == 0u);
+        let w_end = select(select(b.x, b.z, edge == 1u), b.y, edge == 0u);
+        nearer_end = select(end, start, w_start >= w_end);
+        crossed_by = select(select(s.lines.z, s.lines.y, edge == 1u), s.lines.x, edge == 0u);
+        off = (word >> NEIGHBOUR_CORNER_SHIFT) & 3u;
+#endif
         let next = beyond_edge(inst, word, start, end);
         t = next.tri;
         q0 = next.q0;

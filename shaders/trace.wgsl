@@ -44,7 +44,8 @@
 //
 // Flags: COLORS (instances differ in line colour, or an outline's colour differs from the
 // edges': each pixel also keeps the greatest (intensity level, class, instance) word,
-// `OWNER_OUTLINE`, so the edge pass knows whose line it holds and of which class), HIDDEN,
+// `OWNER_OUTLINE`, so the edge pass knows whose line it holds and of which class), HIDDEN
+// (with TURNS: the walks of the visibility test turn at folds, `locate` in scene.wgsl),
 // PATTERNS (a line is dashed or dotted: phase tables, and dashes in `splat_runs`).
 
 @group(0) @binding(9) var<storage, read> clusters: array<Cluster>;

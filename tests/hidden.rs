@@ -164,6 +164,64 @@ fn a_cad_part_hides_its_own_feature_edges() {
     assert!(pixels > 500, "fandisk: {pixels} hidden-line pixels");
 }
 
+/// Hidden-line pixels whose distance is off the ground truth's by more than 0.01 px, or that
+/// one side has within 1.9 px and the other has not (where the ids agree).
+fn hidden_misses(truth: &wirepass::world::Rendering, frame: &wirepass::world::Rendering) -> usize {
+    (0..truth.ids.len())
+        .filter(|&i| truth.ids[i] == frame.ids[i])
+        .filter(|&i| {
+            let (t, f) = (truth.hidden_distance[i], frame.hidden_distance[i]);
+            match (t.is_finite(), f.is_finite()) {
+                (true, true) => (t - f).abs() > 0.01,
+                (false, false) => false,
+                _ => t.min(f) < 1.9,
+            }
+        })
+        .count()
+}
+
+/// A scanned mesh's rim folds back and forth within a pixel: the sheet past a fold hides the
+/// lines behind it where no pixel centre shows it, and the visibility test's walks turn
+/// about the fold's end to reach it (`locate`). Not yet exact there: the pixels still off
+/// are where one sheet past a fold hides a line but the walk reaches another that covers
+/// the point behind it, and stray dots where a line's own triangle is seen edge-on
+/// (measured 29 and 41 here on lavapipe, 33 and 41 on llvmpipe's GL; 48 and 70 without
+/// the turns).
+#[test]
+fn a_folded_rim_hides_the_lines_behind_it() {
+    let mesh = load("stanford-bunny.obj");
+    let world = World::single(mesh.clone(), EdgeSelection::Feature(30.0));
+    let size = (240, 180);
+    let aspect = f64::from(size.0) / f64::from(size.1);
+    let framed = framing(&mesh, size).to_view(aspect);
+    let (lo, hi) = mesh.bounds_f64();
+    let side = wirepass::Camera {
+        eye: glam::Vec3::new(0.3, 0.1, -0.1),
+        target: (0.5 * (lo + hi)).as_vec3(),
+        up: glam::Vec3::Y,
+        fov_y_deg: 45.0,
+        near: 0.01,
+        far: 10.0,
+    }
+    .to_view(aspect);
+    for (name, view, bound) in [("framed", framed, 36), ("side", side, 50)] {
+        let (truth, frame) = truth_and_frame(&world, view, &style(LinePattern::Solid, 1.0), size);
+        let pixels = truth
+            .hidden_distance
+            .iter()
+            .filter(|d| d.is_finite())
+            .count();
+        let misses = hidden_misses(&truth, &frame);
+        println!("{name}: {misses} of {pixels} hidden-line pixels off");
+        assert!(pixels > 1000, "{name}: {pixels} hidden-line pixels");
+        assert!(
+            misses <= bound,
+            "{name}: {misses} pixels off\n{}",
+            worst_hidden(&truth, &frame)
+        );
+    }
+}
+
 #[test]
 fn hidden_off_draws_todays_image() {
     let world = cube_and_torus();

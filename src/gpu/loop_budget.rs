@@ -40,6 +40,11 @@ pub(crate) const WALK_STEPS: u32 = 24;
 /// Steps of the trace pass's walks from the outer ring of a wide window and from the
 /// line's triangles' other neighbours: they only cross the sheet's last few triangles.
 pub(crate) const FOLD_STEPS: u32 = 4;
+/// Times a walk of the trace pass turns about a fold's end instead of ending there
+/// (`locate`), in frames with hidden lines: a surface that folds back and forth within a
+/// pixel hides a line's point with the sheet past the fold. Turning takes steps of the
+/// walk's own, so it adds no loop.
+pub(crate) const FOLD_TURNS: u32 = 1;
 /// Samples of visibility a pixel along an outline piece.
 pub(crate) const RUN_SAMPLES_PER_PX: u32 = 4;
 /// Bisections of a step where visibility changes: 2^-12 of a quarter pixel, well below the
@@ -115,6 +120,7 @@ pub(crate) fn wgsl() -> String {
     format!(
         "const WALK_STEPS: u32 = {WALK_STEPS}u;\n\
          const FOLD_STEPS: u32 = {FOLD_STEPS}u;\n\
+         const FOLD_TURNS: u32 = {FOLD_TURNS}u;\n\
          const RUN_SAMPLES_PER_PX: f32 = {RUN_SAMPLES_PER_PX}.0;\n\
          const RUN_BISECTIONS: u32 = {RUN_BISECTIONS}u;\n\
          const MAX_RUNS: u32 = {MAX_RUNS}u;\n\

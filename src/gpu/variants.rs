@@ -166,6 +166,11 @@ impl Variant {
     /// (`short_pieces`, [`Tuning`](super::Tuning)).
     pub(crate) fn trace_flags(self, short_pieces: bool) -> Vec<&'static str> {
         let mut flags = self.flags();
+        // With hidden lines, the visibility test's walks turn at folds (`locate`): the
+        // sheet past a fold hides the lines behind it. Other frames do not pay for it.
+        if self.hidden {
+            flags.push("TURNS");
+        }
         if short_pieces {
             flags.push("SHORT_PIECES");
         }
