@@ -16,14 +16,17 @@
 
 @group(0) @binding(34) var result: texture_2d<f32>;
 
-// One 8×8 output tile an instance (two triangles), from the tiles the edge pass listed
-// (`composite_rw` in edge_pass.wgsl): the others' result is transparent, and drawing them
-// would cost a software rasterizer a fragment each.
+// One run of 8×8 output tiles along a row an instance (two triangles), from the runs the
+// edge pass listed (`list_composite_runs` in edge_pass.wgsl: tile x | (length - 1) <<
+// COMPOSITE_RUN_SHIFT | tile y << 16): the other tiles' result is transparent, and drawing
+// them would cost a software rasterizer a fragment each.
 @vertex
-fn vs_main(@builtin(vertex_index) i: u32, @location(0) tile: u32) -> @builtin(position) vec4<f32> {
+fn vs_main(@builtin(vertex_index) i: u32, @location(0) run: u32) -> @builtin(position) vec4<f32> {
     let corner = vec2<u32>(select(0u, 1u, i == 1u || i == 4u || i == 5u), select(0u, 1u, i == 2u || i == 3u || i == 5u));
     let size = vec2<f32>(textureDimensions(result));
-    let p = min(vec2<f32>((vec2<u32>(tile & 0xffffu, tile >> 16u) + corner) * 8u), size);
+    let x = run & ((1u << COMPOSITE_RUN_SHIFT) - 1u);
+    let extent = vec2<u32>(((run & 0xffffu) >> COMPOSITE_RUN_SHIFT) + 1u, 1u);
+    let p = min(vec2<f32>((vec2<u32>(x, run >> 16u) + corner * extent) * 8u), size);
     return vec4<f32>(p.x / size.x * 2.0 - 1.0, 1.0 - p.y / size.y * 2.0, 0.0, 1.0);
 }
 

@@ -611,12 +611,52 @@ fn tile_column(bits: u32, column: u32) -> vec2<u32> {
 // pixels next to foreground, which may hold a triangle the rasterizer missed (border_main
 // lists the background next to foreground in the guard band). Reads cost a lane per tile
 // less than a lane per pixel, and the lists' atomics are paid once a tile.
-@compute @workgroup_size(8, 8)
-fn classify_main(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let first = vec2<i32>(8u * gid.xy);
-    if !all(vec2<f32>(first) < frame.output_size) {
-        return;
+// In the result mode it also lists the composite's runs of drawn tiles
+// (`list_composite_runs`), a workgroup's rows of tiles at a time.
+@compute @workgroup_size(CLASSIFY_COLUMNS, CLASSIFY_ROWS)
+fn classify_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_id) local: vec3<u32>) {
+    var drawn = false;
+    if all(vec2<f32>(8u * gid.xy) < frame.output_size) {
+        drawn = classify_tile(gid.xy);
     }
+#if MODE_RESULT
+    list_composite_runs(gid.xy, local.xy, drawn);
+#endif
+}
+
+#if MODE_RESULT
+// Whether each tile of the workgroup's is drawn by the composite.
+var<workgroup> drawn_tiles: array<u32, CLASSIFY_COLUMNS * CLASSIFY_ROWS>;
+
+// Lists for composite.wgsl the runs of drawn tiles along each row of the workgroup's tiles,
+// a run an instance (tile x | (length - 1) << COMPOSITE_RUN_SHIFT | tile y << 16): a
+// software rasterizer sets up every triangle it draws, and a run of up to CLASSIFY_COLUMNS
+// tiles costs it what one tile does.
+fn list_composite_runs(tile: vec2<u32>, local: vec2<u32>, drawn: bool) {
+    let row = CLASSIFY_COLUMNS * local.y;
+    drawn_tiles[row + local.x] = select(0u, 1u, drawn);
+    workgroupBarrier();
+    if all(tile == vec2<u32>(0u)) {
+        atomicStore(&composite_rw.vertices, 6u);
+    }
+    if drawn && (local.x == 0u || drawn_tiles[row + local.x - 1u] == 0u) {
+        var length = 1u;
+        for (var k = local.x + 1u; k < CLASSIFY_COLUMNS; k++) {
+            if drawn_tiles[row + k] == 0u {
+                break;
+            }
+            length++;
+        }
+        let k = atomicAdd(&composite_rw.tiles, 1u);
+        atomicStore(&composite_rw.items[k], tile.x | ((length - 1u) << COMPOSITE_RUN_SHIFT) | (tile.y << 16u));
+    }
+}
+#endif
+
+// classify_main's work for one output tile inside the output; whether the composite draws
+// it (foreground, background the refine dispatch decides, the trace pass's lines).
+fn classify_tile(tile: vec2<u32>) -> bool {
+    let first = vec2<i32>(8u * tile);
     // The tile's columns and rows inside the output, a bit each.
     let room = vec2<i32>(frame.output_size) - first;
     let columns = select(0xffu, (1u << u32(room.x)) - 1u, room.x < 8);
@@ -655,25 +695,17 @@ fn classify_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let from_above = vec2<u32>((fg.x << 8u) | (top & 0xffu), (fg.y << 8u) | (fg.x >> 24u));
     let from_below = vec2<u32>((fg.x >> 8u) | (fg.y << 24u), (fg.y >> 8u) | (bottom << 24u));
     var listed = (from_left | from_right | from_above | from_below) & inside & ~fg;
-#if MODE_RESULT
-    // The tiles whose result may be other than transparent: foreground, background the
-    // refine dispatch decides, the trace pass's lines.
+    // Whether the tile's result may be other than transparent (only the result mode asks).
     var drawn = any((fg | listed) != vec2<u32>(0u));
+#if MODE_RESULT
 #if TRACED
     let columns_out = (u32(frame.output_size.x) + 7u) / 8u;
-    drawn = drawn || acc[traced_tile_marks() + gid.y * columns_out + gid.x] != 0u;
+    drawn = drawn || acc[traced_tile_marks() + tile.y * columns_out + tile.x] != 0u;
 #endif
-    if all(gid.xy == vec2<u32>(0u)) {
-        atomicStore(&composite_rw.vertices, 6u);
-    }
-    if drawn {
-        let k = atomicAdd(&composite_rw.tiles, 1u);
-        atomicStore(&composite_rw.items[k], gid.x | (gid.y << 16u));
-    }
 #endif
     if any(fg != vec2<u32>(0u)) {
         let k = atomicAdd(&tiles_rw.count, 1u);
-        atomicStore(&tiles_rw.items[k], gid.x | (gid.y << 16u));
+        atomicStore(&tiles_rw.items[k], tile.x | (tile.y << 16u));
         let size = list_size(k, 1u);
         atomicMax(&tiles_rw.x, size.x);
         atomicMax(&tiles_rw.y, size.y);
@@ -696,6 +728,7 @@ fn classify_main(@builtin(global_invocation_id) gid: vec3<u32>) {
             k++;
         }
     }
+    return drawn;
 }
 
 #if TRACED

@@ -15,6 +15,12 @@ use std::sync::{Arc, Mutex};
 
 /// Edge-pass workgroup side (8 × 8 pixels).
 pub(crate) const TILE: u32 = 8;
+/// Tiles of one `classify_main` workgroup, columns × rows: wide, because the composite
+/// draws each row's run of drawn tiles within a workgroup as one quad.
+pub(crate) const CLASSIFY_GROUP: (u32, u32) = (32, 2);
+/// Where a composite run's length (less one) starts in its word (`list_composite_runs`):
+/// above the tile column (at most 2 047 tiles, a 16 384-pixel output), below the row.
+pub(crate) const COMPOSITE_RUN_SHIFT: u32 = 11;
 
 pub(crate) struct EdgePipelines {
     /// Writes the pixels without a triangle, where no clear lays them down.
@@ -250,7 +256,10 @@ impl EdgePass {
                 "wirepass edge classify",
                 "edge.classify",
                 &edge.classify,
-                Size::Grid(columns.div_ceil(TILE), rows.div_ceil(TILE)),
+                Size::Grid(
+                    columns.div_ceil(CLASSIFY_GROUP.0),
+                    rows.div_ceil(CLASSIFY_GROUP.1),
+                ),
             ),
             (
                 "wirepass edge border",
