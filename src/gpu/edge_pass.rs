@@ -6,7 +6,7 @@
 
 use super::bindings::{dispatch, store_resources, Compute, Res, Size, Sources};
 use super::frame::FrameData;
-use super::targets::{self, Targets, LIST_HEADER, RESULT_FORMAT};
+use super::targets::{self, Targets, CLASSIFY_GROUP, LIST_HEADER, RESULT_FORMAT};
 use super::variants::{Mode, Variant};
 use super::{shaders, GpuTimer};
 use crate::error::{Error, Result};
@@ -15,12 +15,6 @@ use std::sync::{Arc, Mutex};
 
 /// Edge-pass workgroup side (8 × 8 pixels).
 pub(crate) const TILE: u32 = 8;
-/// Tiles of one `classify_main` workgroup, columns × rows: wide, because the composite
-/// draws each row's run of drawn tiles within a workgroup as one quad.
-pub(crate) const CLASSIFY_GROUP: (u32, u32) = (32, 2);
-/// Where a composite run's length (less one) starts in its word (`list_composite_runs`):
-/// above the tile column (at most 2 047 tiles, a 16 384-pixel output), below the row.
-pub(crate) const COMPOSITE_RUN_SHIFT: u32 = 11;
 
 pub(crate) struct EdgePipelines {
     /// Writes the pixels without a triangle, where no clear lays them down.

@@ -166,9 +166,9 @@ pub fn constants() -> String {
         ("QUAD_MASK_SHIFT", mr::QUAD_MASK_SHIFT),
         ("QUAD_NEXT", mr::QUAD_NEXT),
         ("QUAD_PREVIOUS", mr::QUAD_PREVIOUS),
-        ("CLASSIFY_COLUMNS", super::edge_pass::CLASSIFY_GROUP.0),
-        ("CLASSIFY_ROWS", super::edge_pass::CLASSIFY_GROUP.1),
-        ("COMPOSITE_RUN_SHIFT", super::edge_pass::COMPOSITE_RUN_SHIFT),
+        ("CLASSIFY_COLUMNS", super::targets::CLASSIFY_GROUP.0),
+        ("CLASSIFY_ROWS", super::targets::CLASSIFY_GROUP.1),
+        ("COMPOSITE_RUN_SHIFT", super::targets::COMPOSITE_RUN_SHIFT),
     ];
     let f32s: &[(&str, f64)] = &[
         ("NO_EDGE", f64::from(NO_EDGE)),

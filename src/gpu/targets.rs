@@ -78,6 +78,13 @@ pub const RESULT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 /// Size of the header (indirect dispatch size x, y, z, then a count) of the traced-tile
 /// and refine lists.
 pub(crate) const LIST_HEADER: u64 = 16;
+
+/// Tiles of one `classify_main` workgroup (edge_pass.wgsl), columns × rows: wide, because
+/// the composite draws each row's run of drawn tiles within a workgroup as one quad.
+pub(crate) const CLASSIFY_GROUP: (u32, u32) = (32, 2);
+/// Where a composite run's length (less one) starts in its word (`list_composite_runs`):
+/// above the tile column (at most 2 047 tiles, a 16 384-pixel output), below the row.
+pub(crate) const COMPOSITE_RUN_SHIFT: u32 = 11;
 /// Room in the trace pass's piece list: a piece per this many target pixels, and at least
 /// MIN_PIECES (a piece is at most 2 px of an outline edge, 1 px on a GPU; the 1280×720 views
 /// of a 200 k-triangle sphere and of stanford-bunny list 1 151 and 4 900 on lavapipe).
