@@ -85,6 +85,11 @@ pub(crate) const CLASSIFY_GROUP: (u32, u32) = (32, 2);
 /// Where a composite run's length (less one) starts in its word (`list_composite_runs`):
 /// above the tile column (at most 2 047 tiles, a 16 384-pixel output), below the row.
 pub(crate) const COMPOSITE_RUN_SHIFT: u32 = 11;
+
+// A run's length less one fills the bits between the column and the row (bit 16), and the
+// column field holds any tile column of a 16 384-pixel output.
+const _: () = assert!(CLASSIFY_GROUP.0 <= 1 << (16 - COMPOSITE_RUN_SHIFT));
+const _: () = assert!(16_384 / 8 <= 1 << COMPOSITE_RUN_SHIFT);
 /// Room in the trace pass's piece list: a piece per this many target pixels, and at least
 /// MIN_PIECES (a piece is at most 2 px of an outline edge, 1 px on a GPU; the 1280×720 views
 /// of a 200 k-triangle sphere and of stanford-bunny list 1 151 and 4 900 on lavapipe).
