@@ -5,7 +5,7 @@
 use crate::model::Model;
 use std::sync::{Arc, Mutex};
 use wirepass::camera::Orbit;
-use wirepass::gpu::{Composite, MeshId, PickView, Picked, PickedIds, RenderTarget};
+use wirepass::gpu::{Composite, Location, MeshId, PickView, Picked, PickedIds, RenderTarget};
 use wirepass::{
     wgpu, DeferredPass, EdgeSelection, Instance, MeshStore, OutputTarget, PassOptions, Scene,
     SectionPlane, Style,
@@ -46,35 +46,59 @@ pub fn adapter_options(
     Ok(options)
 }
 
-/// The device, the canvas surface and what draws into it.
-pub struct Gpu {
+/// Resolves once the GPU has finished the work submitted to `queue` so far.
+pub fn work_done(queue: &wgpu::Queue) -> impl std::future::Future<Output = ()> {
+    use std::task::{Poll, Waker};
+    #[derive(Default)]
+    struct State {
+        done: bool,
+        waker: Option<Waker>,
+    }
+    let state = Arc::new(Mutex::new(State::default()));
+    let signal = state.clone();
+    queue.on_submitted_work_done(move || {
+        if let Ok(mut s) = signal.lock() {
+            s.done = true;
+            if let Some(w) = s.waker.take() {
+                w.wake();
+            }
+        }
+    });
+    std::future::poll_fn(move |cx| match state.lock() {
+        Ok(s) if s.done => Poll::Ready(()),
+        Ok(mut s) => {
+            s.waker = Some(cx.waker().clone());
+            Poll::Pending
+        }
+        Err(_) => Poll::Ready(()),
+    })
+}
+
+/// One WebGPU device and what every view on the page shares of it: the adapter it came
+/// from, and the errors it reported on its own (WebGPU reports validation errors there,
+/// since a page cannot wait on an error scope), for the views to show.
+pub struct Device {
+    pub instance: wgpu::Instance,
+    pub adapter: wgpu::Adapter,
     pub device: wgpu::Device,
     pub queue: wgpu::Queue,
     /// The adapter, as the page names it.
-    pub adapter: String,
-    surface: wgpu::Surface<'static>,
-    config: wgpu::SurfaceConfiguration,
-    /// The sRGB view of the canvas's format, which the pass draws into.
-    view_format: wgpu::TextureFormat,
-    pass: DeferredPass,
-    store: MeshStore,
-    /// The store's id of each model mesh, uploaded with the current edge choice, and the
-    /// edges it draws.
-    ids: Vec<(MeshId, EdgeSelection)>,
-    /// The last frame drawn and its scene, which a click picks from.
-    last: Option<(wirepass::PreparedFrame, Scene<'static>)>,
-    /// What the device reported on its own (WebGPU reports validation errors there, since a
-    /// page cannot wait on an error scope), for the page to show.
+    pub name: String,
     pub errors: Arc<Mutex<Vec<String>>>,
 }
 
-impl Gpu {
-    /// Opens a device on `adapter` with `wgpu::Limits::default()` and configures the canvas.
-    pub async fn new(
-        adapter: &wgpu::Adapter,
-        surface: wgpu::Surface<'static>,
-        size: (u32, u32),
-    ) -> Result<Gpu, String> {
+impl Device {
+    /// Opens a device with `wgpu::Limits::default()` on the adapter `options` ask for.
+    pub async fn open(
+        instance: wgpu::Instance,
+        options: wgpu::RequestAdapterOptions<'_, '_>,
+    ) -> Result<Device, String> {
+        let adapter = instance.request_adapter(&options).await.map_err(|e| {
+            format!(
+                "This browser has WebGPU but gave no adapter ({e}): it may be switched off \
+                 for this GPU or driver."
+            )
+        })?;
         let (device, queue) = adapter
             .request_device(&wgpu::DeviceDescriptor {
                 label: Some("wirepass page"),
@@ -100,8 +124,62 @@ impl Gpu {
                 v.push(e);
             }
         });
+        let info = adapter.get_info();
+        let name = [
+            info.name.as_str(),
+            info.driver.as_str(),
+            info.driver_info.as_str(),
+        ]
+        .into_iter()
+        .find(|s| !s.is_empty())
+        .unwrap_or("unnamed adapter")
+        .to_string();
+        Ok(Device {
+            instance,
+            adapter,
+            device,
+            queue,
+            name,
+            errors,
+        })
+    }
+}
+
+/// A canvas of the page, the device's surface on it, and what draws into it.
+pub struct Gpu {
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    /// The adapter, as the page names it.
+    pub adapter: String,
+    surface: wgpu::Surface<'static>,
+    config: wgpu::SurfaceConfiguration,
+    /// The sRGB view of the canvas's format, which the pass draws into.
+    view_format: wgpu::TextureFormat,
+    pass: DeferredPass,
+    store: MeshStore,
+    /// The store's id of each model mesh, uploaded with the current edge choice, and the
+    /// edges it draws.
+    ids: Vec<(MeshId, EdgeSelection)>,
+    /// The last frame drawn and its scene, which a click picks from.
+    last: Option<(wirepass::PreparedFrame, Scene<'static>)>,
+    /// The device's own error reports, shared by every canvas on it.
+    pub errors: Arc<Mutex<Vec<String>>>,
+}
+
+impl Gpu {
+    /// Shows `shared`'s device on `canvas`, `size` pixels.
+    pub fn new(
+        shared: &Device,
+        canvas: web_sys::HtmlCanvasElement,
+        size: (u32, u32),
+    ) -> Result<Gpu, String> {
+        let surface = shared
+            .instance
+            .create_surface(wgpu::SurfaceTarget::Canvas(canvas))
+            .map_err(|e| format!("the canvas cannot show WebGPU: {e}"))?;
+        let device = shared.device.clone();
         let mut config = surface
-            .get_default_config(adapter, size.0.max(1), size.1.max(1))
+            .get_default_config(&shared.adapter, size.0.max(1), size.1.max(1))
             .ok_or("the canvas cannot be drawn to by this adapter")?;
         // Draw through an sRGB view of the canvas's format (WebGPU canvases have no sRGB
         // format of their own), so colours match the native tools' PNGs.
@@ -124,28 +202,18 @@ impl Gpu {
             },
         )
         .map_err(|e| e.to_string())?;
-        let info = adapter.get_info();
-        let adapter = [
-            info.name.as_str(),
-            info.driver.as_str(),
-            info.driver_info.as_str(),
-        ]
-        .into_iter()
-        .find(|s| !s.is_empty())
-        .unwrap_or("unnamed adapter")
-        .to_string();
         Ok(Gpu {
             store: MeshStore::new(&device),
             device,
-            queue,
-            adapter,
+            queue: shared.queue.clone(),
+            adapter: shared.name.clone(),
             surface,
             config,
             view_format,
             pass,
             ids: Vec::new(),
             last: None,
-            errors,
+            errors: shared.errors.clone(),
         })
     }
 
@@ -283,6 +351,27 @@ impl Gpu {
         Ok(())
     }
 
+    /// Draws a frame of `model`'s first instance in `style` into a small offscreen texture,
+    /// so that the browser's GPU process builds and compiles the pipelines that frames of one
+    /// mesh (most files) use while the page fetches and reads a file. Asking for the pipelines
+    /// alone (`DeferredPass::warm_up`) saved less: the shaders compile at their first
+    /// dispatch. Warming the many-instance frames too made a 1 M-triangle GLB's first frame
+    /// slower: the GPU process was busy with pipelines that frame did not use.
+    pub fn warm_up(&mut self, model: &Model, orbit: &Orbit, style: &Style) -> Result<(), String> {
+        let Some(&first) = model.instances.first() else {
+            return Ok(());
+        };
+        let one = Model {
+            name: String::new(),
+            meshes: Vec::new(),
+            instances: vec![first],
+        };
+        let texture = self.offscreen((64, 48));
+        self.record(&texture, &one, orbit, style, &[])?;
+        self.last = None;
+        Ok(())
+    }
+
     /// Starts reading what pixel `at` of the last frame shows; the future holds no borrow
     /// of the page's state.
     pub fn read_pick(
@@ -296,18 +385,19 @@ impl Gpu {
             .map_err(|e| e.to_string())
     }
 
-    /// What pixel `at` of the last frame shows, in words, from its ids read back.
-    pub fn describe_pick(
+    /// What pixel `at` of the last frame shows, from its ids read back: the instance and
+    /// where its surface is, exactly (the triangle, point and normal, and the drawn edge
+    /// and vertex within 8 pixels to snap to); `None` for the background.
+    pub fn locate_pick(
         &self,
         model: &Model,
         ids: &PickedIds,
         at: (u32, u32),
-    ) -> Result<String, String> {
+    ) -> Result<Option<(usize, Location)>, String> {
         let (frame, scene) = self.last.as_ref().ok_or("nothing is drawn yet")?;
         let err = |e: wirepass::Error| e.to_string();
         let hit = match ids.first(&self.store, scene).map_err(err)? {
-            Picked::Background => return Ok(format!("({}, {}): background", at.0, at.1)),
-            Picked::Host => return Ok(format!("({}, {}): the host", at.0, at.1)),
+            Picked::Background | Picked::Host => return Ok(None),
             Picked::Instance(hit) => hit,
         };
         let (m, _) = model.instances[hit.instance];
@@ -320,18 +410,7 @@ impl Gpu {
         let l = hit
             .locate(&model.meshes[m].0, &view, at, 8.0)
             .map_err(err)?;
-        let mut words = format!(
-            "instance {}, triangle {} (polygon {}) at ({:.4}, {:.4}, {:.4})",
-            hit.instance, l.triangle, l.polygon, l.point.x, l.point.y, l.point.z
-        );
-        if let Some(e) = l.edge {
-            let [a, b] = e.vertices;
-            words += &format!("; edge {a}-{b} at {:.1} px", e.distance_px);
-        }
-        if let Some(v) = l.vertex {
-            words += &format!("; vertex {} at {:.1} px", v.vertex, v.distance_px);
-        }
-        Ok(words)
+        Ok(Some((hit.instance, l)))
     }
 
     /// Reads `texture` (of the canvas's format) back as RGBA8, sRGB.

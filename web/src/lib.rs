@@ -15,8 +15,10 @@
 //! are the hooks the browser tests read the page through.
 #![cfg(target_arch = "wasm32")]
 
+mod element;
 mod gpu;
 mod model;
+mod settings;
 
 use gpu::{Gpu, EDGES};
 use model::Model;
@@ -26,17 +28,24 @@ use wasm_bindgen::prelude::*;
 use wasm_bindgen::JsCast;
 use web_sys::{HtmlCanvasElement, HtmlElement, HtmlInputElement, HtmlSelectElement};
 use wirepass::camera::Orbit;
-use wirepass::{wgpu, SectionPlane, Style};
+use wirepass::gpu::Location;
+use wirepass::{wgpu, EdgeSelection, SectionPlane, Style};
 
 /// The page's state: what is shown, how, and the pointers on the canvas.
 struct App {
     gpu: Gpu,
     canvas: HtmlCanvasElement,
-    status: HtmlElement,
+    /// The page's status line, where there is one.
+    status: Option<HtmlElement>,
+    /// The element that gets the view's `load`, `pick` and `error` events, where there is one.
+    host: Option<HtmlElement>,
     model: Model,
     orbit: Orbit,
+    /// The camera the view starts from ([`settings::orbit`]), kept for `fit`.
+    camera: String,
     style: Style,
-    edges: usize,
+    /// The edges every mesh draws; `None`: each file's own.
+    edges: Option<EdgeSelection>,
     /// Which of [`HIDDEN`] the style draws.
     hidden: usize,
     /// The section planes `S` placed.
@@ -49,6 +58,10 @@ struct App {
     picked: Option<String>,
     /// A frame is requested and not drawn yet.
     pending: bool,
+    /// A model was shown and no frame of it drawn yet: the next frame raises `load`.
+    announce: bool,
+    /// Nothing is shown yet: an element draws nothing until its first model is read.
+    hold: bool,
     frames: u32,
     /// The last error shown on the page.
     error: Option<String>,
@@ -90,21 +103,7 @@ impl Viewer {
     /// The current view drawn again into a texture of the canvas's size and format and read
     /// back: RGBA8, sRGB, row 0 at the top (`width × height × 4` bytes).
     pub async fn snapshot(&self) -> Result<Vec<u8>, JsValue> {
-        let read = {
-            let mut app = self.app.borrow_mut();
-            let app = &mut *app;
-            let texture = app.gpu.offscreen(app.gpu.size());
-            app.gpu
-                .record(&texture, &app.model, &app.orbit, &app.style, &app.sections)
-                .map_err(JsValue::from)?;
-            app.gpu.read(&texture)
-        };
-        read.await.map_err(|e| {
-            // What the device reported says why a readback failed.
-            let mut all = self.app.borrow().gpu.take_errors();
-            all.insert(0, e);
-            JsValue::from(all.join("; "))
-        })
+        snapshot(&self.app).await
     }
 
     /// The canvas's width in pixels.
@@ -174,15 +173,7 @@ impl App {
     async fn new(root: &HtmlElement) -> Result<App, String> {
         let js = |e: JsValue| format!("{e:?}");
         let window = web_sys::window().ok_or("no window")?;
-        let gpu_object = js_sys::Reflect::get(&window.navigator(), &"gpu".into()).map_err(js)?;
-        if gpu_object.is_undefined() {
-            return Err(
-                "This browser has no WebGPU (navigator.gpu is missing), which the \
-                        viewer needs for its compute shaders; WebGL2 has none. Try a recent \
-                        Chrome, Edge or Firefox, or Safari 26."
-                    .into(),
-            );
-        }
+        let gpu_object = webgpu_present()?;
         let search = window.location().search().map_err(js)?;
         let params = web_sys::UrlSearchParams::new_with_str(&search).map_err(js)?;
         let options = gpu::adapter_options(params.get("adapter").as_deref())?;
@@ -205,49 +196,53 @@ impl App {
             rs.set_property(k, v).map_err(js)?;
         }
         root.replace_children_with_node_2(&controls, &canvas);
-        let size = canvas_size(&canvas);
-        canvas.set_width(size.0);
-        canvas.set_height(size.1);
 
         let instance = wgpu::Instance::new(wgpu::InstanceDescriptor {
             backends: wgpu::Backends::BROWSER_WEBGPU,
             ..wgpu::InstanceDescriptor::new_without_display_handle()
         });
-        let surface = instance
-            .create_surface(wgpu::SurfaceTarget::Canvas(canvas.clone()))
-            .map_err(|e| format!("the canvas cannot show WebGPU: {e}"))?;
-        let adapter = instance
-            .request_adapter(&wgpu::RequestAdapterOptions {
-                compatible_surface: Some(&surface),
-                ..options
-            })
-            .await
-            .map_err(|e| {
-                format!("This browser has WebGPU but gave no adapter ({e}): it may be switched off for this GPU or driver.")
-            })?;
-        let mut gpu = Gpu::new(&adapter, surface, size).await?;
+        let mut shared = gpu::Device::open(instance, options).await?;
         if let Some(name) =
             browser_adapter_name(&gpu_object, params.get("adapter").as_deref()).await
         {
-            gpu.adapter = name;
+            shared.name = name;
         }
+        App::on(&shared, canvas, Some(status), None)
+    }
+
+    /// A view of the built-in scene on `canvas`, drawn by `shared`'s device; `status` (the
+    /// page's toolbar) says what is shown, `host` (an element) gets the view's events.
+    fn on(
+        shared: &gpu::Device,
+        canvas: HtmlCanvasElement,
+        status: Option<HtmlElement>,
+        host: Option<HtmlElement>,
+    ) -> Result<App, String> {
+        let size = canvas_size(&canvas);
+        canvas.set_width(size.0);
+        canvas.set_height(size.1);
+        let mut gpu = Gpu::new(shared, canvas.clone(), size)?;
         let model = Model::builtin().map_err(|e| e.to_string())?;
-        gpu.upload(&model, EDGES[0].1)?;
+        gpu.upload(&model, None)?;
         let (lo, hi) = model.bounds();
         Ok(App {
             gpu,
             canvas,
             status,
+            host,
             orbit: Orbit::framing(lo, hi),
+            camera: String::new(),
             model,
             style: Style::default(),
-            edges: 0,
+            edges: None,
             hidden: 0,
             sections: Vec::new(),
             pointers: Vec::new(),
             press: None,
             picked: None,
             pending: false,
+            announce: false,
+            hold: false,
             frames: 0,
             error: None,
         })
@@ -255,6 +250,9 @@ impl App {
 
     /// Draws a frame into the canvas, sized to its box on the page.
     fn draw(&mut self) {
+        if self.hold {
+            return;
+        }
         let size = canvas_size(&self.canvas);
         if (self.canvas.width(), self.canvas.height()) != size {
             self.canvas.set_width(size.0);
@@ -275,18 +273,48 @@ impl App {
                 if self.error.is_none() {
                     self.show_status();
                 }
+                if std::mem::take(&mut self.announce) {
+                    let detail = js_sys::Object::new();
+                    set(&detail, "name", &self.model.name.as_str().into());
+                    set(
+                        &detail,
+                        "triangles",
+                        &(self.model.triangles() as f64).into(),
+                    );
+                    // `load` says the model is on screen: once the GPU has drawn the frame.
+                    let done = gpu::work_done(&self.gpu.queue);
+                    if let Some(host) = self.host.clone() {
+                        wasm_bindgen_futures::spawn_local(async move {
+                            done.await;
+                            dispatch(&host, "load", detail.into());
+                        });
+                    }
+                }
             }
         }
     }
 
+    /// Raises `event` with `detail` on the host element, once the caller's borrow of the
+    /// view has ended (its listeners may call the view).
+    fn emit(&self, event: &str, detail: JsValue) {
+        let Some(host) = self.host.clone() else {
+            return;
+        };
+        let event = event.to_string();
+        wasm_bindgen_futures::spawn_local(async move { dispatch(&host, &event, detail) });
+    }
+
     fn show_status(&self) {
+        let Some(status) = &self.status else {
+            return;
+        };
         let (w, h) = self.gpu.size();
-        self.status.set_text_content(Some(&format!(
+        status.set_text_content(Some(&format!(
             "{}: {} triangles, {} edges, outlines {}, hidden {}, sections {}, width {:.1}; \
              {w}×{h} on {}",
             self.model.name,
             self.model.triangles(),
-            EDGES[self.edges].0,
+            settings::edges_name(self.edges),
             if self.style.outlines { "on" } else { "off" },
             HIDDEN[self.hidden].0,
             self.sections.len(),
@@ -300,7 +328,7 @@ impl App {
     fn drawing_svg(&self) -> Result<String, String> {
         use wirepass::drawing::{Drawing, Page};
         use wirepass::world::{Object, Shot, World, WorldMesh};
-        let edges = EDGES[self.edges].1;
+        let edges = self.edges;
         let meshes = self
             .model
             .meshes
@@ -336,9 +364,15 @@ impl App {
         Ok(drawing.to_svg(&Page::pixels()))
     }
 
+    /// Says what went wrong: in the status line, or as the host element's `error` event.
     fn show_error(&mut self, message: &str) {
         web_sys::console::error_1(&message.into());
-        self.status.set_text_content(Some(message));
+        if let Some(status) = &self.status {
+            status.set_text_content(Some(message));
+        }
+        let detail = js_sys::Object::new();
+        set(&detail, "message", &message.into());
+        self.emit("error", detail.into());
         self.error = Some(message.into());
     }
 
@@ -350,11 +384,23 @@ impl App {
         });
     }
 
-    fn set_edges(&mut self, edges: usize) {
-        self.edges = edges % EDGES.len();
-        if let Err(e) = self.gpu.upload(&self.model, EDGES[self.edges].1) {
+    /// Draws `edges` on every mesh (`None`: each file's own).
+    fn set_edges(&mut self, edges: Option<EdgeSelection>) -> Result<(), String> {
+        self.gpu.upload(&self.model, edges)?;
+        self.edges = edges;
+        Ok(())
+    }
+
+    /// The page's edge choice `index` of [`EDGES`].
+    fn choose_edges(&mut self, index: usize) {
+        if let Err(e) = self.set_edges(EDGES[index % EDGES.len()].1) {
             self.show_error(&e);
         }
+    }
+
+    /// The index in [`EDGES`] of the edges drawn (0 where the page offers no such choice).
+    fn edge_index(&self) -> usize {
+        EDGES.iter().position(|e| e.1 == self.edges).unwrap_or(0)
     }
 
     fn pointer_moved(&mut self, id: i32, x: f64, y: f64, shift: bool) {
@@ -511,36 +557,40 @@ fn schedule(app: &Shared) {
 /// Replaces the model with a file's, framed anew; an unreadable file is an error on the
 /// page and leaves the model as it was.
 fn show_file(app: &Shared, name: &str, bytes: &[u8]) -> Result<(), String> {
-    let loaded = Model::from_file(name, bytes).map_err(|e| format!("{name}: {e}"));
+    let loaded =
+        Model::from_file(name, bytes, &model::Resources::new()).map_err(|e| format!("{name}: {e}"));
     show(app, loaded)
 }
 
-/// Shows `loaded`, framed anew, or its error.
+/// Shows `loaded`, framed anew (by the view's camera setting), or says why not; the model
+/// stays as it was then.
 fn show(app: &Shared, loaded: Result<Model, String>) -> Result<(), String> {
-    let result = {
-        let mut a = app.borrow_mut();
-        let a = &mut *a;
-        match loaded.and_then(|model| {
-            let edges = EDGES[a.edges].1;
-            a.gpu.upload(&model, edges).map(|()| model)
-        }) {
-            Ok(model) => {
-                let (lo, hi) = model.bounds();
-                a.orbit = Orbit::framing(lo, hi);
-                a.model = model;
-                a.error = None;
-                Ok(())
-            }
-            Err(e) => {
-                // The old model's meshes went with the failed upload: put them back.
-                let restored = a.gpu.upload(&a.model, EDGES[a.edges].1);
-                a.show_error(&e);
-                restored.and(Err(e))
-            }
-        }
-    };
+    let result = replace_model(app, loaded);
+    if let Err(e) = &result {
+        app.borrow_mut().show_error(e);
+    }
     schedule(app);
     result
+}
+
+/// Replaces the model with `loaded`, framed anew; an error leaves the old one, and is
+/// returned, not shown.
+fn replace_model(app: &Shared, loaded: Result<Model, String>) -> Result<(), String> {
+    let mut a = app.borrow_mut();
+    let a = &mut *a;
+    let model = loaded?;
+    let orbit = settings::orbit(&a.camera, model.bounds())?;
+    if let Err(e) = a.gpu.upload(&model, a.edges) {
+        // The old model's meshes went with the failed upload: put them back.
+        a.gpu.upload(&a.model, a.edges)?;
+        return Err(e);
+    }
+    a.orbit = orbit;
+    a.model = model;
+    a.error = None;
+    a.announce = true;
+    a.hold = false;
+    Ok(())
 }
 
 /// Reads a dropped or picked file and shows it.
@@ -576,20 +626,24 @@ fn pick(app: &Shared, x: f64, y: f64) {
     };
     let app = app.clone();
     wasm_bindgen_futures::spawn_local(async move {
-        let said = match read {
+        let found = match read {
             Ok(read) => match read.await {
                 Ok(ids) => {
                     let a = app.borrow();
-                    a.gpu.describe_pick(&a.model, &ids, at)
+                    a.gpu.locate_pick(&a.model, &ids, at)
                 }
                 Err(e) => Err(e.to_string()),
             },
             Err(e) => Err(e),
         };
         let mut a = app.borrow_mut();
-        match said {
-            Ok(words) => {
-                a.status.set_text_content(Some(&format!("picked {words}")));
+        match found {
+            Ok(found) => {
+                let words = pick_words(at, found.as_ref());
+                if let Some(status) = &a.status {
+                    status.set_text_content(Some(&format!("picked {words}")));
+                }
+                a.emit("pick", pick_detail(at, found.as_ref()));
                 a.picked = Some(words);
             }
             Err(e) => a.show_error(&format!("pick: {e}")),
@@ -597,16 +651,131 @@ fn pick(app: &Shared, x: f64, y: f64) {
     });
 }
 
-/// Adds `handler` for `event` on `target` for the page's lifetime.
+/// Raises the custom event `event` with `detail` on `host`.
+fn dispatch(host: &HtmlElement, event: &str, detail: JsValue) {
+    let init = web_sys::CustomEventInit::new();
+    init.set_detail(&detail);
+    if let Ok(e) = web_sys::CustomEvent::new_with_event_init_dict(event, &init) {
+        let _ = host.dispatch_event(&e);
+    }
+}
+
+/// The browser's `navigator.gpu`, or why there is none.
+fn webgpu_present() -> Result<JsValue, String> {
+    let window = web_sys::window().ok_or("no window")?;
+    let gpu = js_sys::Reflect::get(&window.navigator(), &"gpu".into()).unwrap_or_default();
+    if gpu.is_undefined() {
+        return Err(
+            "This browser has no WebGPU (navigator.gpu is missing), which the \
+                    viewer needs for its compute shaders; WebGL2 has none. Try a recent \
+                    Chrome, Edge or Firefox, or Safari 26."
+                .into(),
+        );
+    }
+    Ok(gpu)
+}
+
+/// `app`'s current view drawn again into a texture of the canvas's size and format and
+/// read back: RGBA8, sRGB, row 0 at the top.
+async fn snapshot(app: &Shared) -> Result<Vec<u8>, JsValue> {
+    let read = {
+        let mut a = app.borrow_mut();
+        let a = &mut *a;
+        let texture = a.gpu.offscreen(a.gpu.size());
+        a.gpu
+            .record(&texture, &a.model, &a.orbit, &a.style, &a.sections)
+            .map_err(JsValue::from)?;
+        a.gpu.read(&texture)
+    };
+    read.await.map_err(|e| {
+        // What the device reported says why a readback failed.
+        let mut all = app.borrow().gpu.take_errors();
+        all.insert(0, e);
+        JsValue::from(all.join("; "))
+    })
+}
+
+/// What a pick at pixel `at` of `app`'s canvas found, in words.
+fn pick_words(at: (u32, u32), found: Option<&(usize, Location)>) -> String {
+    let Some((instance, l)) = found else {
+        return format!("({}, {}): background", at.0, at.1);
+    };
+    let mut words = format!(
+        "instance {instance}, triangle {} (polygon {}) at ({:.4}, {:.4}, {:.4})",
+        l.triangle, l.polygon, l.point.x, l.point.y, l.point.z
+    );
+    if let Some(e) = l.edge {
+        let [a, b] = e.vertices;
+        words += &format!("; edge {a}-{b} at {:.1} px", e.distance_px);
+    }
+    if let Some(v) = l.vertex {
+        words += &format!("; vertex {} at {:.1} px", v.vertex, v.distance_px);
+    }
+    words
+}
+
+/// What a pick at pixel `at` found, as the `pick` event's `detail`: `pixel`, and for a
+/// surface `instance`, `triangle`, `polygon`, `point`, `normal`, `edge` (`vertices`,
+/// `point`, `distance`, in pixels) and `vertex` (`index`, `position`, `distance`), the
+/// last two `null` where nothing is within 8 pixels; `instance` is `null` on the
+/// background.
+fn pick_detail(at: (u32, u32), found: Option<&(usize, Location)>) -> JsValue {
+    let detail = js_sys::Object::new();
+    let xyz = |v: wirepass::glam::DVec3| -> JsValue {
+        js_sys::Array::of3(&v.x.into(), &v.y.into(), &v.z.into()).into()
+    };
+    set(
+        &detail,
+        "pixel",
+        &js_sys::Array::of2(&at.0.into(), &at.1.into()),
+    );
+    let Some((instance, l)) = found else {
+        set(&detail, "instance", &JsValue::NULL);
+        return detail.into();
+    };
+    set(&detail, "instance", &(*instance as f64).into());
+    set(&detail, "triangle", &l.triangle.into());
+    set(&detail, "polygon", &l.polygon.into());
+    set(&detail, "point", &xyz(l.point));
+    set(&detail, "normal", &xyz(l.normal));
+    let edge = l.edge.map_or(JsValue::NULL, |e| {
+        let o = js_sys::Object::new();
+        let [a, b] = e.vertices;
+        set(&o, "vertices", &js_sys::Array::of2(&a.into(), &b.into()));
+        set(&o, "point", &xyz(e.point));
+        set(&o, "distance", &e.distance_px.into());
+        o.into()
+    });
+    set(&detail, "edge", &edge);
+    let vertex = l.vertex.map_or(JsValue::NULL, |v| {
+        let o = js_sys::Object::new();
+        set(&o, "index", &v.vertex.into());
+        set(&o, "position", &xyz(v.position));
+        set(&o, "distance", &v.distance_px.into());
+        o.into()
+    });
+    set(&detail, "vertex", &vertex);
+    detail.into()
+}
+
+/// Sets `object[key] = value` (on a fresh object, which cannot fail).
+fn set(object: &js_sys::Object, key: &str, value: &JsValue) {
+    let _ = js_sys::Reflect::set(object, &key.into(), value);
+}
+
+/// Adds `handler` for `event` on `target` for as long as the view lives (the listener holds
+/// no reference that keeps a removed element's view alive).
 fn listen<E: JsCast>(
     target: &web_sys::EventTarget,
     event: &str,
     app: &Shared,
     handler: impl Fn(&Shared, E) + 'static,
 ) -> Result<(), JsValue> {
-    let app = app.clone();
+    let app = Rc::downgrade(app);
     let closure = Closure::<dyn Fn(web_sys::Event)>::new(move |e: web_sys::Event| {
-        handler(&app, e.unchecked_into())
+        if let Some(app) = app.upgrade() {
+            handler(&app, e.unchecked_into())
+        }
     });
     target.add_event_listener_with_callback(event, closure.as_ref().unchecked_ref())?;
     closure.forget();
@@ -765,7 +934,7 @@ fn wire_toolbar(app: &Shared, root: &HtmlElement) -> Result<(), JsValue> {
             },
         )
     };
-    on_select("edges", App::set_edges)?;
+    on_select("edges", App::choose_edges)?;
     on_select("hidden", App::set_hidden)?;
     listen(
         &control(root, "outlines")?,
@@ -821,9 +990,9 @@ fn wire_keys(app: &Shared, root: &HtmlElement) -> Result<(), JsValue> {
                 let mut a = app.borrow_mut();
                 match e.key().as_str() {
                     "e" | "E" => {
-                        let next = a.edges + 1;
-                        a.set_edges(next);
-                        select("edges", a.edges);
+                        let next = a.edge_index() + 1;
+                        a.choose_edges(next);
+                        select("edges", a.edge_index());
                     }
                     "h" | "H" => {
                         let next = a.hidden + 1;

@@ -1,10 +1,14 @@
 //! What the page shows: the built-in scene, or a mesh file read from its bytes (a browser has
 //! no file system: files come by the file picker or drag and drop).
 
+use std::collections::HashMap;
 use std::path::Path;
 use wirepass::glam::{DMat4, DVec3};
 use wirepass::mesh::formats::gltf::load_gltf_bytes;
 use wirepass::{EdgeSelection, Mesh};
+
+/// The files a `.gltf` names beside it (its external buffers), by URI as it writes them.
+pub type Resources = HashMap<String, Vec<u8>>;
 
 /// Meshes placed as instances, as a file describes them.
 pub struct Model {
@@ -27,20 +31,29 @@ impl Model {
         })
     }
 
-    /// Reads a `.glb`, `.gltf` (its buffers embedded), `.obj`, `.stl` or `.ply` file, the
-    /// loader chosen by `name`'s extension. A glTF scene keeps its instances and authored
-    /// edges; every other format is one mesh at the origin.
-    pub fn from_file(name: &str, bytes: &[u8]) -> Result<Model, wirepass::Error> {
+    /// Reads a `.glb`, `.gltf`, `.obj`, `.stl` or `.ply` file, the loader chosen by `name`'s
+    /// extension; a `.gltf`'s external buffers come from `resources`, by their URI as the
+    /// file writes it. A glTF scene keeps its instances and authored edges; every other
+    /// format is one mesh at the origin.
+    pub fn from_file(
+        name: &str,
+        bytes: &[u8],
+        resources: &Resources,
+    ) -> Result<Model, wirepass::Error> {
         let path = Path::new(name);
         let ext = path
             .extension()
             .map(|e| e.to_string_lossy().to_ascii_lowercase());
         if matches!(ext.as_deref(), Some("gltf" | "glb")) {
-            let doc = load_gltf_bytes(path, bytes, &mut |uri: &str| {
-                Err(format!(
+            let doc = load_gltf_bytes(path, bytes, &mut |uri: &str| match resources.get(uri) {
+                Some(bytes) => Ok(bytes.clone()),
+                None if resources.is_empty() => Err(format!(
                     "names the external buffer {uri:?}, which a page cannot fetch beside a \
                      dropped file: use a .glb, or a .gltf with its buffers embedded"
-                ))
+                )),
+                None => Err(format!(
+                    "names the external buffer {uri:?}, which was not fetched"
+                )),
             })?;
             return Ok(Model {
                 name: name.into(),
