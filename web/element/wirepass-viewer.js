@@ -207,7 +207,13 @@ export class WirepassViewer extends HTMLElement {
       const reading = performance.now();
       performance.measure("wirepass-viewer: fetch", { start: fetching, end: reading });
       this.#view.load(name, bytes, uris, buffers);
-      performance.measure("wirepass-viewer: read and upload", { start: reading });
+      const drawing = performance.now();
+      performance.measure("wirepass-viewer: read and upload", { start: reading, end: drawing });
+      this.addEventListener(
+        "load",
+        () => performance.measure("wirepass-viewer: first frame", { start: drawing }),
+        { once: true },
+      );
     } catch (e) {
       if (!load.signal.aborted) this.#fail(e);
     } finally {
