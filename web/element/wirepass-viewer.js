@@ -99,7 +99,7 @@ export class WirepassViewer extends HTMLElement {
     this.#progress = root.querySelector(".progress");
     this.#resize = new ResizeObserver(() => this.#view?.resize());
     // Every error, the view's and the element's, shows in the element's box.
-    this.addEventListener("error", (e) => this.#show(e.detail?.message ?? "error"));
+    this.addEventListener("error", (e) => this.#say(e.detail?.message ?? "error"));
   }
 
   connectedCallback() {
@@ -128,6 +128,9 @@ export class WirepassViewer extends HTMLElement {
   }
 
   async #start() {
+    // The download starts at once, beside the WebAssembly and the device.
+    const src = this.getAttribute("src");
+    const download = src === null ? null : this.#download(src);
     let gpu;
     try {
       const starting = performance.now();
@@ -137,22 +140,26 @@ export class WirepassViewer extends HTMLElement {
       this.#view = new ElementView(gpu, this, this.#canvas);
       performance.measure("wirepass-viewer: view", { start: opened });
     } catch (e) {
+      download?.load.abort();
       this.#fail(e);
       return;
     }
     for (const name of ATTRIBUTES) {
       if (this.hasAttribute(name)) this.#set(name, this.getAttribute(name));
     }
-    if (this.hasAttribute("src")) {
-      this.#open(this.getAttribute("src"));
-      // The GPU builds the pipelines while the file is fetched and read.
+    const now = this.getAttribute("src");
+    if (now === null) {
+      download?.load.abort();
+      this.#builtin();
+    } else {
+      // The GPU compiles the pipelines while the file arrives and is read.
       try {
-        this.#view.warm_up();
+        this.#view.warm_up(new URL(now, document.baseURI).pathname);
       } catch (e) {
         console.warn(e);
       }
-    } else {
-      this.#builtin();
+      // `src` may have changed while the device opened.
+      this.#show(now === src ? download : this.#download(now));
     }
   }
 
@@ -186,7 +193,12 @@ export class WirepassViewer extends HTMLElement {
     }
   }
 
-  async #open(src) {
+  #open(src) {
+    this.#show(this.#download(src));
+  }
+
+  // Starts fetching `src` (and a .gltf's buffers), ending any download before.
+  #download(src) {
     this.#load?.abort();
     const load = (this.#load = new AbortController());
     this.#message.classList.remove("shown");
@@ -194,7 +206,7 @@ export class WirepassViewer extends HTMLElement {
       this.#progress.classList.add("shown");
       this.#progress.style.width = total ? `${(100 * read) / total}%` : "50%";
     };
-    try {
+    const files = (async () => {
       const url = new URL(src, document.baseURI);
       // Where the time to the first image goes, in the browser's performance timeline.
       const fetching = performance.now();
@@ -203,9 +215,20 @@ export class WirepassViewer extends HTMLElement {
       const [uris, buffers] = name.toLowerCase().endsWith(".gltf")
         ? await gltfBuffers(bytes, url, load.signal, progress)
         : [[], []];
+      performance.measure("wirepass-viewer: fetch", { start: fetching });
+      return { name, bytes, uris, buffers };
+    })();
+    // Its failure is reported when it is shown (or not at all, once aborted).
+    files.catch(() => {});
+    return { load, files };
+  }
+
+  // Shows a download once it has arrived.
+  async #show({ load, files }) {
+    try {
+      const { name, bytes, uris, buffers } = await files;
       if (load.signal.aborted || !this.#view) return;
       const reading = performance.now();
-      performance.measure("wirepass-viewer: fetch", { start: fetching, end: reading });
       this.#view.load(name, bytes, uris, buffers);
       const drawing = performance.now();
       performance.measure("wirepass-viewer: read and upload", { start: reading, end: drawing });
@@ -226,7 +249,7 @@ export class WirepassViewer extends HTMLElement {
     this.dispatchEvent(new CustomEvent("error", { detail: { message } }));
   }
 
-  #show(message) {
+  #say(message) {
     this.#message.textContent = message;
     this.#message.classList.add("shown");
   }

@@ -13,7 +13,7 @@ use std::rc::Rc;
 use wasm_bindgen::prelude::*;
 use web_sys::{HtmlCanvasElement, HtmlElement};
 use wirepass::camera::Orbit;
-use wirepass::wgpu;
+use wirepass::{wgpu, EdgeSelection};
 
 /// The WebGPU device the page's elements share: one adapter, one device, one queue.
 #[wasm_bindgen]
@@ -121,11 +121,19 @@ impl ElementView {
     }
 
     /// Draws a small frame in the current style offscreen, so that the browser builds and
-    /// compiles the pipelines while the element fetches and reads its file.
-    pub fn warm_up(&self) -> Result<(), JsValue> {
+    /// compiles the pipelines while the element fetches and reads the file `name`: with the
+    /// edges such a file likely draws (each triangle's own where its format has no polygons
+    /// and the element draws the file's edges, which decides which pipelines a frame uses).
+    pub fn warm_up(&self, name: &str) -> Result<(), JsValue> {
         let mut a = self.app.borrow_mut();
         let a = &mut *a;
-        Ok(a.gpu.warm_up(&a.model, &a.orbit, &a.style)?)
+        let ext = name.rsplit('.').next().unwrap_or("").to_ascii_lowercase();
+        let likely = a.edges.unwrap_or(match ext.as_str() {
+            "glb" | "gltf" | "stl" => EdgeSelection::All,
+            _ => EdgeSelection::Polygon,
+        });
+        Ok(a.gpu
+            .warm_up(&a.model, (a.edges, likely), &a.orbit, &a.style)?)
     }
 
     /// Frames the model again as the camera setting has it, undoing orbit, pan and zoom.

@@ -351,13 +351,21 @@ impl Gpu {
         Ok(())
     }
 
-    /// Draws a frame of `model`'s first instance in `style` into a small offscreen texture,
-    /// so that the browser's GPU process builds and compiles the pipelines that frames of one
-    /// mesh (most files) use while the page fetches and reads a file. Asking for the pipelines
-    /// alone (`DeferredPass::warm_up`) saved less: the shaders compile at their first
-    /// dispatch. Warming the many-instance frames too made a 1 M-triangle GLB's first frame
-    /// slower: the GPU process was busy with pipelines that frame did not use.
-    pub fn warm_up(&mut self, model: &Model, orbit: &Orbit, style: &Style) -> Result<(), String> {
+    /// Draws a frame of `model`'s first instance in `style`, its meshes drawing `edges`, into
+    /// a small offscreen texture, so that the browser's GPU process builds and compiles the
+    /// pipelines that frames of one mesh (most files) use while the page fetches and reads a
+    /// file; `model` is uploaded again as it was after. The shaders compile at their first
+    /// dispatch, so asking for the pipelines alone (`DeferredPass::warm_up`) saves less; and
+    /// the GPU process compiles one pipeline after another, so a warm-up of frames the file
+    /// will not draw delays the ones it will (a 1 M-triangle GLB's first frame took longer
+    /// with two warm-up frames than with none).
+    pub fn warm_up(
+        &mut self,
+        model: &Model,
+        edges: (Option<EdgeSelection>, EdgeSelection),
+        orbit: &Orbit,
+        style: &Style,
+    ) -> Result<(), String> {
         let Some(&first) = model.instances.first() else {
             return Ok(());
         };
@@ -367,9 +375,11 @@ impl Gpu {
             instances: vec![first],
         };
         let texture = self.offscreen((64, 48));
-        self.record(&texture, &one, orbit, style, &[])?;
+        self.upload(model, Some(edges.1))?;
+        let drawn = self.record(&texture, &one, orbit, style, &[]);
         self.last = None;
-        Ok(())
+        self.upload(model, edges.0)?;
+        drawn
     }
 
     /// Starts reading what pixel `at` of the last frame shows; the future holds no borrow
