@@ -1,10 +1,12 @@
 // Draws a frame's result (premultiplied linear RGBA, written by the edge pass in its result
-// mode) into the host's own render pass: one triangle over the viewport, blended with
-// (One, OneMinusSrcAlpha). The host's colour attachment decides the encoding: sRGB formats
+// mode) into the host's own render pass: quads over the runs of tiles that hold something,
+// within the render pass's viewport (the frame's size, anywhere in the attachment), blended
+// with (One, OneMinusSrcAlpha). The host's colour attachment decides the encoding: sRGB formats
 // store sRGB and blend in linear light, float formats hold linear values. Assembled after
 // common.wgsl.
 //
-// Flags: TESTED (the frame was seeded from the host's depth, and the render pass has the
+// Flags: ENCODE_SRGB (the target is an 8-bit format without sRGB, which holds sRGB-encoded
+// values); TESTED (the frame was seeded from the host's depth, and the render pass has the
 // host's depth attachment). The result decides per pixel whether an instance or the host
 // shows, from the host's farthest sample there; where the host's own geometry in front of an
 // instance covers only some of a pixel's samples, the draw then tests each sample against
@@ -20,20 +22,38 @@
 // edge pass listed (`list_composite_runs` in edge_pass.wgsl: tile x | (length - 1) <<
 // COMPOSITE_RUN_SHIFT | tile y << 16): the other tiles' result is transparent, and drawing
 // them would cost a software rasterizer a fragment each.
+// The result texel a fragment shows comes from the quad, not from the fragment's position in
+// the attachment, so the host may place the frame anywhere in its render pass with a
+// viewport of the frame's size (an editor's panel, egui's paint callback).
+struct Quad {
+    @builtin(position) position: vec4<f32>,
+    // The fragment's pixel in the result texture, interpolated without perspective: exact
+    // to rounding at each pixel's centre.
+    @location(0) @interpolate(linear) texel: vec2<f32>,
+}
+
 @vertex
-fn vs_main(@builtin(vertex_index) i: u32, @location(0) run: u32) -> @builtin(position) vec4<f32> {
+fn vs_main(@builtin(vertex_index) i: u32, @location(0) run: u32) -> Quad {
     let corner = vec2<u32>(select(0u, 1u, i == 1u || i == 4u || i == 5u), select(0u, 1u, i == 2u || i == 3u || i == 5u));
     let size = vec2<f32>(textureDimensions(result));
     let x = run & ((1u << COMPOSITE_RUN_SHIFT) - 1u);
     let extent = vec2<u32>(((run & 0xffffu) >> COMPOSITE_RUN_SHIFT) + 1u, 1u);
     let p = min(vec2<f32>((vec2<u32>(x, run >> 16u) + corner * extent) * 8u), size);
-    return vec4<f32>(p.x / size.x * 2.0 - 1.0, 1.0 - p.y / size.y * 2.0, 0.0, 1.0);
+    return Quad(vec4<f32>(p.x / size.x * 2.0 - 1.0, 1.0 - p.y / size.y * 2.0, 0.0, 1.0), p);
 }
 
-fn result_at(position: vec4<f32>) -> vec4<f32> {
+fn result_at(texel: vec2<f32>) -> vec4<f32> {
     let size = vec2<i32>(textureDimensions(result));
-    let xy = clamp(vec2<i32>(floor(position.xy)), vec2<i32>(0), size - 1);
-    return textureLoad(result, xy, 0);
+    let xy = clamp(vec2<i32>(floor(texel)), vec2<i32>(0), size - 1);
+    let c = textureLoad(result, xy, 0);
+#if ENCODE_SRGB
+    // An 8-bit target without sRGB holds sRGB-encoded values (as the storage output's
+    // Rgba8Unorm and egui's surface do): the colour encoded, still premultiplied, so the
+    // blend works on encoded values as the host's own drawing does.
+    return vec4<f32>(linear_to_srgb(c.rgb / max(c.a, 1e-6)) * c.a, c.a);
+#else
+    return c;
+#endif
 }
 
 #if TESTED
@@ -74,8 +94,8 @@ fn axis_change(r: f32, a: f32, b: f32) -> f32 {
 }
 
 @fragment
-fn fs_main(@builtin(position) position: vec4<f32>) -> Tested {
-    let xy = vec2<i32>(floor(position.xy + frame.output_offset));
+fn fs_main(quad: Quad) -> Tested {
+    let xy = vec2<i32>(floor(quad.texel + frame.output_offset));
     let r = instance_depth(xy);
     // The instance's depth change to its neighbours, per axis the larger (a crease may lie
     // within the pixel), summed: a sample lies within half a pixel per axis, and the change
@@ -85,14 +105,14 @@ fn fs_main(@builtin(position) position: vec4<f32>) -> Tested {
     let change = axis_change(r, instance_depth(xy - x), instance_depth(xy + x))
         + axis_change(r, instance_depth(xy - y), instance_depth(xy + y));
     let nearest = min(r + change + host_margin(r, host.quantum), 1.0);
-    let pixel = floor(position.xy + frame.output_offset + frame.target_origin) + 0.5;
+    let pixel = floor(quad.texel + frame.output_offset + frame.target_origin) + 0.5;
     let d = clamp(host_depth_of(nearest, pixel), 0.0, 1.0);
     let everywhere = select(0.0, 1.0, host.reversed == 1u);
-    return Tested(result_at(position), select(everywhere, d, r >= 0.0));
+    return Tested(result_at(quad.texel), select(everywhere, d, r >= 0.0));
 }
 #else
 @fragment
-fn fs_main(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f32> {
-    return result_at(position);
+fn fs_main(quad: Quad) -> @location(0) vec4<f32> {
+    return result_at(quad.texel);
 }
 #endif

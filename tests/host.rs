@@ -1596,3 +1596,151 @@ fn soak_memory_stays_flat_over_changing_frames() {
         );
     }
 }
+
+/// The frame drawn through `Composite::Shaded` into a `format` target of `attachment`
+/// pixels with the render pass's viewport at `origin` (the frame's size), read back as sRGB
+/// bytes.
+fn composite_at(
+    attachment: (u32, u32),
+    origin: (u32, u32),
+    format: wgpu::TextureFormat,
+) -> Vec<u8> {
+    let ctx = device();
+    let f = fixture();
+    let mut pass = DeferredPass::new(
+        &ctx.device,
+        PassOptions {
+            render_target: Some(RenderTarget {
+                format,
+                sample_count: 1,
+                depth_stencil: None,
+                content: Composite::Shaded,
+            }),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let wp = Wirepass::new();
+    let view = f.scene.view(ASPECT, DepthRange::Standard);
+    let frame = wp.prepare(&mut pass, view, Canvas::new(SIZE)).unwrap();
+    let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+    let target = texture_2d(&ctx.device, "attachment", attachment, format, usage);
+    let target_view = target.create_view(&Default::default());
+    // sRGB (124, 203, 149): linear for an sRGB target, the encoded bytes for another.
+    let clear = match format.is_srgb() {
+        true => wgpu::Color {
+            r: 0.2,
+            g: 0.6,
+            b: 0.3,
+            a: 1.0,
+        },
+        false => wgpu::Color {
+            r: 124.0 / 255.0,
+            g: 203.0 / 255.0,
+            b: 149.0 / 255.0,
+            a: 1.0,
+        },
+    };
+    let mut encoder = ctx.device.create_command_encoder(&Default::default());
+    pass.encode(
+        &ctx.device,
+        &mut encoder,
+        &wp.store,
+        &frame,
+        OutputTarget::RenderPass,
+    )
+    .unwrap();
+    {
+        let mut rp = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("host pass with a viewport"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &target_view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(clear),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            ..Default::default()
+        });
+        rp.set_viewport(
+            origin.0 as f32,
+            origin.1 as f32,
+            SIZE.0 as f32,
+            SIZE.1 as f32,
+            0.0,
+            1.0,
+        );
+        pass.render(&mut rp, &frame).unwrap();
+    }
+    ctx.queue.submit([encoder.finish()]);
+    let rgba = read_srgb8(&target);
+    ctx.finish().unwrap();
+    rgba
+}
+
+/// A host may give the frame any place in its render pass (a panel of an editor, egui's
+/// paint callback): with the viewport moved inside a larger attachment, the frame's pixels
+/// are the same bytes as with the viewport at the origin of an attachment of its own size,
+/// and the rest of the attachment is untouched.
+#[test]
+fn a_frame_drawn_into_a_viewport_anywhere_in_the_attachment_is_the_same_frame() {
+    let srgb = wgpu::TextureFormat::Rgba8UnormSrgb;
+    let alone = composite_at(SIZE, (0, 0), srgb);
+    let (origin, attachment) = ((37, 23), (SIZE.0 + 60, SIZE.1 + 41));
+    let placed = composite_at(attachment, origin, srgb);
+    let clear = [124u8, 203, 149, 255];
+    let (mut inside, mut outside) = (0, 0);
+    for y in 0..attachment.1 {
+        for x in 0..attachment.0 {
+            let k = 4 * (y * attachment.0 + x) as usize;
+            let (fx, fy) = (x.wrapping_sub(origin.0), y.wrapping_sub(origin.1));
+            if fx < SIZE.0 && fy < SIZE.1 {
+                let j = 4 * (fy * SIZE.0 + fx) as usize;
+                assert_eq!(
+                    placed[k..k + 4],
+                    alone[j..j + 4],
+                    "frame pixel ({fx}, {fy})"
+                );
+                inside += usize::from(alone[j..j + 4] != clear);
+            } else {
+                assert_eq!(placed[k..k + 4], clear, "attachment pixel ({x}, {y})");
+                outside += 1;
+            }
+        }
+    }
+    assert!(inside > 10_000, "only {inside} pixels of the frame drawn");
+    println!("{inside} pixels drawn in the viewport, {outside} outside it untouched");
+}
+
+/// `Rgba8Unorm` and `Bgra8Unorm` targets hold sRGB-encoded values (egui's surface, a canvas
+/// without an sRGB view): the composite writes the same colours as into an sRGB target,
+/// differing only where it blends partly covered pixels (on encoded values instead of in
+/// linear light).
+#[test]
+fn an_8_bit_target_without_srgb_gets_encoded_colours() {
+    use wgpu::TextureFormat as F;
+    let srgb = composite_at(SIZE, (0, 0), F::Rgba8UnormSrgb);
+    for format in [F::Rgba8Unorm, F::Bgra8Unorm] {
+        let encoded = composite_at(SIZE, (0, 0), format);
+        let (mut off, mut far, mut sum) = (0, 0, 0u64);
+        for (a, b) in srgb.chunks_exact(4).zip(encoded.chunks_exact(4)) {
+            let d = (0..3).map(|k| a[k].abs_diff(b[k])).max().unwrap();
+            off += usize::from(d > 1);
+            far += usize::from(d > 24);
+            sum += u64::from(d);
+        }
+        let pixels = srgb.len() / 4;
+        let mean = sum as f64 / pixels as f64;
+        println!(
+            "{format:?}: {off} pixels off by more than 1, {far} by more than 24, mean {mean:.3}"
+        );
+        // Antialiased line pixels blend a dark line over the light fill in encoded values:
+        // up to some tens of steps from the linear blend, on the lines' edges only (< 1 %).
+        assert!(
+            off * 50 < pixels && far * 100 < pixels && mean < 0.5,
+            "{format:?}"
+        );
+    }
+}

@@ -23,9 +23,11 @@ pub enum Composite {
 /// into it, given at construction (as egui-wgpu's and glyphon's renderers take theirs).
 ///
 /// Blending happens in linear light for sRGB formats (the hardware decodes and encodes) and
-/// float formats. An 8-bit format without sRGB is blended on its stored values, which the
-/// pass takes to be linear; to draw over an image that holds sRGB-encoded values in such a
-/// texture, give the render pass an sRGB view of it (`TextureDescriptor::view_formats`).
+/// float formats. `Rgba8Unorm` and `Bgra8Unorm` are taken to hold sRGB-encoded values, as
+/// the storage output's `Rgba8Unorm` does and as egui and most UI toolkits draw into such a
+/// surface: the draw encodes its colours and blends on the encoded values. For blending in
+/// linear light over such a texture, give the render pass an sRGB view of it
+/// (`TextureDescriptor::view_formats`) and this target the sRGB format.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct RenderTarget {
     /// Format of the colour attachment.
@@ -98,6 +100,15 @@ impl RenderTarget {
             _ => Ok(()),
         }
     }
+}
+
+/// Whether a target of `format` holds sRGB-encoded values the draw must encode: the 8-bit
+/// RGBA formats without sRGB ([`RenderTarget`] says why).
+fn encodes_srgb(format: wgpu::TextureFormat) -> bool {
+    matches!(
+        format,
+        wgpu::TextureFormat::Rgba8Unorm | wgpu::TextureFormat::Bgra8Unorm
+    )
 }
 
 /// The composite's pipelines for one render target: the plain draw, and where the render
@@ -295,7 +306,9 @@ impl Draw {
         });
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("wirepass composite"),
-            source: wgpu::ShaderSource::Wgsl(shaders::composite_source(compare.is_some()).into()),
+            source: wgpu::ShaderSource::Wgsl(
+                shaders::composite_source(compare.is_some(), encodes_srgb(target.format)).into(),
+            ),
         });
         let premultiplied = wgpu::BlendComponent {
             src_factor: wgpu::BlendFactor::One,

@@ -629,6 +629,10 @@ impl DeferredPass {
     /// and no other frame of this pass encoded since (each frame's result lives in the
     /// pass's one result texture until the next encode).
     ///
+    /// The frame fills the render pass's viewport, which the host sets to the frame's size
+    /// anywhere in its attachment (the whole attachment by default; a panel of an editor, or
+    /// egui's paint callback, elsewhere); the host's scissor rectangle clips it.
+    ///
     /// A frame prepared with the host's depth, drawn into a render pass with a depth
     /// attachment, is tested against that attachment per sample (it must hold the depth
     /// the frame was prepared with), so a multisampled host's own edges in front of an

@@ -239,9 +239,10 @@ pub fn host_depth_source(multisampled: bool) -> String {
 }
 
 /// The composite's module: testing the host's depth per sample (`tested`) or not.
-pub fn composite_source(tested: bool) -> String {
-    let flags: &[&str] = if tested { &["TESTED"] } else { &[] };
-    assemble(&[COMPOSITE], flags)
+pub fn composite_source(tested: bool, encode_srgb: bool) -> String {
+    let flags = [("TESTED", tested), ("ENCODE_SRGB", encode_srgb)];
+    let flags: Vec<&str> = flags.iter().filter(|f| f.1).map(|f| f.0).collect();
+    assemble(&[COMPOSITE], &flags)
 }
 
 #[cfg(test)]

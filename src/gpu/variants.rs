@@ -187,10 +187,12 @@ pub fn shader_modules() -> Vec<(String, String)> {
     use wgpu::TextureFormat as F;
     let mut out = vec![];
     for tested in [false, true] {
-        out.push((
-            format!("composite tested={tested}"),
-            composite_source(tested),
-        ));
+        for encode in [false, true] {
+            out.push((
+                format!("composite tested={tested} encode_srgb={encode}"),
+                composite_source(tested, encode),
+            ));
+        }
     }
     for multisampled in [false, true] {
         out.push((
