@@ -137,6 +137,12 @@ export class WirepassViewer extends HTMLElement {
       gpu = await sharedDevice();
       const opened = performance.now();
       performance.measure("wirepass-viewer: WebAssembly and device", { start: starting, end: opened });
+      if (!this.isConnected) {
+        // Removed while the device opened: a later connection starts again.
+        download?.load.abort();
+        this.#starting = null;
+        return;
+      }
       this.#view = new ElementView(gpu, this, this.#canvas);
       performance.measure("wirepass-viewer: view", { start: opened });
     } catch (e) {

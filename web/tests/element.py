@@ -14,7 +14,8 @@ beside it), a URL that answers 404 and a file that is not a model. Checked:
   (`web/tests/reference/element.json`);
 - setting `hidden="dashed"` redraws with hidden lines (the native frame of that view);
 - a drag turns the view and `fit()` brings the camera's view back; `exportSvg()` draws lines;
-- nothing is drawn while nothing changes; the package's demo page draws;
+- nothing is drawn while nothing changes; an element removed while it starts raises nothing,
+  and put back it loads; the package's demo page draws;
 - on a page without WebGPU an element raises `error` and says so in its box.
 
     python3 web/tests/element.py [--package web/package] [--chromedriver /usr/bin/chromedriver]
@@ -123,6 +124,28 @@ NO_WEBGPU = """<!doctype html>
   document.getElementById("lone").addEventListener("error", (e) => events.push(e.detail.message));
 </script>
 <script type="module" src="/web/package/wirepass-viewer.js"></script>
+</body></html>
+"""
+
+# The page's first element, removed while the WebAssembly and the device start (it must not
+# draw or raise anything while out of the page), put back 1.5 s later.
+REMOVED = """<!doctype html>
+<html><head><meta charset="utf-8"></head><body>
+<script type="module">
+  const events = [];
+  const el = document.createElement("wirepass-viewer");
+  el.setAttribute("src", "/tests/data/meshes/suzanne.obj");
+  for (const type of ["load", "error"]) el.addEventListener(type, () => events.push(type));
+  document.body.append(el);
+  await import("/web/package/wirepass-viewer.js");
+  el.remove();
+  await new Promise((done) => setTimeout(done, 1500));
+  const before = events.splice(0);
+  const frames = el.frames;
+  document.body.append(el);
+  await new Promise((done) => el.addEventListener("load", done, {once: true}));
+  window.removed = {before, frames, after: events};
+</script>
 </body></html>
 """
 
@@ -241,6 +264,7 @@ def main():
         "/test/page.html": ("text/html", page(views).encode()),
         "/test/no-webgpu.html": ("text/html", NO_WEBGPU.encode()),
         "/test/first-frame.html": ("text/html", FIRST_FRAME.encode()),
+        "/test/removed.html": ("text/html", REMOVED.encode()),
         "/test/broken.glb": ("model/gltf-binary", b"glTF\x02\x00\x00\x00this is not a model"),
         "/test/model.glb": ("model/gltf-binary", big),
     }
@@ -415,6 +439,16 @@ def main():
             sys.exit(f"element: line-width=-2 raised {errors}, not one error naming it")
         if run("return document.getElementById('v0').frames") != frames:
             sys.exit("element: an attribute it could not read redrew the view")
+
+        # An element removed while the page's device opens raises nothing; put back, it
+        # starts again and loads.
+        call(base, "POST", s + "/url", {"url": origin + "/test/removed.html"})
+        removed = wait("the element removed and put back", "return window.removed", 120)
+        print(f"element: removed while starting: {removed['before']} events, {removed['frames']} frames; "
+              f"put back: {removed['after']}")
+        if removed["before"] != [] or removed["frames"] != 0 or removed["after"] != ["load"]:
+            sys.exit(f"element: removed while starting it drew {removed['frames']} frames and raised "
+                     f"{removed['before']}; put back, {removed['after']}")
 
         # The package's demo page, as a visitor opens it, with a model by ?model=.
         call(base, "POST", s + "/url", {"url": origin + f"/web/package/index.html?model=/{views[0]['src']}"})
