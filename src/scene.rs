@@ -432,6 +432,24 @@ impl SectionPlane {
         SectionPlane { point, normal }
     }
 
+    /// Parses `PX,PY,PZ,NX,NY,NZ`: a point on the plane and its normal, towards what is kept
+    /// (the command line's `--section`, the web element's `sections`). Not validated: call
+    /// [`validate`](Self::validate).
+    pub fn parse(s: &str) -> Result<SectionPlane> {
+        let bad = || Error::InvalidSetting(format!("{s:?} is not PX,PY,PZ,NX,NY,NZ, six numbers"));
+        let n: Vec<f64> = s
+            .split(',')
+            .map(|t| t.trim().parse::<f64>().map_err(|_| bad()))
+            .collect::<Result<_>>()?;
+        let [px, py, pz, nx, ny, nz] = n[..] else {
+            return Err(bad());
+        };
+        Ok(SectionPlane::new(
+            DVec3::new(px, py, pz),
+            DVec3::new(nx, ny, nz),
+        ))
+    }
+
     /// The plane through the point `orbit` circles, its normal the way the camera looks: the
     /// half nearer the eye is cut away, so the cut faces the viewer (a viewer's `S` key).
     pub fn across(orbit: &Orbit) -> SectionPlane {

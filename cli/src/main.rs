@@ -169,18 +169,7 @@ fn parse_switch(s: &str) -> std::result::Result<bool, String> {
 }
 
 fn parse_section(s: &str) -> std::result::Result<wirepass::SectionPlane, String> {
-    let bad = || format!("{s:?} is not PX,PY,PZ,NX,NY,NZ, six numbers");
-    let n: Vec<f64> = s
-        .split(',')
-        .map(|t| t.trim().parse::<f64>().map_err(|_| bad()))
-        .collect::<std::result::Result<_, _>>()?;
-    let [px, py, pz, nx, ny, nz] = n[..] else {
-        return Err(bad());
-    };
-    let plane = wirepass::SectionPlane::new(
-        wirepass::glam::DVec3::new(px, py, pz),
-        wirepass::glam::DVec3::new(nx, ny, nz),
-    );
+    let plane = wirepass::SectionPlane::parse(s).map_err(|e| e.to_string())?;
     plane.validate(0).map_err(|e| format!("{s:?}: {e}"))?;
     Ok(plane)
 }

@@ -96,20 +96,7 @@ pub fn sections(s: &str) -> Result<Vec<SectionPlane>, String> {
         .split(';')
         .map(str::trim)
         .filter(|p| !p.is_empty())
-        .map(|p| {
-            let bad = || format!("section {p:?} is not PX,PY,PZ,NX,NY,NZ, six numbers");
-            let n: Vec<f64> = p
-                .split(',')
-                .map(|t| t.trim().parse::<f64>().map_err(|_| bad()))
-                .collect::<Result<_, _>>()?;
-            let [px, py, pz, nx, ny, nz] = n[..] else {
-                return Err(bad());
-            };
-            Ok(SectionPlane::new(
-                DVec3::new(px, py, pz),
-                DVec3::new(nx, ny, nz),
-            ))
-        })
+        .map(|p| SectionPlane::parse(p).map_err(|e| format!("sections: {e}")))
         .collect::<Result<_, _>>()?;
     if planes.len() > MAX_SECTIONS {
         return Err(format!(

@@ -476,7 +476,7 @@ fn draw_offscreen(
         // An sRGB format encodes the clear colour; any other 8-bit format holds it encoded.
         let linear = |c: f64| {
             if format.is_srgb() {
-                srgb_to_linear(c)
+                f64::from(wirepass::style::srgb_to_linear(c as f32))
             } else {
                 c
             }
@@ -507,14 +507,6 @@ fn draw_offscreen(
         rgba.chunks_exact_mut(4).for_each(|p| p.swap(0, 2));
     }
     Ok(rgba)
-}
-
-fn srgb_to_linear(c: f64) -> f64 {
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
 }
 
 impl eframe::App for App {
