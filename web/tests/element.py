@@ -33,13 +33,11 @@ import http.server
 import json
 import os
 import struct
-import subprocess
 import sys
-import threading
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from page import call, free_port  # noqa: E402
+from page import browser, call  # noqa: E402
 
 WEB = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 ROOT = os.path.dirname(WEB)
@@ -251,8 +249,6 @@ def main():
         sys.exit(f"element: {package}/wirepass-viewer.js is missing: run web/package.sh first")
     with open(os.path.join(WEB, "tests", "reference", "element.json")) as f:
         views = json.load(f)
-    with open(os.path.join(WEB, "webdriver.json")) as f:
-        capabilities = json.load(f)
     big = b""
     if args.first_frame:
         big, triangles = sphere_glb(args.first_frame)
@@ -294,25 +290,7 @@ def main():
         def log_message(self, *args):
             pass
 
-    server = http.server.ThreadingHTTPServer(("127.0.0.1", free_port()), functools.partial(Handler, directory=ROOT))
-    threading.Thread(target=server.serve_forever, daemon=True).start()
-    port = free_port()
-    driver = subprocess.Popen([args.chromedriver, f"--port={port}"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    base = f"http://127.0.0.1:{port}"
-    session = None
-    try:
-        for _ in range(100):
-            try:
-                call(base, "GET", "/status")
-                break
-            except OSError:
-                time.sleep(0.1)
-        options = dict(capabilities["goog:chromeOptions"], binary=os.environ.get("CHROMIUM", "/usr/bin/chromium"))
-        session = call(base, "POST", "/session", {"capabilities": {"alwaysMatch": {"goog:chromeOptions": options}}})["sessionId"]
-        s = f"/session/{session}"
-        call(base, "POST", s + "/timeouts", {"script": 300000})
-        origin = f"http://127.0.0.1:{server.server_port}"
-
+    with browser(functools.partial(Handler, directory=ROOT), args.chromedriver, 300) as (base, s, origin):
         def run(script, *arguments):
             return call(base, "POST", s + "/execute/sync", {"script": script, "args": list(arguments)})
 
@@ -465,14 +443,6 @@ def main():
         if "WebGPU" not in message or shown != message:
             sys.exit(f"element: without WebGPU the element said {message!r} and shows {shown!r}")
         print("element: ok")
-    finally:
-        if session:
-            try:
-                call(base, "DELETE", f"/session/{session}")
-            except OSError:
-                pass
-        driver.terminate()
-        server.shutdown()
 
 
 if __name__ == "__main__":

@@ -11,6 +11,7 @@ Exits non-zero with one line saying what failed.
 """
 
 import argparse
+import contextlib
 import functools
 import http.server
 import json
@@ -38,6 +39,41 @@ def call(base, method, path, body=None):
     with urllib.request.urlopen(request, timeout=120) as response:
         value = json.load(response)["value"]
     return value
+
+
+@contextlib.contextmanager
+def browser(handler, chromedriver, script_seconds):
+    """Serves `handler` over HTTP, starts chromedriver and a headless Chromium session with
+    web/webdriver.json's options, and yields (the driver's URL, the session's path, the
+    server's origin); everything is shut down after."""
+    with open(os.path.join(WEB, "webdriver.json")) as f:
+        capabilities = json.load(f)
+    server = http.server.ThreadingHTTPServer(("127.0.0.1", free_port()), handler)
+    threading.Thread(target=server.serve_forever, daemon=True).start()
+    port = free_port()
+    driver = subprocess.Popen([chromedriver, f"--port={port}"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    base = f"http://127.0.0.1:{port}"
+    session = None
+    try:
+        for _ in range(100):
+            try:
+                call(base, "GET", "/status")
+                break
+            except OSError:
+                time.sleep(0.1)
+        options = dict(capabilities["goog:chromeOptions"], binary=os.environ.get("CHROMIUM", "/usr/bin/chromium"))
+        session = call(base, "POST", "/session", {"capabilities": {"alwaysMatch": {"goog:chromeOptions": options}}})["sessionId"]
+        s = f"/session/{session}"
+        call(base, "POST", s + "/timeouts", {"script": script_seconds * 1000})
+        yield base, s, f"http://127.0.0.1:{server.server_port}"
+    finally:
+        if session:
+            try:
+                call(base, "DELETE", f"/session/{session}")
+            except OSError:
+                pass
+        driver.terminate()
+        server.shutdown()
 
 
 # The shares of background, surface and line pixels of an RGBA8 snapshot, computed in the
@@ -75,32 +111,13 @@ def main():
     args = parser.parse_args()
     if not os.path.exists(os.path.join(WEB, "pkg", "wirepass_web.js")):
         sys.exit("page: web/pkg/wirepass_web.js is missing: build the page first (see the README)")
-    with open(os.path.join(WEB, "webdriver.json")) as f:
-        capabilities = json.load(f)
 
     class Quiet(http.server.SimpleHTTPRequestHandler):
         def log_message(self, *args):
             pass
 
-    handler = functools.partial(Quiet, directory=WEB)
-    server = http.server.ThreadingHTTPServer(("127.0.0.1", free_port()), handler)
-    threading.Thread(target=server.serve_forever, daemon=True).start()
-    port = free_port()
-    driver = subprocess.Popen([args.chromedriver, f"--port={port}"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    base = f"http://127.0.0.1:{port}"
-    session = None
-    try:
-        for _ in range(100):
-            try:
-                call(base, "GET", "/status")
-                break
-            except OSError:
-                time.sleep(0.1)
-        options = dict(capabilities["goog:chromeOptions"], binary=os.environ.get("CHROMIUM", "/usr/bin/chromium"))
-        session = call(base, "POST", "/session", {"capabilities": {"alwaysMatch": {"goog:chromeOptions": options}}})["sessionId"]
-        s = f"/session/{session}"
-        call(base, "POST", s + "/timeouts", {"script": 120000})
-        call(base, "POST", s + "/url", {"url": f"http://127.0.0.1:{server.server_port}/index.html"})
+    with browser(functools.partial(Quiet, directory=WEB), args.chromedriver, 120) as (base, s, origin):
+        call(base, "POST", s + "/url", {"url": f"{origin}/index.html"})
 
         def run(script):
             return call(base, "POST", s + "/execute/sync", {"script": script, "args": []})
@@ -142,14 +159,6 @@ def main():
         if turned["background"] == first["background"] and turned["lines"] == first["lines"]:
             sys.exit("page: a drag did not change the view")
         print("page: ok")
-    finally:
-        if session:
-            try:
-                call(base, "DELETE", f"/session/{session}")
-            except OSError:
-                pass
-        driver.terminate()
-        server.shutdown()
 
 
 if __name__ == "__main__":
