@@ -238,6 +238,13 @@ export class WirepassViewer extends HTMLElement {
       this.#view.load(name, bytes, uris, buffers);
       const drawing = performance.now();
       performance.measure("wirepass-viewer: read and upload", { start: reading, end: drawing });
+      // The preprocessing's steps end the reading, one after the other.
+      const steps = this.#view.upload_steps();
+      let start = drawing - steps.reduce((sum, [, ms]) => sum + ms, 0);
+      for (const [step, ms] of steps) {
+        performance.measure(`wirepass-viewer: ${step}`, { start, duration: ms });
+        start += ms;
+      }
       this.addEventListener(
         "load",
         () => performance.measure("wirepass-viewer: first frame", { start: drawing }),

@@ -180,6 +180,16 @@ impl ElementView {
         Ok(self.app.borrow().drawing_svg()?)
     }
 
+    /// Where the model's preprocessing went: `[step, milliseconds]` pairs in order.
+    pub fn upload_steps(&self) -> js_sys::Array {
+        let a = self.app.borrow();
+        a.gpu
+            .upload_steps()
+            .into_iter()
+            .map(|(name, ms)| js_sys::Array::of2(&name.into(), &ms.into()))
+            .collect()
+    }
+
     /// Frames drawn so far: the element draws only when something changed.
     pub fn frames(&self) -> u32 {
         self.app.borrow().frames

@@ -240,6 +240,33 @@ impl Gpu {
         Ok(())
     }
 
+    /// What the last upload's preprocessing took, step by step over its meshes, as
+    /// `step ms` pairs (`MeshStore::upload_report`).
+    pub fn upload_steps(&self) -> Vec<(&'static str, f64)> {
+        let mut steps: Vec<(&'static str, f64)> = Vec::new();
+        for &(id, _) in &self.ids {
+            let Ok(r) = self.store.upload_report(id) else {
+                continue;
+            };
+            let each = [
+                ("adjacency", r.adjacency),
+                ("outline hints", r.outline_hints),
+                ("clusters", r.clusters),
+                ("crossings", r.crossings),
+                ("edges: patches, chains", r.edges),
+                ("records", r.records),
+                ("queue the upload", r.upload),
+            ];
+            for (k, (name, d)) in each.into_iter().enumerate() {
+                match steps.get_mut(k) {
+                    Some(s) => s.1 += d.as_secs_f64() * 1e3,
+                    None => steps.push((name, d.as_secs_f64() * 1e3)),
+                }
+            }
+        }
+        steps
+    }
+
     /// Configures the canvas again when its size changed.
     pub fn resize(&mut self, size: (u32, u32)) {
         let max = self.device.limits().max_texture_dimension_2d;
