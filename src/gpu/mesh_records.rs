@@ -163,9 +163,10 @@ impl MeshData {
         }
         let tris = mesh.triangles();
         let indices = order.iter().map(|&t| tris[t as usize]).collect();
+        let across = Across::of(mesh);
         let neighbours = order
             .iter()
-            .map(|&t| [0, 1, 2].map(|i| neighbour_word(mesh, &stored, t as usize, i)))
+            .map(|&t| [0, 1, 2].map(|i| across.word(&stored, t as usize, i)))
             .collect();
         let bounds: Vec<[f32; 8]> = clusters
             .bounds
@@ -237,36 +238,54 @@ pub(crate) const NEIGHBOUR_SAME_WAY: u32 = 1 << 31;
 /// `neighbour_word`): its stored index, its corner k off the shared edge and whether its
 /// corners k + 1 and k + 2 are that edge's start and end (the same way) or its end and start.
 /// A step of a walk across the edge then reads one corner, not three; `u32::MAX` where there
-/// is no neighbour. The shared corners are found by position, as the adjacency welds them.
+/// is no neighbour. The shared corners are found by their welded vertices (equal
+/// positions), as the adjacency pairs them.
+#[cfg(test)]
 fn neighbour_word(mesh: &Mesh, stored: &[u32], t: usize, i: usize) -> u32 {
-    let n = mesh.edge_neighbours()[t][i];
-    if n == NO_NEIGHBOUR {
-        return u32::MAX;
+    Across::of(mesh).word(stored, t, i)
+}
+
+/// What [`neighbour_word`] reads of a mesh, borrowed once for all its triangles.
+struct Across<'a> {
+    neighbours: &'a [[u32; 3]],
+    triangles: &'a [[u32; 3]],
+    weld: &'a [u32],
+}
+
+impl<'a> Across<'a> {
+    fn of(mesh: &'a Mesh) -> Self {
+        Across {
+            neighbours: mesh.edge_neighbours(),
+            triangles: mesh.triangles(),
+            weld: mesh.welded(),
+        }
     }
-    let tris = mesh.triangles();
-    let at = |v: u32| {
-        (mesh.positions()[v as usize] + Vec3::ZERO)
-            .to_array()
-            .map(f32::to_bits)
-    };
-    let (a, b) = (at(tris[t][i]), at(tris[t][(i + 1) % 3]));
-    let other = tris[n as usize];
-    let back = (0..3).find(|&j| {
-        let (p, q) = (at(other[j]), at(other[(j + 1) % 3]));
-        mesh.edge_neighbours()[n as usize][j] == t as u32 && ((p, q) == (a, b) || (p, q) == (b, a))
-    });
-    // The adjacency pairs the two sides of an edge with the same welded ends, so `back` is
-    // always found; without it the edge reads as a boundary.
-    let Some(j) = back else {
-        return u32::MAX;
-    };
-    let k = (j as u32 + 2) % 3;
-    let same_way = if at(other[j]) == a {
-        NEIGHBOUR_SAME_WAY
-    } else {
-        0
-    };
-    stored[n as usize] | k << NEIGHBOUR_CORNER_SHIFT | same_way
+
+    fn word(&self, stored: &[u32], t: usize, i: usize) -> u32 {
+        let n = self.neighbours[t][i];
+        if n == NO_NEIGHBOUR {
+            return u32::MAX;
+        }
+        let corner = |t: usize, i: usize| self.weld[self.triangles[t][i % 3] as usize];
+        let (a, b) = (corner(t, i), corner(t, i + 1));
+        let n = n as usize;
+        let back = (0..3).find(|&j| {
+            let (p, q) = (corner(n, j), corner(n, j + 1));
+            self.neighbours[n][j] == t as u32 && ((p, q) == (a, b) || (p, q) == (b, a))
+        });
+        // The adjacency pairs the two sides of an edge with the same welded ends, so `back`
+        // is always found; without it the edge reads as a boundary.
+        let Some(j) = back else {
+            return u32::MAX;
+        };
+        let k = (j as u32 + 2) % 3;
+        let same_way = if corner(n, j) == a {
+            NEIGHBOUR_SAME_WAY
+        } else {
+            0
+        };
+        stored[n] | k << NEIGHBOUR_CORNER_SHIFT | same_way
+    }
 }
 
 /// Bit of [`EdgeData::info`]: the triangle's patch is large ([`Patches::large`]).

@@ -93,17 +93,15 @@ pub fn edge_neighbours(positions: &[glam::Vec3], triangles: &[[u32; 3]]) -> Vec<
 pub fn welded_neighbours(weld: &[u32], triangles: &[[u32; 3]]) -> Vec<[u32; 3]> {
     // One entry per half-edge: (undirected welded edge key, triangle * 3 + edge). Sorting
     // by key groups the two sides of each edge; a sort scales to tens of millions of edges
-    // with far less memory than a hash map.
-    let mut half_edges: Vec<(u64, u32)> = triangles
-        .par_iter()
-        .enumerate()
-        .flat_map_iter(|(t, tri)| {
-            let w = tri.map(|v| weld[v as usize]);
-            (0..3).map(move |i| {
-                let (a, b) = (w[i], w[(i + 1) % 3]);
-                let key = (u64::from(a.min(b)) << 32) | u64::from(a.max(b));
-                (key, (t * 3 + i) as u32)
-            })
+    // with far less memory than a hash map. Made from an indexed range, the list is
+    // allocated once at its size (a flat map's collect grows it by copying).
+    let mut half_edges: Vec<(u64, u32)> = (0..triangles.len() * 3)
+        .into_par_iter()
+        .map(|h| {
+            let tri = triangles[h / 3];
+            let (a, b) = (weld[tri[h % 3] as usize], weld[tri[(h + 1) % 3] as usize]);
+            let key = (u64::from(a.min(b)) << 32) | u64::from(a.max(b));
+            (key, h as u32)
         })
         .collect();
     half_edges.par_sort_unstable();

@@ -142,7 +142,8 @@ fn bound(
         spread: ALWAYS,
     };
     let mut normals = Vec::with_capacity(ids.len());
-    let mut fold: f64 = 0.0;
+    // The largest fold code: `fold_bound` grows with the code, so its bound is the largest.
+    let mut fold_code = 0;
     for &t in ids {
         let (q, boundary) = (hint(t) >> 1, hint(t) & 1 != 0);
         let [a, b, c] = corners(t);
@@ -151,8 +152,9 @@ fn bound(
             return always;
         }
         normals.push(n);
-        fold = fold.max(fold_bound(q).min(1.0).asin());
+        fold_code = fold_code.max(q);
     }
+    let fold = fold_bound(fold_code).min(1.0).asin();
     let axis = normals.iter().sum::<DVec3>().normalize_or_zero();
     if axis == DVec3::ZERO {
         return always;

@@ -54,7 +54,9 @@ mod sequential {
         }
     }
 
-    /// rayon's `flat_map_iter`, which is `flat_map` on one thread.
+    /// rayon's `flat_map_iter`, which is `flat_map` on one thread (used by the drawings and
+    /// the tools, not by the pass alone).
+    #[allow(dead_code)]
     pub(crate) trait FlatMapIter: Iterator + Sized {
         fn flat_map_iter<U: IntoIterator, F: FnMut(Self::Item) -> U>(
             self,
