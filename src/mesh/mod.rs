@@ -45,6 +45,7 @@ pub use procedural::{
 
 use crate::error::{Error, Result};
 use glam::Vec3;
+use std::borrow::Cow;
 
 #[cfg_attr(not(feature = "truth"), doc(hidden))]
 /// All three edges of a triangle. Edge `i` runs from corner `i` to corner `(i + 1) % 3`.
@@ -330,11 +331,36 @@ impl Mesh {
     /// asks for the geometry's own edges, so the mask is dropped and every edge may be an
     /// outline again.
     pub fn resolve_edges(self, requested: Option<EdgeSelection>) -> (Mesh, EdgeSelection) {
+        let (drops_mask, edges) = self.resolution(requested);
+        if drops_mask {
+            (self.without_outline_mask(), edges)
+        } else {
+            (self, edges)
+        }
+    }
+
+    /// [`Mesh::resolve_edges`] for a mesh the caller keeps (to pick on it, or to draw it
+    /// again with other edges): the mesh itself where it draws as it is, a copy only where
+    /// the selection drops the file's outline mask.
+    pub fn resolved_edges(
+        &self,
+        requested: Option<EdgeSelection>,
+    ) -> (Cow<'_, Mesh>, EdgeSelection) {
+        let (drops_mask, edges) = self.resolution(requested);
+        if drops_mask {
+            (Cow::Owned(self.clone().without_outline_mask()), edges)
+        } else {
+            (Cow::Borrowed(self), edges)
+        }
+    }
+
+    /// Whether `requested` drops the outline mask, and the selection it draws.
+    fn resolution(&self, requested: Option<EdgeSelection>) -> (bool, EdgeSelection) {
         match requested {
-            None if self.authored_edges.is_some() => (self, EdgeSelection::Authored),
-            None => (self, EdgeSelection::Polygon),
-            Some(EdgeSelection::Authored) => (self, EdgeSelection::Authored),
-            Some(other) => (self.without_outline_mask(), other),
+            None if self.authored_edges.is_some() => (false, EdgeSelection::Authored),
+            None => (false, EdgeSelection::Polygon),
+            Some(EdgeSelection::Authored) => (false, EdgeSelection::Authored),
+            Some(other) => (self.outline_mask.is_some(), other),
         }
     }
 
@@ -818,6 +844,19 @@ mod tests {
             vec![ALL_EDGES; 2],
             "the mask is dropped"
         );
+        // Kept by the caller: borrowed unless the mask is dropped, then a copy without it.
+        let kept = authored();
+        let (m, edges) = kept.resolved_edges(None);
+        assert!(matches!(m, Cow::Borrowed(_)));
+        assert_eq!(edges, EdgeSelection::Authored);
+        let (m, edges) = kept.resolved_edges(Some(EdgeSelection::All));
+        assert_eq!(edges, EdgeSelection::All);
+        assert_eq!(m.outline_mask().to_vec(), vec![ALL_EDGES; 2]);
+        assert_eq!(kept.outline_mask().to_vec(), vec![0b011, 0b100]);
+        // Without a mask there is nothing to drop: no copy.
+        let plain = quad();
+        let (m, _) = plain.resolved_edges(Some(EdgeSelection::All));
+        assert!(matches!(m, Cow::Borrowed(_)));
         // Merging keeps both, the plain quad drawing its polygon edges.
         let merged = Mesh::merge(&[authored(), quad()]).unwrap();
         assert_eq!(

@@ -230,7 +230,7 @@ impl Gpu {
             self.store.remove(id).map_err(|e| e.to_string())?;
         }
         for (mesh, own) in &model.meshes {
-            let (mesh, selection) = mesh.clone().resolve_edges(edges.or(*own));
+            let (mesh, selection) = mesh.resolved_edges(edges.or(*own));
             let id = self
                 .store
                 .insert(&self.device, &self.queue, &mesh, selection)
