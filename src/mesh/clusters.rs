@@ -159,10 +159,21 @@ fn bound(
     if axis == DVec3::ZERO {
         return always;
     }
-    let cone = normals
+    // The normal furthest from the axis, found by comparing angles in [0, π] through their
+    // sines and cosines (the sine of their difference), then its angle: one atan2 a
+    // cluster, not one a triangle (a software function in a browser's WebAssembly).
+    let (sin, cos) = normals
         .iter()
-        .map(|n| n.cross(axis).length().atan2(n.dot(axis)))
-        .fold(0.0, f64::max);
+        .map(|n| (n.cross(axis).length(), n.dot(axis)))
+        .fold((0.0, 1.0), |(s, c), (si, ci)| {
+            let wider = si * c - ci * s;
+            if wider > 0.0 || (wider == 0.0 && ci < c) {
+                (si, ci)
+            } else {
+                (s, c)
+            }
+        });
+    let cone = sin.atan2(cos);
     ClusterBounds {
         center,
         radius,
@@ -219,6 +230,38 @@ mod tests {
                 if p != NO_NEIGHBOUR {
                     assert_eq!(partners[p as usize], t as u32);
                     assert_eq!(stored[t].abs_diff(stored[p as usize]), 1, "quad {t}, {p}");
+                }
+            }
+        }
+    }
+
+    /// Every triangle's normal lies within its cluster's cone: the angle from the axis, as
+    /// atan2 gives it, is at most the spread (which adds the fold and the margin).
+    #[test]
+    fn the_normal_cone_holds_every_normal_of_its_cluster() {
+        // Facing +z, +z and -z: the axis +z, the widest normal π away.
+        let tris = [
+            [DVec3::ZERO, DVec3::X, DVec3::Y],
+            [DVec3::ZERO, DVec3::X, DVec3::Y],
+            [DVec3::ZERO, DVec3::Y, DVec3::X],
+        ];
+        let b = bound(&[0, 1, 2], |t| tris[t as usize], |_| 0);
+        assert!(b.spread >= std::f64::consts::PI, "{}", b.spread);
+        for mesh in [crate::mesh::sphere(20_000), crate::mesh::torus(20_000)] {
+            let mesh = mesh.unwrap();
+            let c = mesh.traced_clusters();
+            let corner = |t: u32, k: usize| {
+                mesh.positions()[mesh.triangles()[t as usize][k] as usize].as_dvec3()
+            };
+            for (ids, b) in c.order.chunks(CLUSTER_TRIANGLES).zip(&c.bounds) {
+                if b.spread >= ALWAYS {
+                    continue;
+                }
+                for &t in ids {
+                    let (a, e, f) = (corner(t, 0), corner(t, 1), corner(t, 2));
+                    let n = (e - a).cross(f - a).normalize();
+                    let angle = n.cross(b.axis).length().atan2(n.dot(b.axis));
+                    assert!(angle <= b.spread - SPREAD_MARGIN, "{angle} > {}", b.spread);
                 }
             }
         }
