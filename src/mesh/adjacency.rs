@@ -106,23 +106,22 @@ pub fn welded_neighbours(weld: &[u32], triangles: &[[u32; 3]]) -> Vec<[u32; 3]> 
         .collect();
     half_edges.par_sort_unstable();
 
+    // The sides of an edge are paired where its key appears exactly twice; a degenerate
+    // edge (both ends welded together) has no neighbour either.
     let mut neighbours = vec![[NO_NEIGHBOUR; 3]; triangles.len()];
-    let mut start = 0;
-    while start < half_edges.len() {
-        let key = half_edges[start].0;
-        let mut end = start + 1;
-        while end < half_edges.len() && half_edges[end].0 == key {
-            end += 1;
+    let key = |k: usize| half_edges.get(k).map(|h| h.0);
+    in_blocks(half_edges.len(), |range| {
+        for k in range {
+            let (h, next) = (half_edges[k], key(k + 1));
+            let first = k == 0 || key(k - 1) != Some(h.0);
+            let degenerate = (h.0 >> 32) == (h.0 & 0xffff_ffff);
+            if first && next == Some(h.0) && key(k + 2) != Some(h.0) && !degenerate {
+                let (a, b) = (h.1, half_edges[k + 1].1);
+                neighbours[(a / 3) as usize][(a % 3) as usize] = b / 3;
+                neighbours[(b / 3) as usize][(b % 3) as usize] = a / 3;
+            }
         }
-        // A degenerate edge (both ends welded together) has no neighbour either.
-        let degenerate = (key >> 32) == (key & 0xffff_ffff);
-        if end - start == 2 && !degenerate {
-            let (a, b) = (half_edges[start].1, half_edges[start + 1].1);
-            neighbours[(a / 3) as usize][(a % 3) as usize] = b / 3;
-            neighbours[(b / 3) as usize][(b % 3) as usize] = a / 3;
-        }
-        start = end;
-    }
+    });
     neighbours
 }
 
@@ -139,12 +138,15 @@ pub fn weld_by_position(positions: &[glam::Vec3]) -> Vec<u32> {
     order.par_sort_unstable_by_key(|&i| (key(i as usize), i));
     let mut weld = vec![0u32; positions.len()];
     let mut first = 0;
-    for (k, &i) in order.iter().enumerate() {
-        if k == 0 || key(i as usize) != key(order[k - 1] as usize) {
-            first = i;
+    in_blocks(order.len(), |range| {
+        for k in range {
+            let i = order[k];
+            if k == 0 || key(i as usize) != key(order[k - 1] as usize) {
+                first = i;
+            }
+            weld[i as usize] = first;
         }
-        weld[i as usize] = first;
-    }
+    });
     weld
 }
 

@@ -651,16 +651,24 @@ impl Mesh {
 /// length is twice its area, to its three corners.
 pub fn smooth_normals(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
     let mut acc = vec![glam::DVec3::ZERO; positions.len()];
-    for tri in triangles {
-        let [a, b, c] = tri.map(|v| positions[v as usize].as_dvec3());
-        let n = (b - a).cross(c - a);
-        for &v in tri {
-            acc[v as usize] += n;
+    par::in_blocks(triangles.len(), |range| {
+        for tri in &triangles[range] {
+            let [a, b, c] = tri.map(|v| positions[v as usize].as_dvec3());
+            let n = (b - a).cross(c - a);
+            for &v in tri {
+                acc[v as usize] += n;
+            }
         }
-    }
-    acc.into_iter()
-        .map(|n| n.try_normalize().unwrap_or(glam::DVec3::ZERO).as_vec3())
-        .collect()
+    });
+    let mut normals = Vec::with_capacity(acc.len());
+    par::in_blocks(acc.len(), |range| {
+        normals.extend(
+            acc[range]
+                .iter()
+                .map(|n| n.try_normalize().unwrap_or(glam::DVec3::ZERO).as_vec3()),
+        )
+    });
+    normals
 }
 
 #[cfg(test)]

@@ -5,6 +5,28 @@
 #[cfg(feature = "parallel")]
 pub(crate) use rayon::{join, prelude::*};
 
+/// Indices a block of [`in_blocks`] holds.
+const BLOCK: usize = 1 << 14;
+
+/// Calls `f` on `0..n` in blocks of [`BLOCK`] indices, each block a call of its own.
+///
+/// A browser runs a WebAssembly function first as quickly compiled baseline code, and
+/// switches to its optimised code at a later call, never within one: a single call looping
+/// over a million triangles runs unoptimised to its end, where blocks switch a few blocks
+/// in. Natively it costs a call per block.
+pub(crate) fn in_blocks(n: usize, mut f: impl FnMut(std::ops::Range<usize>)) {
+    #[inline(never)]
+    fn block<F: FnMut(std::ops::Range<usize>)>(f: &mut F, range: std::ops::Range<usize>) {
+        f(range)
+    }
+    let mut start = 0;
+    while start < n {
+        let end = n.min(start + BLOCK);
+        block(&mut f, start..end);
+        start = end;
+    }
+}
+
 #[cfg(not(feature = "parallel"))]
 pub(crate) use sequential::*;
 
