@@ -259,9 +259,22 @@ impl App {
             self.canvas.set_height(size.1);
         }
         self.gpu.resize(size);
+        // A model's first frame: its recording in the page's performance timeline.
+        let timeline = web_sys::window()
+            .and_then(|w| w.performance())
+            .filter(|_| self.announce);
+        if let Some(p) = &timeline {
+            let _ = p.mark("wirepass-viewer: recording");
+        }
         let drawn = self
             .gpu
             .draw(&self.model, &self.orbit, &self.style, &self.sections);
+        if let Some(p) = &timeline {
+            let _ = p.measure_with_start_mark(
+                "wirepass-viewer: record the frame",
+                "wirepass-viewer: recording",
+            );
+        }
         let mut errors = self.gpu.take_errors();
         if let Err(e) = drawn {
             errors.push(e);
