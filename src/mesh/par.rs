@@ -52,7 +52,7 @@ mod sequential {
     /// Slice methods of rayon's `ParallelSlice` and `ParallelSliceMut`.
     pub(crate) trait ParallelSlice<T> {
         fn par_iter(&self) -> std::slice::Iter<'_, T>;
-        fn par_chunks(&self, size: usize) -> std::slice::Chunks<'_, T>;
+        fn par_chunks(&self, size: usize) -> Blocks<'_, T>;
         fn par_sort_unstable(&mut self)
         where
             T: Ord;
@@ -62,8 +62,8 @@ mod sequential {
         fn par_iter(&self) -> std::slice::Iter<'_, T> {
             self.iter()
         }
-        fn par_chunks(&self, size: usize) -> std::slice::Chunks<'_, T> {
-            self.chunks(size)
+        fn par_chunks(&self, size: usize) -> Blocks<'_, T> {
+            Blocks(self.chunks(size))
         }
         fn par_sort_unstable(&mut self)
         where
@@ -73,6 +73,24 @@ mod sequential {
         }
         fn par_sort_unstable_by_key<K: Ord, F: Fn(&T) -> K>(&mut self, key: F) {
             self.sort_unstable_by_key(key)
+        }
+    }
+
+    /// `par_chunks` on one thread: the chunks, whose `map` calls its function for each chunk
+    /// as a call of its own, so that a browser swaps in the function's optimised code after
+    /// the first chunks (see [`super::in_blocks`]).
+    pub(crate) struct Blocks<'a, T>(std::slice::Chunks<'a, T>);
+
+    impl<'a, T> Blocks<'a, T> {
+        pub(crate) fn map<B, F: Fn(&'a [T]) -> B>(
+            self,
+            f: F,
+        ) -> impl Iterator<Item = B> + use<'a, T, B, F> {
+            #[inline(never)]
+            fn call<A, B, F: Fn(A) -> B>(f: &F, a: A) -> B {
+                f(a)
+            }
+            self.0.map(move |chunk| call(&f, chunk))
         }
     }
 
