@@ -6,7 +6,7 @@
 
 use crate::camera::{Orbit, View};
 use crate::error::{Error, Result};
-use crate::style::{Color, HiddenLines, LinePattern, MAX_LINE_WIDTH};
+use crate::style::{comma_separated, Color, HiddenLines, LinePattern, MAX_LINE_WIDTH};
 use glam::{DMat4, DVec3};
 
 /// Most instances a frame may hold: instance slots must fit 18 bits of the trace pass's
@@ -437,10 +437,7 @@ impl SectionPlane {
     /// [`validate`](Self::validate).
     pub fn parse(s: &str) -> Result<SectionPlane> {
         let bad = || Error::InvalidSetting(format!("{s:?} is not PX,PY,PZ,NX,NY,NZ, six numbers"));
-        let n: Vec<f64> = s
-            .split(',')
-            .map(|t| t.trim().parse::<f64>().map_err(|_| bad()))
-            .collect::<Result<_>>()?;
+        let n: Vec<f64> = comma_separated(s, bad)?;
         let [px, py, pz, nx, ny, nz] = n[..] else {
             return Err(bad());
         };

@@ -248,11 +248,7 @@ impl LinePattern {
             Some((n, l)) => (n, Some(l)),
             None => (s, None),
         };
-        let numbers = |l: &str| -> Result<Vec<f32>> {
-            l.split(',')
-                .map(|t| t.trim().parse::<f32>().map_err(|_| bad()))
-                .collect()
-        };
+        let numbers = |l: &str| comma_separated::<f32>(l, bad);
         let pattern = match (name, lengths) {
             ("off", None) => return Ok(None),
             ("solid", None) => LinePattern::Solid,
@@ -626,6 +622,18 @@ pub fn srgb_to_linear(x: f32) -> f32 {
     } else {
         ((x + 0.055) / 1.055).powf(2.4)
     }
+}
+
+/// The numbers of `s`, separated by commas (spaces around each allowed); `bad` is the error
+/// where one is not a number. Settings of the command line, scene files and the web element
+/// are read with it.
+pub(crate) fn comma_separated<T: std::str::FromStr>(
+    s: &str,
+    bad: impl Fn() -> Error,
+) -> Result<Vec<T>> {
+    s.split(',')
+        .map(|t| t.trim().parse::<T>().map_err(|_| bad()))
+        .collect()
 }
 
 #[cfg(test)]

@@ -134,10 +134,7 @@ pub fn parse_size(s: &str) -> Result<(u32, u32)> {
 /// Parses `x,y,z`.
 pub fn parse_vec3(s: &str) -> Result<Vec3> {
     let bad = || Error::InvalidSetting(format!("{s:?} is not three numbers x,y,z"));
-    let v: Vec<f32> = s
-        .split(',')
-        .map(|c| c.trim().parse::<f32>().map_err(|_| bad()))
-        .collect::<Result<_>>()?;
+    let v: Vec<f32> = crate::style::comma_separated(s, bad)?;
     match v[..] {
         [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok(Vec3::new(x, y, z)),
         _ => Err(bad()),
