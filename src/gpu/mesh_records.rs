@@ -40,15 +40,23 @@ pub struct UploadReport {
 }
 
 impl UploadReport {
+    /// The steps in the order an insert takes them, named as `wirepass render --timings`
+    /// and the web element's timeline name them, with their times.
+    pub fn steps(&self) -> [(&'static str, Duration); 7] {
+        [
+            ("adjacency", self.adjacency),
+            ("outline hints", self.outline_hints),
+            ("clusters", self.clusters),
+            ("crossings", self.crossings),
+            ("edges: patches, chains", self.edges),
+            ("records", self.records),
+            ("queue the upload", self.upload),
+        ]
+    }
+
     /// The steps' times added up.
     pub fn total(&self) -> Duration {
-        self.adjacency
-            + self.outline_hints
-            + self.clusters
-            + self.crossings
-            + self.edges
-            + self.records
-            + self.upload
+        self.steps().iter().map(|(_, d)| *d).sum()
     }
 }
 

@@ -5,7 +5,9 @@
 use crate::model::Model;
 use std::sync::{Arc, Mutex};
 use wirepass::camera::Orbit;
-use wirepass::gpu::{Composite, Location, MeshId, PickView, Picked, PickedIds, RenderTarget};
+use wirepass::gpu::{
+    Composite, Location, MeshId, PickView, Picked, PickedIds, RenderTarget, UploadReport,
+};
 use wirepass::{
     wgpu, DeferredPass, EdgeSelection, Instance, MeshStore, OutputTarget, PassOptions, Scene,
     SectionPlane, Style,
@@ -243,28 +245,16 @@ impl Gpu {
     /// What the last upload's preprocessing took, step by step over its meshes, as
     /// `step ms` pairs (`MeshStore::upload_report`).
     pub fn upload_steps(&self) -> Vec<(&'static str, f64)> {
-        let mut steps: Vec<(&'static str, f64)> = Vec::new();
+        let mut steps = UploadReport::default().steps().map(|(name, _)| (name, 0.0));
         for &(id, _) in &self.ids {
-            let Ok(r) = self.store.upload_report(id) else {
+            let Ok(report) = self.store.upload_report(id) else {
                 continue;
             };
-            let each = [
-                ("adjacency", r.adjacency),
-                ("outline hints", r.outline_hints),
-                ("clusters", r.clusters),
-                ("crossings", r.crossings),
-                ("edges: patches, chains", r.edges),
-                ("records", r.records),
-                ("queue the upload", r.upload),
-            ];
-            for (k, (name, d)) in each.into_iter().enumerate() {
-                match steps.get_mut(k) {
-                    Some(s) => s.1 += d.as_secs_f64() * 1e3,
-                    None => steps.push((name, d.as_secs_f64() * 1e3)),
-                }
+            for (step, (_, d)) in steps.iter_mut().zip(report.steps()) {
+                step.1 += d.as_secs_f64() * 1e3;
             }
         }
-        steps
+        steps.to_vec()
     }
 
     /// Configures the canvas again when its size changed.
