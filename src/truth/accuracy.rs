@@ -5,12 +5,21 @@
 use crate::error::{Error, Result};
 use crate::world::{Rendering, BACKGROUND};
 
-/// Edge distances are compared only where the true distance is below this many pixels:
-/// that is where a line can be drawn, and where the distance matters.
+/// Edge distances are compared where the true distance is below this many pixels: that is
+/// where a line can be drawn, and where the distance matters.
 pub const DISTANCE_RANGE_PX: f64 = 4.0;
 
+/// And where the frame's distance is below this many pixels, whatever the truth's: a line
+/// this near its pixel's centre colours it at any width, so a frame's line where the ground
+/// truth has none is a stray line pixel. (Beyond a line's reach the distances a frame
+/// reports need not match: it colours nothing there.)
+pub const STRAY_RANGE_PX: f64 = 1.0;
+
 /// Edge-distance error in pixels: over pixels whose ids agree with the ground truth and whose
-/// true distance is finite and under [`DISTANCE_RANGE_PX`]. `None` when no pixel qualifies.
+/// true distance is under [`DISTANCE_RANGE_PX`] or measured one under [`STRAY_RANGE_PX`], so
+/// that a line missing from the frame and a stray line the ground truth does not draw both
+/// count (as an infinite error where the other side has no line). `None` when no pixel
+/// qualifies.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[cfg_attr(feature = "tools", derive(serde::Serialize))]
 pub struct DistanceError {
@@ -18,7 +27,7 @@ pub struct DistanceError {
     pub mean: Option<f64>,
     /// 99th percentile (nearest rank) of the absolute error.
     pub p99: Option<f64>,
-    /// Largest absolute error (`inf` where a method reports no edge where there is one).
+    /// Largest absolute error (`inf` where one side has a line and the other none).
     pub max: Option<f64>,
     /// Number of pixels measured.
     pub pixels: usize,
@@ -117,7 +126,7 @@ pub fn percentile(sorted: &[f64], q: f64) -> Option<f64> {
 }
 
 /// Per pixel, `|d − d_true|` where it is measured (ids agree, background included, which
-/// outlines reach; true distance finite and under [`DISTANCE_RANGE_PX`]), `None` elsewhere.
+/// outlines reach; see [`DistanceError`]), `None` elsewhere.
 pub fn distance_errors(reference: &Rendering, frame: &Rendering) -> Result<Vec<Option<f64>>> {
     errors_of(reference, frame, |f| &f.edge_distance)
 }
@@ -139,12 +148,11 @@ fn errors_of(
     let (truths, distances) = (map(reference), map(frame));
     Ok((0..reference.ids.len())
         .map(|i| {
-            let id = reference.ids[i];
-            let truth = f64::from(truths[i]);
-            let measured = frame.ids[i] == id && truth.is_finite() && truth < DISTANCE_RANGE_PX;
+            let (truth, d) = (f64::from(truths[i]), f64::from(distances[i]));
+            let measured = frame.ids[i] == reference.ids[i]
+                && (truth < DISTANCE_RANGE_PX || d < STRAY_RANGE_PX);
             measured.then(|| {
-                let d = f64::from(distances[i]);
-                if d.is_finite() {
+                if d.is_finite() && truth.is_finite() {
                     (d - truth).abs()
                 } else {
                     f64::INFINITY
@@ -152,4 +160,37 @@ fn errors_of(
             })
         })
         .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Four pixels of one triangle, with the given edge distances.
+    fn frame(edge_distance: [f32; 4]) -> Rendering {
+        Rendering {
+            size: (4, 1),
+            rgba: vec![0; 16],
+            ids: vec![7; 4],
+            depth: vec![0.5; 4],
+            edge_distance: edge_distance.to_vec(),
+            hidden_distance: vec![f32::INFINITY; 4],
+            line_class: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn a_missing_and_a_stray_line_pixel_both_count() {
+        let inf = f32::INFINITY;
+        let truth = frame([0.5, 2.0, inf, inf]);
+        // Alike, and a line of the frame beyond the stray range: no error.
+        let same = distance_error(&truth, &frame([0.5, 2.0, inf, 3.0])).unwrap();
+        assert_eq!((same.max, same.pixels), (Some(0.0), 2));
+        // The line through pixel 1 missing.
+        let missing = distance_error(&truth, &frame([0.5, inf, inf, inf])).unwrap();
+        assert_eq!((missing.max, missing.pixels), (Some(f64::INFINITY), 2));
+        // A line through pixel 2 that the truth does not draw.
+        let stray = distance_error(&truth, &frame([0.5, 2.0, 0.25, inf])).unwrap();
+        assert_eq!((stray.max, stray.pixels), (Some(f64::INFINITY), 3));
+    }
 }
