@@ -22,6 +22,10 @@ beside it), a URL that answers 404 and a file that is not a model. Checked:
     python3 web/tests/element.py --first-frame 1000000   # a sphere of that many triangles as a
                                                           # GLB (written to --out): time from
                                                           # `src` set to its first frame
+    python3 web/tests/element.py --first-frame 1000000 --compile-times
+        # and how long the browser's GPU process takes to compile each pipeline that frame
+        # built: recorded as the element creates them, then created again one at a time
+        # (createComputePipelineAsync) on a new browser's device, where nothing is cached
 
 Exits non-zero with one line saying what failed.
 """
@@ -147,6 +151,66 @@ REMOVED = """<!doctype html>
 </body></html>
 """
 
+# Records every pipeline the page creates (its WGSL and entry points, and a render
+# pipeline's fixed state) in `window.pipelines`, before the element's module runs.
+RECORD_PIPELINES = """<script>
+  const codes = new WeakMap();
+  window.pipelines = [];
+  const device = GPUDevice.prototype;
+  const module = device.createShaderModule;
+  device.createShaderModule = function (d) {
+    const m = module.call(this, d);
+    codes.set(m, d.code);
+    return m;
+  };
+  const compute = device.createComputePipeline;
+  device.createComputePipeline = function (d) {
+    window.pipelines.push({label: d.label, code: codes.get(d.compute.module), entry: d.compute.entryPoint});
+    return compute.call(this, d);
+  };
+  const render = device.createRenderPipeline;
+  device.createRenderPipeline = function (d) {
+    const stage = (s) => s && {code: codes.get(s.module), entry: s.entryPoint};
+    window.pipelines.push({label: d.label, vertex: {...stage(d.vertex), buffers: d.vertex.buffers},
+      fragment: d.fragment && {...stage(d.fragment), targets: d.fragment.targets},
+      primitive: d.primitive, depthStencil: d.depthStencil, multisample: d.multisample});
+    return render.call(this, d);
+  };
+</script>"""
+
+# Compiles the pipelines of /test/pipelines.json one after another on a new device, and
+# leaves each one's time from the call to its promise resolving in `window.compiled`.
+COMPILE = """<!doctype html>
+<html><head><meta charset="utf-8"></head><body>
+<script type="module">
+  try {
+    const pipelines = await (await fetch("/test/pipelines.json")).json();
+    const adapter = await navigator.gpu.requestAdapter();
+    const device = await adapter.requestDevice();
+    const stage = (s) => s && {module: device.createShaderModule({code: s.code}), entryPoint: s.entry};
+    const times = [];
+    for (const p of pipelines) {
+      const start = performance.now();
+      if (p.code) {
+        await device.createComputePipelineAsync({layout: "auto", compute: stage(p)});
+      } else {
+        const d = {layout: "auto", vertex: {...stage(p.vertex), buffers: p.vertex.buffers}};
+        for (const k of ["primitive", "depthStencil", "multisample"]) {
+          if (p[k]) d[k] = p[k];
+        }
+        if (p.fragment) d.fragment = {...stage(p.fragment), targets: p.fragment.targets};
+        await device.createRenderPipelineAsync(d);
+      }
+      times.push([p.entry ?? p.vertex.entry, p.label, performance.now() - start]);
+    }
+    window.compiled = times;
+  } catch (e) {
+    window.failed = String(e);
+  }
+</script>
+</body></html>
+"""
+
 FIRST_FRAME = """<!doctype html>
 <html><head><meta charset="utf-8">
 <style>wirepass-viewer { width: 640px; height: 480px; display: block; }</style></head><body>
@@ -235,6 +299,45 @@ at("pointerup", 15 * moves, 0);
 """
 
 
+def first_frame(args, handler, served):
+    """--first-frame: the time from `src` set to the first frame, and with --compile-times
+    each pipeline's compile time on a new browser's device."""
+    def poll(base, s, what, script, seconds):
+        start = time.time()
+        while True:
+            value = call(base, "POST", s + "/execute/sync", {"script": script, "args": []})
+            if value:
+                return value
+            if time.time() - start > seconds:
+                sys.exit(f"element: timed out waiting for {what}")
+            time.sleep(0.1)
+
+    with browser(handler, args.chromedriver, 300) as (base, s, origin):
+        call(base, "POST", s + "/url", {"url": origin + "/test/first-frame.html"})
+        ms = poll(base, s, "the model's first frame", "return window.firstFrame || window.failed", 600)
+        if isinstance(ms, str):
+            sys.exit(f"element: {ms}")
+        print(f"element: {args.out}/sphere.glb, 640x480, from src set to the first frame drawn: "
+              f"{ms['cold']:.0f} ms on a new element (module, device and pipelines included), "
+              f"{ms['warm']:.0f} ms as a new src of a drawing element (cold, then warm: {ms['steps']})")
+        if not args.compile_times:
+            return
+        # The pipelines, recorded in a page of their own (its first frame is not timed).
+        call(base, "POST", s + "/url", {"url": origin + "/test/first-frame-recorded.html"})
+        poll(base, s, "the recorded page's first frame", "return window.firstFrame || window.failed", 600)
+        pipelines = call(base, "POST", s + "/execute/sync", {"script": "return window.pipelines", "args": []})
+    served["/test/pipelines.json"] = ("application/json", json.dumps(pipelines).encode())
+    with browser(handler, args.chromedriver, 300) as (base, s, origin):
+        call(base, "POST", s + "/url", {"url": origin + "/test/compile.html"})
+        times = poll(base, s, "the pipelines to compile", "return window.compiled || window.failed", 600)
+        if isinstance(times, str):
+            sys.exit(f"element: compiling the pipelines: {times}")
+        total = sum(t for _, _, t in times)
+        print(f"element: the first frame's {len(times)} pipelines compile in {total:.0f} ms, one after "
+              "another on a new device: "
+              + ", ".join(f"{entry} {t:.0f} ms" for entry, _, t in sorted(times, key=lambda t: -t[2])))
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--package", default=os.path.join(WEB, "package"))
@@ -243,7 +346,11 @@ def main():
                         help="where a snapshot that fails its comparison is saved")
     parser.add_argument("--first-frame", metavar="TRIANGLES", type=int,
                         help="time a sphere GLB of this many triangles from `src` set to its first frame")
+    parser.add_argument("--compile-times", action="store_true",
+                        help="with --first-frame: time the GPU process compiling each pipeline of that frame")
     args = parser.parse_args()
+    if args.compile_times and not args.first_frame:
+        sys.exit("element: --compile-times times the pipelines of --first-frame's frame: give both")
     package = os.path.abspath(args.package)
     if not os.path.exists(os.path.join(package, "wirepass-viewer.js")):
         sys.exit(f"element: {package}/wirepass-viewer.js is missing: run web/package.sh first")
@@ -260,6 +367,8 @@ def main():
         "/test/page.html": ("text/html", page(views).encode()),
         "/test/no-webgpu.html": ("text/html", NO_WEBGPU.encode()),
         "/test/first-frame.html": ("text/html", FIRST_FRAME.encode()),
+        "/test/first-frame-recorded.html": ("text/html", FIRST_FRAME.replace("<body>", "<body>" + RECORD_PIPELINES, 1).encode()),
+        "/test/compile.html": ("text/html", COMPILE.encode()),
         "/test/removed.html": ("text/html", REMOVED.encode()),
         "/test/broken.glb": ("model/gltf-binary", b"glTF\x02\x00\x00\x00this is not a model"),
         "/test/model.glb": ("model/gltf-binary", big),
@@ -290,6 +399,10 @@ def main():
         def log_message(self, *args):
             pass
 
+    if args.first_frame:
+        first_frame(args, functools.partial(Handler, directory=ROOT), served)
+        return
+
     with browser(functools.partial(Handler, directory=ROOT), args.chromedriver, 300) as (base, s, origin):
         def run(script, *arguments):
             return call(base, "POST", s + "/execute/sync", {"script": script, "args": list(arguments)})
@@ -306,16 +419,6 @@ def main():
                 if time.time() - start > seconds:
                     sys.exit(f"element: timed out waiting for {what}")
                 time.sleep(0.1)
-
-        if args.first_frame:
-            call(base, "POST", s + "/url", {"url": origin + "/test/first-frame.html"})
-            ms = wait("the model's first frame", "return window.firstFrame || window.failed", 600)
-            if isinstance(ms, str):
-                sys.exit(f"element: {ms}")
-            print(f"element: {args.out}/sphere.glb, 640x480, from src set to the first frame drawn: "
-                  f"{ms['cold']:.0f} ms on a new element (module, device and pipelines included), "
-                  f"{ms['warm']:.0f} ms as a new src of a drawing element (cold, then warm: {ms['steps']})")
-            return
 
         call(base, "POST", s + "/url", {"url": origin + "/test/page.html"})
         events = "return window.events.filter(e => e.id === arguments[0] && e.type === arguments[1])"
