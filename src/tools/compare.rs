@@ -209,9 +209,9 @@ fn frame_image(frame: &Rendering) -> Image {
 pub enum MethodReport {
     /// It rendered; its metrics and timing.
     Measured {
-        /// Accuracy against the ground truth.
+        /// Accuracy against the ground truth (boxed: it is most of the report's size).
         #[serde(flatten)]
-        metrics: Metrics,
+        metrics: Box<Metrics>,
         /// GPU time of the method's passes; `None` where not measured (see `note`).
         gpu_ms: Option<f64>,
         /// Wall-clock time of the whole render call: pipeline creation, upload, draw and
@@ -317,7 +317,7 @@ pub fn run(ctx: &GpuContext, shot: &Shot<'_>, out: &Path) -> Result<Report> {
                 flip.save_png(&out.join(format!("{key}_flip.png")))?;
                 panels.push((name.to_string(), Some([frame_image(&frame), heat, flip])));
                 MethodReport::Measured {
-                    metrics: metrics(&reference, &frame)?,
+                    metrics: Box::new(metrics(&reference, &frame)?),
                     gpu_ms: gpu_ms.get(name).copied(),
                     wall_ms,
                     note: note.clone(),
@@ -411,13 +411,15 @@ pub fn table(report: &Report) -> String {
         None => "-".into(),
     };
     let mut lines = vec![format!(
-        "{:<10} {:>9} {:>9} {:>9} {:>9} {:>9} {:>8} {:>8} {:>9} {:>9}",
+        "{:<10} {:>9} {:>9} {:>9} {:>9} {:>9} {:>7} {:>7} {:>8} {:>8} {:>9} {:>9}",
         "method",
         "id agree",
         "coverage",
         "d mean",
         "d p99",
         "d max",
+        "stray",
+        "missing",
         "flip",
         "flip p99",
         "gpu ms",
@@ -431,13 +433,15 @@ pub fn table(report: &Report) -> String {
                 wall_ms,
                 ..
             } => format!(
-                "{:<10} {:>9.5} {:>9.5} {:>9} {:>9} {:>9} {:>8.4} {:>8.4} {:>9} {:>9.1}",
+                "{:<10} {:>9.5} {:>9.5} {:>9} {:>9} {:>9} {:>7} {:>7} {:>8.4} {:>8.4} {:>9} {:>9.1}",
                 m.name(),
                 metrics.id_agreement,
                 metrics.coverage_agreement,
                 fmt(metrics.distance_error_px.mean),
                 fmt(metrics.distance_error_px.p99),
                 fmt(metrics.distance_error_px.max),
+                metrics.distance_error_px.stray,
+                metrics.distance_error_px.missing,
                 metrics.image_difference.flip_mean,
                 metrics.image_difference.flip_p99,
                 gpu_ms.map_or("-".into(), |v| format!("{v:.3}")),
@@ -462,16 +466,18 @@ pub fn table(report: &Report) -> String {
     if hidden.iter().any(|(_, h)| h.pixels > 0) {
         lines.push(String::new());
         lines.push(format!(
-            "{:<10} {:>9} {:>9} {:>9} {:>9}",
-            "hidden", "h mean", "h p99", "h max", "pixels"
+            "{:<10} {:>9} {:>9} {:>9} {:>7} {:>7} {:>9}",
+            "hidden", "h mean", "h p99", "h max", "stray", "missing", "pixels"
         ));
         for (m, h) in hidden {
             lines.push(format!(
-                "{:<10} {:>9} {:>9} {:>9} {:>9}",
+                "{:<10} {:>9} {:>9} {:>9} {:>7} {:>7} {:>9}",
                 m.name(),
                 fmt(h.mean),
                 fmt(h.p99),
                 fmt(h.max),
+                h.stray,
+                h.missing,
                 h.pixels
             ));
         }
@@ -544,6 +550,7 @@ mod tests {
         assert_eq!(d.max, Some(0.25));
         assert_eq!(d.p99, Some(0.25));
         assert!((d.mean.unwrap() - 0.25 / 3.0).abs() < 1e-12);
+        assert_eq!((d.stray, d.missing), (0, 0));
         assert_eq!(m.image_difference.flip_mean, 0.0);
     }
 

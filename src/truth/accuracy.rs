@@ -31,6 +31,10 @@ pub struct DistanceError {
     pub max: Option<f64>,
     /// Number of pixels measured.
     pub pixels: usize,
+    /// Measured pixels where the frame has a line and the ground truth none.
+    pub stray: usize,
+    /// Measured pixels where the ground truth has a line and the frame none.
+    pub missing: usize,
 }
 
 /// Checks that two frames can be compared pixel for pixel.
@@ -78,23 +82,42 @@ pub fn id_agreement(reference: &Rendering, frame: &Rendering) -> Result<(f64, f6
 
 /// The [`DistanceError`] of `frame` against `reference`; an error if their sizes differ.
 pub fn distance_error(reference: &Rendering, frame: &Rendering) -> Result<DistanceError> {
-    Ok(summarise(distance_errors(reference, frame)?))
+    summarise(reference, frame, |f| &f.edge_distance)
 }
 
 /// [`distance_error`] of the hidden lines ([`Rendering::hidden_distance`]).
 pub fn hidden_distance_error(reference: &Rendering, frame: &Rendering) -> Result<DistanceError> {
-    Ok(summarise(hidden_distance_errors(reference, frame)?))
+    summarise(reference, frame, |f| &f.hidden_distance)
 }
 
-fn summarise(errors: Vec<Option<f64>>) -> DistanceError {
+fn summarise(
+    reference: &Rendering,
+    frame: &Rendering,
+    map: impl Fn(&Rendering) -> &[f32],
+) -> Result<DistanceError> {
+    let errors = errors_of(reference, frame, &map)?;
+    // An infinite error is a line on one side only: the frame's (stray) or the truth's.
+    let lined = map(frame);
+    let (mut stray, mut missing) = (0, 0);
+    for (i, e) in errors.iter().enumerate() {
+        if *e == Some(f64::INFINITY) {
+            if lined[i].is_finite() {
+                stray += 1;
+            } else {
+                missing += 1;
+            }
+        }
+    }
     let mut measured: Vec<f64> = errors.into_iter().flatten().collect();
     measured.sort_by(f64::total_cmp);
-    DistanceError {
+    Ok(DistanceError {
         mean: (!measured.is_empty()).then(|| measured.iter().sum::<f64>() / measured.len() as f64),
         p99: percentile(&measured, 0.99),
         max: measured.last().copied(),
         pixels: measured.len(),
-    }
+        stray,
+        missing,
+    })
 }
 
 /// Among pixels whose ids agree and where either side has a line, the fraction whose
@@ -189,8 +212,10 @@ mod tests {
         // The line through pixel 1 missing.
         let missing = distance_error(&truth, &frame([0.5, inf, inf, inf])).unwrap();
         assert_eq!((missing.max, missing.pixels), (Some(f64::INFINITY), 2));
+        assert_eq!((missing.stray, missing.missing), (0, 1));
         // A line through pixel 2 that the truth does not draw.
         let stray = distance_error(&truth, &frame([0.5, 2.0, 0.25, inf])).unwrap();
         assert_eq!((stray.max, stray.pixels), (Some(f64::INFINITY), 3));
+        assert_eq!((stray.stray, stray.missing), (1, 0));
     }
 }
