@@ -299,19 +299,22 @@ at("pointerup", 15 * moves, 0);
 """
 
 
+def poll(base, s, what, script, seconds):
+    """Runs `script` in the session's page until it returns something, for `what`; exits
+    naming it after `seconds`."""
+    start = time.time()
+    while True:
+        value = call(base, "POST", s + "/execute/sync", {"script": script, "args": []})
+        if value:
+            return value
+        if time.time() - start > seconds:
+            sys.exit(f"element: timed out waiting for {what}")
+        time.sleep(0.1)
+
+
 def first_frame(args, handler, served):
     """--first-frame: the time from `src` set to the first frame, and with --compile-times
     each pipeline's compile time on a new browser's device."""
-    def poll(base, s, what, script, seconds):
-        start = time.time()
-        while True:
-            value = call(base, "POST", s + "/execute/sync", {"script": script, "args": []})
-            if value:
-                return value
-            if time.time() - start > seconds:
-                sys.exit(f"element: timed out waiting for {what}")
-            time.sleep(0.1)
-
     with browser(handler, args.chromedriver, 300) as (base, s, origin):
         call(base, "POST", s + "/url", {"url": origin + "/test/first-frame.html"})
         ms = poll(base, s, "the model's first frame", "return window.firstFrame || window.failed", 600)
@@ -411,14 +414,7 @@ def main():
             return call(base, "POST", s + "/execute/async", {"script": script, "args": list(arguments)})
 
         def wait(what, script, seconds=240):
-            start = time.time()
-            while True:
-                value = run(script)
-                if value:
-                    return value
-                if time.time() - start > seconds:
-                    sys.exit(f"element: timed out waiting for {what}")
-                time.sleep(0.1)
+            return poll(base, s, what, script, seconds)
 
         call(base, "POST", s + "/url", {"url": origin + "/test/page.html"})
         events = "return window.events.filter(e => e.id === arguments[0] && e.type === arguments[1])"
