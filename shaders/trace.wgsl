@@ -919,6 +919,8 @@ struct Segment {
     hidden_dir: f32,
     // How the eye's ray reaches the line where no other surface tells (`capped`).
     cap: u32,
+    // The line's ends (`LineEnds`).
+    ends: LineEnds,
 }
 
 fn seg_at(s: Segment, k: f32) -> Projected {
@@ -935,7 +937,7 @@ fn seg_class(s: Segment, k: f32) -> u32 {
     let inset = min(END_INSET / max(distance(s.start.xy, s.end.xy), 1e-30), 0.5);
     let q = seg_at(s, clamp(k, inset, 1.0 - inset));
     let w = 1.0 / q.inv_w;
-    let c = class_at(q.xy, q.near_w * w, w, q.reverse, s.on, s.cap);
+    let c = class_at(q.xy, q.near_w * w, w, q.reverse, s.on, s.cap, s.ends);
 #if HIDDEN
     let behind_host = (instances[slot(s.on.inst)].flags & INSTANCE_BEHIND_HOST) != 0u;
     return select(c, 1u, c == 2u && behind_host);
@@ -1018,6 +1020,8 @@ fn clip_outline(on: On, a: vec3<f32>, b: vec3<f32>, anchor: vec4<f32>, skip: u32
     c.seg.start = lerp_projected(p0, p1, u.x);
     c.seg.end = lerp_projected(p0, p1, u.y);
     c.seg.on = on;
+    // An edge's ends are mesh vertices; a cut line's and an intersection line's are not.
+    c.seg.ends = LineEnds(skip == NO_PLANE && !on.crossing, a, b);
     let full = length(d);
     c.seg.phase = anchor.x + select((1.0 - u.x) * full, u.x * full, anchor.y > 0.0);
     c.seg.phase_dir = anchor.y;
@@ -1392,7 +1396,7 @@ fn mark_traced_tiles(first_m: i32, last_m: i32, first_o: i32, last_o: i32, major
 // surface in front of it (within HIDDEN_MARGIN) faces away, the ray came out of the solid
 // through it; where that surface faces the eye, it went in there; where none is nearer by
 // CAP_MARGIN, the line's own triangles tell (CAP_INSIDE).
-fn class_at(x: vec2<f32>, near: f32, w: f32, reverse: f32, on: On, cap: u32) -> u32 {
+fn class_at(x: vec2<f32>, near: f32, w: f32, reverse: f32, on: On, cap: u32, ends: LineEnds) -> u32 {
     let centre = vec2<i32>(floor(x - frame.target_origin));
     if host_hides_point(x - frame.target_origin, reverse) {
         return 2u;
@@ -1414,7 +1418,7 @@ fn class_at(x: vec2<f32>, near: f32, w: f32, reverse: f32, on: On, cap: u32) -> 
         last = id;
         // The outer ring's walks only cross the sheet's last few triangles to x.
         let steps = select(WALK_STEPS, FOLD_STEPS, max(abs(offset.x), abs(offset.y)) > 1);
-        if hides(locate(id.x, id.y, x, steps, true), on, near, w, &front) {
+        if hides(locate(id.x, id.y, x, steps, true), on, ends, near, w, &front) {
             return 1u;
         }
     }
@@ -1433,7 +1437,7 @@ fn class_at(x: vec2<f32>, near: f32, w: f32, reverse: f32, on: On, cap: u32) -> 
             if m == BACKGROUND_ID || lies_on(on, owner_inst, m) {
                 continue;
             }
-            if hides(locate(owner_inst, m, x, FOLD_STEPS, true), on, near, w, &front) {
+            if hides(locate(owner_inst, m, x, FOLD_STEPS, true), on, ends, near, w, &front) {
                 return 1u;
             }
         }
@@ -1476,12 +1480,36 @@ fn lies_on(on: On, inst: u32, tri: u32) -> bool {
 
 // Whether sample s of a triangle the line does not lie on covers the line's point (near
 // row `near`, w `w`) nearer than it (by HIDDEN_MARGIN); else keeps in `front` the nearest
-// one within that margin but nearer by CAP_MARGIN, and whether it faces away.
-fn hides(s: Sample, on: On, near: f32, w: f32, front: ptr<function, vec2<f32>>) -> bool {
-    if !s.covers || lies_on(on, s.inst, s.tri) {
+// one within that margin but nearer by CAP_MARGIN, and whether it faces away. A triangle
+// with a corner at an end of the line (an edge's, `ends`) that covers a point within
+// COVERAGE_MARGIN of its edges covers it only where `fan_covers` agrees: its two edges
+// through that vertex pass within f32 rounding of the line's points near it, and of all its
+// points where the line runs along one of them on screen (beside a triangle seen edge-on).
+fn hides(s: Sample, on: On, ends: LineEnds, near: f32, w: f32, front: ptr<function, vec2<f32>>) -> bool {
+    if lies_on(on, s.inst, s.tri) {
         return false;
     }
-    if nearer(s.near, near, w) {
+    let in_front = nearer(s.near, near, w);
+    var covers = s.covers;
+    // Farther from the triangle's edges rounding does not decide, and behind the point
+    // coverage does not matter. (A loop, not an `if`: a software rasterizer skips a loop no
+    // lane enters, and runs the body of an `if` for every lane.)
+    for (var near_edge = s.covers && in_front && ends.edge && s.inst == on.inst && s.margin < COVERAGE_MARGIN; near_edge; near_edge = false) {
+        let at = vec3<bool>(all(s.v0.xyz == ends.a), all(s.v1.xyz == ends.a), all(s.v2.xyz == ends.a));
+        let bt = vec3<bool>(all(s.v0.xyz == ends.b), all(s.v1.xyz == ends.b), all(s.v2.xyz == ends.b));
+        let at_a = any(at);
+        if at_a || any(bt) {
+            let corner = select(bt, at, at_a);
+            let v = select(ends.b, ends.a, at_a);
+            // The weight of the shared corner: the opposite edge's side.
+            let weight = select(select(s.bary.z, s.bary.y, corner.y), s.bary.x, corner.x);
+            covers = fan_covers(s, v, select(ends.a, ends.b, at_a) - v, weight);
+        }
+    }
+    if !covers {
+        return false;
+    }
+    if in_front {
         return true;
     }
 #if SECTIONS
@@ -1491,3 +1519,54 @@ fn hides(s: Sample, on: On, near: f32, w: f32, front: ptr<function, vec2<f32>>) 
 #endif
     return false;
 }
+
+// A line's ends in the local coordinates of its instance, and whether they are mesh
+// vertices (`edge`: an edge's, not a cut line's or an intersection line's).
+struct LineEnds {
+    edge: bool,
+    a: vec3<f32>,
+    b: vec3<f32>,
+}
+
+// Whether sample s, a triangle with a corner at v (its weight `weight` at the point), covers
+// the point of the line leaving v along direction `d` in front of the line: the point lies
+// inside the triangle's edge opposite v, the line's direction lies inside the triangle's
+// angle at v as seen from the eye (the triangle lies inside that angle), and the line leaves
+// v to the far side of the triangle's plane. The last two hold all along the line or nowhere
+// on it, and are triple products of the differences from v in the instance's own
+// coordinates (as `is_silhouette`'s): f32 keeps them where a point near v, or near the
+// triangle's edges through v, loses its side, and where a line runs along such an edge
+// (beside a triangle seen edge-on). Where one of them is within EDGE_ON of 0 they do not
+// decide, nor with v behind the eye (a line the near plane cuts): the sample's own coverage
+// tells.
+fn fan_covers(s: Sample, v: vec3<f32>, d: vec3<f32>, weight: f32) -> bool {
+    // The triangle's two other corners.
+    var p = array<vec3<f32>, 2>(s.v1.xyz, s.v2.xyz);
+    if all(s.v1.xyz == v) {
+        p = array<vec3<f32>, 2>(s.v2.xyz, s.v0.xyz);
+    } else if all(s.v2.xyz == v) {
+        p = array<vec3<f32>, 2>(s.v0.xyz, s.v1.xyz);
+    }
+    let e1 = p[0] - v;
+    let e2 = p[1] - v;
+    let to_eye = towards_eye(v, instances[slot(s.inst)].eye);
+    let n = cross(e1, e2);
+    let turn = select(-1.0, 1.0, dot(to_eye, n) > 0.0);
+    // Each side of d against an edge, positive inside the angle, and the sines' margins.
+    let side1 = turn * dot(to_eye, cross(e1, d));
+    let side2 = turn * dot(to_eye, cross(d, e2));
+    let scale = EDGE_ON * length(to_eye) * length(d);
+    let margin = scale * vec2<f32>(length(e1), length(e2));
+    let inside = dot(to_eye, n) != 0.0 && side1 > margin.x && side2 > margin.y;
+    let outside = side1 < -margin.x || side2 < -margin.y;
+    // Positive where the line leaves v towards the eye's side of the triangle's plane.
+    let eye_side = dot(n, d) * sign(dot(n, to_eye));
+    let plane = EDGE_ON * length(n) * length(d);
+    let in_front = eye_side < -plane;
+    let behind = eye_side > plane;
+    let ahead = (instances[slot(s.inst)].clip * vec4<f32>(v, 1.0)).w > 0.0;
+    let decided = ahead && (outside || (inside && (in_front || behind)));
+    return select(s.covers, s.in_view && weight >= 0.0 && inside && in_front, decided);
+}
+
+
