@@ -294,9 +294,6 @@ struct Sample {
     // The point's ray hits the triangle between the near and far planes, where no section
     // plane cuts it away.
     covers: bool,
-    // The same, whatever the barycentric weights: the ray's hit on the triangle's plane lies
-    // between the near and far planes, and no section plane cuts it away.
-    in_view: bool,
     // Distances from the point to the three edge lines, drawn or not.
     lines: vec3<f32>,
     // The smallest of them.
@@ -344,8 +341,7 @@ fn sample_corners(inst: u32, tri: u32, v0: vec4<f32>, v1: vec4<f32>, v2: vec4<f3
     // Not cut away by a section plane (the visibility pass's test, at this point).
     let sides = section_sides(frame, hit);
     let kept = all(sides.a >= vec4<f32>(0.0)) && all(sides.b >= vec2<f32>(0.0));
-    s.in_view = hit.z >= 0.0 && r >= 0.0 && kept;
-    s.covers = all(b >= vec3<f32>(0.0)) && s.in_view;
+    s.covers = all(b >= vec3<f32>(0.0)) && hit.z >= 0.0 && r >= 0.0 && kept;
     s.near = hit.z;
     s.w = hit.w;
     s.depth = r / hit.w;

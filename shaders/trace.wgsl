@@ -1495,15 +1495,11 @@ fn hides(s: Sample, on: On, ends: LineEnds, near: f32, w: f32, front: ptr<functi
     // coverage does not matter. (A loop, not an `if`: a software rasterizer skips a loop no
     // lane enters, and runs the body of an `if` for every lane.)
     for (var near_edge = s.covers && in_front && ends.edge && s.inst == on.inst && s.margin < COVERAGE_MARGIN; near_edge; near_edge = false) {
-        let at = vec3<bool>(all(s.v0.xyz == ends.a), all(s.v1.xyz == ends.a), all(s.v2.xyz == ends.a));
-        let bt = vec3<bool>(all(s.v0.xyz == ends.b), all(s.v1.xyz == ends.b), all(s.v2.xyz == ends.b));
-        let at_a = any(at);
-        if at_a || any(bt) {
-            let corner = select(bt, at, at_a);
+        let at_a = all(s.v0.xyz == ends.a) || all(s.v1.xyz == ends.a) || all(s.v2.xyz == ends.a);
+        let at_b = all(s.v0.xyz == ends.b) || all(s.v1.xyz == ends.b) || all(s.v2.xyz == ends.b);
+        if at_a || at_b {
             let v = select(ends.b, ends.a, at_a);
-            // The weight of the shared corner: the opposite edge's side.
-            let weight = select(select(s.bary.z, s.bary.y, corner.y), s.bary.x, corner.x);
-            covers = fan_covers(s, v, select(ends.a, ends.b, at_a) - v, weight);
+            covers = fan_covers(s, v, select(ends.a, ends.b, at_a) - v);
         }
     }
     if !covers {
@@ -1528,18 +1524,17 @@ struct LineEnds {
     b: vec3<f32>,
 }
 
-// Whether sample s, a triangle with a corner at v (its weight `weight` at the point), covers
-// the point of the line leaving v along direction `d` in front of the line: the point lies
-// inside the triangle's edge opposite v, the line's direction lies inside the triangle's
-// angle at v as seen from the eye (the triangle lies inside that angle), and the line leaves
-// v to the far side of the triangle's plane. The last two hold all along the line or nowhere
-// on it, and are triple products of the differences from v in the instance's own
+// Whether sample s, a triangle with a corner at v that rounding says covers a point of the
+// line leaving v along direction `d`, in front of it, does: the line's direction lies inside
+// the triangle's angle at v as seen from the eye (the triangle lies inside that angle), and
+// the line leaves v to the far side of the triangle's plane. Both hold all along the line or
+// nowhere on it, and are triple products of the differences from v in the instance's own
 // coordinates (as `is_silhouette`'s): f32 keeps them where a point near v, or near the
 // triangle's edges through v, loses its side, and where a line runs along such an edge
 // (beside a triangle seen edge-on). Where one of them is within EDGE_ON of 0 they do not
-// decide, nor with v behind the eye (a line the near plane cuts): the sample's own coverage
-// tells.
-fn fan_covers(s: Sample, v: vec3<f32>, d: vec3<f32>, weight: f32) -> bool {
+// decide, nor with v behind the eye (a line the near plane cuts): the sample's coverage
+// stands.
+fn fan_covers(s: Sample, v: vec3<f32>, d: vec3<f32>) -> bool {
     // The triangle's two other corners.
     var p = array<vec3<f32>, 2>(s.v1.xyz, s.v2.xyz);
     if all(s.v1.xyz == v) {
@@ -1566,7 +1561,5 @@ fn fan_covers(s: Sample, v: vec3<f32>, d: vec3<f32>, weight: f32) -> bool {
     let behind = eye_side > plane;
     let ahead = (instances[slot(s.inst)].clip * vec4<f32>(v, 1.0)).w > 0.0;
     let decided = ahead && (outside || (inside && (in_front || behind)));
-    return select(s.covers, s.in_view && weight >= 0.0 && inside && in_front, decided);
+    return !decided || (inside && in_front);
 }
-
-
