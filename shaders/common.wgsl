@@ -398,6 +398,21 @@ fn is_silhouette(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>, d: vec3<f32>, eye: ve
     return edge_on || !(side_c * side_d < 0.0);
 }
 
+// Whether an outline edge a -> b (of a triangle with third corner c; with `across`, across
+// an edge to a neighbour with a point d off the edge) runs with the side that faces `eye` on
+// its left: the way its outline chain runs (`outline_chain_ends` in trace.wgsl). Told by the
+// triangle further from edge-on, as the two sides of a silhouette tell the same but an
+// edge-on one rounds either way (twin of `edge_math::outline_forward`).
+fn outline_forward(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>, d: vec3<f32>, across: bool, eye: vec4<f32>) -> bool {
+    let to_eye = towards_eye(a, eye);
+    let normal_c = cross(b - a, c - a);
+    let normal_d = cross(b - a, d - a);
+    let side_c = dot(to_eye, normal_c);
+    let side_d = dot(to_eye, normal_d);
+    let by_c = !across || abs(side_c) * length(normal_d) >= abs(side_d) * length(normal_c);
+    return select(side_d > 0.0, side_c > 0.0, by_c);
+}
+
 // Bounds on a cluster of nearby triangles (src/mesh/clusters.rs): a sphere holding their
 // corners, and the axis and spread (cone half-angle plus largest fold, radians; over π/2:
 // never skipped) of their normals.

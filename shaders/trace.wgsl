@@ -29,7 +29,8 @@
 // finds a surface in front) get the key of the nearest point of a dash of the hidden-line
 // pattern (`dash_nearest`) in their own word (`hidden_lines`). The pattern's phase runs
 // along the edge's projection from its end that comes first in (x, y, z) order, or on
-// along its chain of drawn edges (`chain_phases`).
+// along its chain of drawn edges (`chain_phases`), or, an outline's, on along the frame's
+// outline chains (`outline_chain_ends`).
 //
 // Listed edges (INSTANCE_LISTED_EDGES): an instance whose drawn edges are dashed or dotted,
 // or cut by section planes, has all of them in view listed here too, their visible runs
@@ -609,6 +610,19 @@ fn list_triangle(inst: u32, t: u32) -> bool {
     for (var j = 0u; j < found.count; j++) {
         all = list_outline(inst, t, p, found.words[j]) && all;
     }
+#if PATTERNS
+#if HIDDEN
+    // Outlines whose hidden parts are patterned join the frame's outline chains.
+    let chained = (instances[slot(inst)].flags & INSTANCE_OUTLINE_PHASES) != 0u;
+    for (var j = select(found.count, 0u, chained); j < found.count; j++) {
+        let mode = found.words[j] >> 2u;
+        let i = found.words[j] & 3u;
+        if (mode & (DRAW_OUTLINE | DRAW_HIDDEN)) == (DRAW_OUTLINE | DRAW_HIDDEN) && !hidden_on_chain(inst, t, i) {
+            push_outline_edge(inst, t, p, i);
+        }
+    }
+#endif
+#endif
     return all;
 }
 
@@ -727,17 +741,35 @@ fn pattern_anchor(inst: u32, t: u32, i: u32, a: vec3<f32>, b: vec3<f32>, mode: u
     let chained = (info[instances[slot(inst)].triangle_base + t] >> (INFO_CHAINED_SHIFT + i)) & 1u;
     if frame.chain_work.x != 0u && chained != 0u && (flags & INSTANCE_PHASES) != 0u && (mode & DRAW_CUT) == 0u {
         let e = chain_anchor(inst, phase_key(t, i));
-        let hidden_edges = INSTANCE_EDGES | INSTANCE_HIDDEN | INSTANCE_HIDDEN_EDGES;
         if (flags & INSTANCE_LISTED_EDGES) != 0u && (mode & DRAW_OUTLINE) == 0u {
             anchor = vec4<f32>(e.y, e.z, anchor.zw);
         }
-        if (flags & hidden_edges) == hidden_edges && instances[slot(inst)].hidden_period > 0.0 {
+        if hidden_on_chain(inst, t, i) {
             anchor = vec4<f32>(anchor.xy, e.x, e.z);
         }
     }
+#if HIDDEN
+    let outline_hidden = DRAW_OUTLINE | DRAW_HIDDEN;
+    if (flags & INSTANCE_OUTLINE_PHASES) != 0u && (mode & outline_hidden) == outline_hidden && !hidden_on_chain(inst, t, i) {
+        let o = outline_chain_anchor(inst, phase_key(t, i));
+        anchor = select(anchor, vec4<f32>(anchor.xy, o), o.y != 0.0);
+    }
+#endif
 #endif
     return anchor;
 }
+
+#if PATTERNS
+// Whether the hidden-line pattern of edge i of triangle t of `inst` runs along its chain of
+// drawn edges (`chain_phases`): the edge is chained, and the instance's drawn edges show
+// their hidden parts in a pattern.
+fn hidden_on_chain(inst: u32, t: u32, i: u32) -> bool {
+    let flags = instances[slot(inst)].flags;
+    let chained = (info[instances[slot(inst)].triangle_base + t] >> (INFO_CHAINED_SHIFT + i)) & 1u;
+    let hidden_edges = INSTANCE_EDGES | INSTANCE_HIDDEN | INSTANCE_HIDDEN_EDGES | INSTANCE_PHASES;
+    return frame.chain_work.x != 0u && chained != 0u && (flags & hidden_edges) == hidden_edges && instances[slot(inst)].hidden_period > 0.0;
+}
+#endif
 
 #if PATTERNS
 // The mesh store's chain records (src/gpu/mesh_records.rs, ChainRecords): per chain (first
@@ -827,6 +859,288 @@ fn chain_anchor(inst: u32, key: u32) -> vec3<f32> {
     }
     return vec3<f32>(0.0, 0.0, 1.0);
 }
+#endif
+
+#if PATTERNS
+#if HIDDEN
+// Outline chains. An outline's hidden-line pattern runs on along the frame's chains of
+// outline edges, as a drawn edge's runs along its chain: a silhouette of a smooth part is a
+// loop of edges a pixel or two long, and a pattern restarting on each would look solid. The
+// chains depend on the view, so they are found each frame (src/truth/traced.rs defines the
+// same in f64): each outline edge of an instance flagged INSTANCE_OUTLINE_PHASES, but one
+// whose hidden part runs along a chain of drawn edges, runs with its front side on its left
+// (`outline_forward`), and it continues into the edge that starts where it ends when
+// exactly one such edge starts there and exactly one ends there (vertices compared by
+// position). A chain that closes starts at its edge whose start comes first in (x, y, z)
+// order (`comes_first`), an open one at its first edge; the pattern's position on an edge
+// is the projected length of the chain before it, modulo the period.
+//
+// `trace_list_main` appends the edges (`push_outline_edge`); `outline_chain_ends` counts
+// the ends at each vertex and hashes the edges by key; `outline_chain_start` links each edge
+// to the one before it; then 2⌈log₂(capacity)/2⌉ rounds of `outline_chain_jump_ab` and
+// `_ba`, each doubling how far every edge has looked back (list ranking by pointer
+// jumping): the lengths summed on the way back to the chain's start, and the edge seen
+// whose start comes first, with the length back to it. An edge never looks back more than the capacity, so every
+// chain is seen whole, closed or not.
+//
+// The area, after the phase tables, for a capacity of C edges (`frame.chain_work.w`, a power
+// of two; OUTLINE_CHAIN_WORDS per edge): a header (indirect dispatch size x, y, z, count),
+// per edge (instance, key, forward, projected length, start x, y, z, unused), the looks back
+// A and B per edge (the edge before the window or OUTLINE_NONE, length from it to the edge,
+// the edge in the window whose start comes first, length from it), 4C vertex buckets (tag: 2 edge + end + 1, ends in | out << 16,
+// the first edge to end there, the first to start there), and 2C edge slots (edge + 1).
+const OUTLINE_NONE: u32 = 0xffffffffu;
+
+fn outline_area() -> u32 {
+    return phase_tables() + frame.chain_work.x - 4u - OUTLINE_CHAIN_WORDS * frame.chain_work.w;
+}
+
+fn outline_record(e: u32) -> u32 {
+    return outline_area() + 4u + 8u * e;
+}
+
+fn outline_look(e: u32, b: bool) -> u32 {
+    return outline_area() + 4u + 4u * frame.chain_work.w * select(2u, 3u, b) + 4u * e;
+}
+
+fn outline_buckets() -> u32 {
+    return outline_area() + 4u + 16u * frame.chain_work.w;
+}
+
+// The start of outline chain edge e (`outline_chain_ends` stores it).
+fn outline_start(e: u32) -> vec3<f32> {
+    let r = outline_record(e) + 4u;
+    return bitcast<vec3<f32>>(vec3<u32>(atomicLoad(&acc_rw[r]), atomicLoad(&acc_rw[r + 1u]), atomicLoad(&acc_rw[r + 2u])));
+}
+
+fn outline_slots() -> u32 {
+    return outline_buckets() + 16u * frame.chain_work.w;
+}
+
+// Appends outline edge i of triangle t of `inst` (local corners p) to the frame's outline
+// chains, with its direction.
+fn push_outline_edge(inst: u32, t: u32, p: array<vec3<f32>, 3>, i: u32) {
+    let base = instances[slot(inst)].triangle_base;
+    let word = neighbour_word(base + t, i);
+    let a = p[i];
+    let b = p[(i + 1u) % 3u];
+    let across = neighbour_of(word) != BACKGROUND_ID;
+    var d = a;
+    for (var go = across; go; go = false) {
+        let q = beyond_edge(inst, word, vec4<f32>(a, 0.0), vec4<f32>(b, 0.0));
+        d = (q.q0.xyz + q.q1.xyz + q.q2.xyz) / 3.0;
+    }
+    let forward = outline_forward(a, b, p[(i + 2u) % 3u], d, across, instances[slot(inst)].eye);
+    let area = outline_area();
+    let e = atomicAdd(&acc_rw[area + 3u], 1u);
+    if e >= frame.chain_work.w {
+        return;
+    }
+    let r = outline_record(e);
+    atomicStore(&acc_rw[r], inst);
+    atomicStore(&acc_rw[r + 1u], phase_key(t, i));
+    atomicStore(&acc_rw[r + 2u], select(0u, 1u, forward));
+    let size = list_size(e, 64u);
+    atomicMax(&acc_rw[area], size.x);
+    atomicMax(&acc_rw[area + 1u], size.y);
+}
+
+// The outline chain edge of a lane of an indirect dispatch over them, or OUTLINE_NONE.
+fn outline_edge_of(group: vec3<u32>, lane: u32) -> u32 {
+    let e = list_group(group) * 64u + lane;
+    let count = min(atomicLoad(&acc_rw[outline_area() + 3u]), frame.chain_work.w);
+    return select(OUTLINE_NONE, e, e < count);
+}
+
+// The ends of outline chain edge e as it runs: start, end.
+fn outline_ends(e: u32) -> array<vec3<f32>, 2> {
+    let r = outline_record(e);
+    let inst = atomicLoad(&acc_rw[r]);
+    let key = atomicLoad(&acc_rw[r + 1u]);
+    let p = triangle_corners(inst, key >> 2u);
+    let a = p[key & 3u];
+    let b = p[((key & 3u) + 1u) % 3u];
+    let forward = atomicLoad(&acc_rw[r + 2u]) != 0u;
+    return array<vec3<f32>, 2>(select(b, a, forward), select(a, b, forward));
+}
+
+fn mix_bits(x: u32) -> u32 {
+    var h = x;
+    h ^= h >> 16u;
+    h *= 0x7feb352du;
+    h ^= h >> 15u;
+    h *= 0x846ca68bu;
+    h ^= h >> 16u;
+    return h;
+}
+
+// The bucket (word index) of the vertex at `end` (0 start, 1 end) of outline chain edge e:
+// the one whose tag names an end at the same position of the same instance, claimed if
+// none does.
+fn outline_bucket(e: u32, end: u32) -> u32 {
+    let inst = atomicLoad(&acc_rw[outline_record(e)]);
+    let v = outline_ends(e)[end];
+    // -0 and 0 are one position.
+    let z = select(v, vec3<f32>(0.0), v == vec3<f32>(0.0));
+    let mask = 4u * frame.chain_work.w - 1u;
+    var h = mix_bits(mix_bits(mix_bits(mix_bits(inst) ^ bitcast<u32>(z.x)) ^ bitcast<u32>(z.y)) ^ bitcast<u32>(z.z)) & mask;
+    let tag = 2u * e + end + 1u;
+    let buckets = outline_buckets();
+    for (var probe = 0u; probe <= 2u * mask; probe++) {
+        let at = buckets + 4u * h;
+        let old = atomicCompareExchangeWeak(&acc_rw[at], 0u, tag);
+        if old.exchanged {
+            return at;
+        }
+        if old.old_value == 0u {
+            continue;
+        }
+        let other = (old.old_value - 1u) >> 1u;
+        let same_inst = atomicLoad(&acc_rw[outline_record(other)]) == inst;
+        if same_inst && all(outline_ends(other)[(old.old_value - 1u) & 1u] == v) {
+            return at;
+        }
+        h = (h + 1u) & mask;
+    }
+    return OUTLINE_NONE;
+}
+
+// The slot of the edge hash for (instance, key).
+fn outline_slot(inst: u32, key: u32) -> u32 {
+    return mix_bits(mix_bits(inst) ^ key) & (2u * frame.chain_work.w - 1u);
+}
+
+// One invocation per outline chain edge: counts its ends at their vertices, enters it in
+// the edge hash, and measures its projection.
+@compute @workgroup_size(64)
+fn outline_chain_ends(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+    let e = outline_edge_of(group, lane);
+    if e == OUTLINE_NONE {
+        return;
+    }
+    let start = outline_bucket(e, 0u);
+    let end = outline_bucket(e, 1u);
+    if start != OUTLINE_NONE && (atomicAdd(&acc_rw[start + 1u], 1u << 16u) >> 16u) == 0u {
+        atomicStore(&acc_rw[start + 3u], e);
+    }
+    if end != OUTLINE_NONE && (atomicAdd(&acc_rw[end + 1u], 1u) & 0xffffu) == 0u {
+        atomicStore(&acc_rw[end + 2u], e);
+    }
+    let r = outline_record(e);
+    let inst = atomicLoad(&acc_rw[r]);
+    let key = atomicLoad(&acc_rw[r + 1u]);
+    let mask = 2u * frame.chain_work.w - 1u;
+    var h = outline_slot(inst, key);
+    let slots = outline_slots();
+    for (var probe = 0u; probe <= 2u * mask; probe++) {
+        let old = atomicCompareExchangeWeak(&acc_rw[slots + h], 0u, e + 1u);
+        if old.exchanged {
+            break;
+        }
+        if old.old_value != 0u {
+            h = (h + 1u) & mask;
+        }
+    }
+    let ends = outline_ends(e);
+    let span = edge_span(inst, ends[0], ends[1], NO_PLANE);
+    let length = select(0.0, length(span.p1.xy - span.p0.xy), span.s.x <= span.s.y);
+    atomicStore(&acc_rw[r + 3u], bitcast<u32>(length));
+    atomicStore(&acc_rw[r + 4u], bitcast<u32>(ends[0].x));
+    atomicStore(&acc_rw[r + 5u], bitcast<u32>(ends[0].y));
+    atomicStore(&acc_rw[r + 6u], bitcast<u32>(ends[0].z));
+}
+
+// One invocation per outline chain edge: the edge before it (the only one ending where it
+// starts, where only it starts there), and its first look back.
+@compute @workgroup_size(64)
+fn outline_chain_start(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+    let e = outline_edge_of(group, lane);
+    if e == OUTLINE_NONE {
+        return;
+    }
+    let start = outline_bucket(e, 0u);
+    var before = OUTLINE_NONE;
+    if start != OUTLINE_NONE && atomicLoad(&acc_rw[start + 1u]) == (1u | (1u << 16u)) {
+        before = atomicLoad(&acc_rw[start + 2u]);
+    }
+    before = select(before, OUTLINE_NONE, before == e);
+    let look = outline_look(e, false);
+    atomicStore(&acc_rw[look], before);
+    atomicStore(&acc_rw[look + 1u], 0u);
+    atomicStore(&acc_rw[look + 2u], e);
+    atomicStore(&acc_rw[look + 3u], 0u);
+}
+
+// x modulo the period p (> 0).
+fn wrap_period(x: f32, p: f32) -> f32 {
+    return x - p * floor(x / p);
+}
+
+// One round of looking back: edge e's window joins the window of the edge before it.
+fn outline_jump(e: u32, from_b: bool) {
+    let mine = outline_look(e, from_b);
+    let out = outline_look(e, !from_b);
+    let j = atomicLoad(&acc_rw[mine]);
+    var next = vec4<u32>(j, atomicLoad(&acc_rw[mine + 1u]), atomicLoad(&acc_rw[mine + 2u]), atomicLoad(&acc_rw[mine + 3u]));
+    for (var go = j != OUTLINE_NONE; go; go = false) {
+        let theirs = outline_look(j, from_b);
+        let r = outline_record(j);
+        let period = instances[slot(atomicLoad(&acc_rw[r]))].hidden_period;
+        let own = bitcast<f32>(next.y);
+        let step = bitcast<f32>(atomicLoad(&acc_rw[r + 3u])) + own;
+        let total = wrap_period(bitcast<f32>(atomicLoad(&acc_rw[theirs + 1u])) + step, period);
+        let best = atomicLoad(&acc_rw[theirs + 2u]);
+        let back = wrap_period(bitcast<f32>(atomicLoad(&acc_rw[theirs + 3u])) + step, period);
+        let take = comes_first(outline_start(best), outline_start(next.z));
+        next = vec4<u32>(atomicLoad(&acc_rw[theirs]), bitcast<u32>(total), select(next.z, best, take), select(next.w, bitcast<u32>(back), take));
+    }
+    atomicStore(&acc_rw[out], next.x);
+    atomicStore(&acc_rw[out + 1u], next.y);
+    atomicStore(&acc_rw[out + 2u], next.z);
+    atomicStore(&acc_rw[out + 3u], next.w);
+}
+
+@compute @workgroup_size(64)
+fn outline_chain_jump_ab(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+    let e = outline_edge_of(group, lane);
+    if e != OUTLINE_NONE {
+        outline_jump(e, false);
+    }
+}
+
+@compute @workgroup_size(64)
+fn outline_chain_jump_ba(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+    let e = outline_edge_of(group, lane);
+    if e != OUTLINE_NONE {
+        outline_jump(e, true);
+    }
+}
+
+// Where the hidden-line pattern stands on outline edge `key` of `inst`: its position at the
+// edge's start along the pattern, and +1 as it runs from corner i, -1 from corner i + 1; a
+// direction 0 where the edge is not in the outline chains (beyond their capacity).
+fn outline_chain_anchor(inst: u32, key: u32) -> vec2<f32> {
+    let mask = 2u * frame.chain_work.w - 1u;
+    var h = outline_slot(inst, key);
+    let slots = outline_slots();
+    for (var probe = 0u; probe <= mask; probe++) {
+        let k = atomicLoad(&acc_rw[slots + h]);
+        if k == 0u {
+            break;
+        }
+        let r = outline_record(k - 1u);
+        if atomicLoad(&acc_rw[r]) == inst && atomicLoad(&acc_rw[r + 1u]) == key {
+            // The looks back end in A: the rounds are even.
+            let look = outline_look(k - 1u, false);
+            let closed = atomicLoad(&acc_rw[look]) != OUTLINE_NONE;
+            let position = bitcast<f32>(atomicLoad(&acc_rw[look + select(1u, 3u, closed)]));
+            return vec2<f32>(position, select(-1.0, 1.0, atomicLoad(&acc_rw[r + 2u]) != 0u));
+        }
+        h = (h + 1u) & mask;
+    }
+    return vec2<f32>(0.0);
+}
+#endif
 #endif
 
 // What a listed edge draws: its visible runs (into the lines), its hidden runs (HIDDEN, into

@@ -95,6 +95,29 @@ pub fn is_silhouette(a: DVec3, b: DVec3, c: DVec3, d: DVec3, eye: DVec4) -> bool
     edge_on || !(side_c * side_d < 0.0)
 }
 
+/// Whether an outline edge `a -> b` (of a triangle with third corner `c`; with `d`, across
+/// an edge to a neighbour with a point `d` off the edge) runs with the side that faces `eye`
+/// on its left: the direction of the outline chains along which a hidden-line pattern runs.
+/// Told by the triangle further from edge-on: both sides of a silhouette tell the same, but
+/// an edge-on one rounds either way in f32 and f64.
+pub fn outline_forward(a: DVec3, b: DVec3, c: DVec3, d: Option<DVec3>, eye: DVec4) -> bool {
+    let to_eye = towards_eye(a, eye);
+    let normal_c = (b - a).cross(c - a);
+    let side_c = to_eye.dot(normal_c);
+    match d {
+        Some(d) => {
+            let normal_d = (b - a).cross(d - a);
+            let side_d = to_eye.dot(normal_d);
+            if side_c.abs() * normal_d.length() >= side_d.abs() * normal_c.length() {
+                side_c > 0.0
+            } else {
+                side_d > 0.0
+            }
+        }
+        None => side_c > 0.0,
+    }
+}
+
 /// Whether the triangle with corners `c` is seen from `eye` (homogeneous) within
 /// [`EDGE_ON`] of edge-on, taken at its centroid; one without area, or with NaN, counts as
 /// edge-on. Such a triangle draws as a line: it hides nothing, and no pixel's ray meets it.

@@ -389,6 +389,99 @@ fn dashes_run_on_along_a_chain_of_short_edges() {
     );
 }
 
+/// Hidden outlines run their pattern on along the outline: a teapot behind a slab, its
+/// silhouette made of edges a pixel or two long, is dashed evenly (about its pattern's share
+/// of the solid line's core; restarted at every edge it would be nearly solid), where the
+/// ground truth puts the dashes; in perspective, close (the near plane through the teapot),
+/// orthographic, and with two instances, one mirrored.
+#[test]
+fn hidden_outlines_dash_along_the_silhouette() {
+    let mut world = World {
+        sections: Vec::new(),
+        meshes: vec![
+            WorldMesh {
+                mesh: Arc::new(load("teapot.obj")),
+                edges: EdgeSelection::Feature(30.0),
+                name: "teapot".into(),
+            },
+            WorldMesh {
+                mesh: Arc::new(Procedural::Cube(300).build().unwrap()),
+                edges: EdgeSelection::Feature(30.0),
+                name: "slab".into(),
+            },
+        ],
+        objects: vec![
+            Object::new(0, DMat4::IDENTITY),
+            Object::new(
+                1,
+                DMat4::from_translation(DVec3::new(0.3, 1.4, 2.2))
+                    * DMat4::from_scale(DVec3::new(1.6, 0.9, 0.3)),
+            ),
+        ],
+    };
+    // Outlines only: the pattern runs along nothing but the outline chains.
+    world.objects[0].style.edges = Some(false);
+    world.objects[1].style.edges = Some(false);
+    let dashed = Style {
+        hidden: Some(HiddenLines {
+            edges: false,
+            ..style(
+                LinePattern::Dashed {
+                    dash: 6.0,
+                    gap: 6.0,
+                },
+                1.0,
+            )
+            .hidden
+            .unwrap()
+        }),
+        ..Style::default()
+    };
+    let view = perspective(&world, DVec3::new(0.5, 4.5, 9.0));
+    let pixels = check("teapot behind a slab", &world, view, &dashed);
+    assert!(pixels > 800, "teapot: {pixels} hidden-line pixels");
+    let core = |style: &Style, method| {
+        let r = shoot_world(&world, view, style, SIZE, method);
+        r.hidden_distance.iter().filter(|&&d| d <= 0.5).count() as f64
+    };
+    let solid = Style {
+        hidden: dashed.hidden.map(|h| HiddenLines {
+            pattern: LinePattern::Solid,
+            ..h
+        }),
+        ..dashed.clone()
+    };
+    for method in [Method::Raycast, Method::Deferred] {
+        let share = core(&dashed, method) / core(&solid, method);
+        println!("{method:?}: {share:.3} of the solid outline's core is dashed");
+        // A 6 px dash and its round caps' 0.5 px each, every 12 px: 0.583 (restarted at every
+        // edge of 1-3 px, it would be nearly 1).
+        assert!((0.52..0.65).contains(&share), "{method:?}: {share}");
+    }
+    check(
+        "close",
+        &world,
+        perspective(&world, DVec3::new(2.2, 1.2, 1.0)),
+        &dashed,
+    );
+    let aspect = f64::from(SIZE.0) / f64::from(SIZE.1);
+    let at = (
+        DVec3::new(-2.0, 3.0, 8.0),
+        DVec3::new(0.2, 1.2, 0.0),
+        DVec3::Y,
+    );
+    let ortho = View::orthographic(at, 4.0, aspect, (0.1, 40.0));
+    check("orthographic", &world, ortho, &dashed);
+    world.objects.push(Object::new(
+        0,
+        DMat4::from_translation(DVec3::new(1.5, 0.2, -3.0))
+            * DMat4::from_scale(DVec3::new(-0.8, 0.8, 0.8)),
+    ));
+    world.objects[2].style.edges = Some(false);
+    let view = perspective(&world, DVec3::new(2.5, 3.5, 9.0));
+    check("with a mirrored teapot", &world, view, &dashed);
+}
+
 /// Each instance's own hidden-line style (`InstanceStyle::hidden`): its colour, width and
 /// pattern, none at all, or the frame's; and a frame drawing none but for one instance (a
 /// selected part seen through the others).

@@ -23,7 +23,7 @@ use wirepass::{Camera, EdgeSelection, HiddenLines, SectionPlane, Style};
 const TABLE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/work.txt");
 
 /// The counters, in the table's column order.
-const COLUMNS: [&str; 8] = [
+const COLUMNS: [&str; 9] = [
     "tiles",
     "traced",
     "refined",
@@ -31,6 +31,7 @@ const COLUMNS: [&str; 8] = [
     "lines",
     "pieces",
     "overflowed",
+    "chained",
     "pipelines",
 ];
 
@@ -134,7 +135,7 @@ fn cases() -> Vec<Case> {
 
 /// The counters of one frame of `case`, drawn by a new pass split for a software
 /// rasterizer (so that a GPU counts the same pieces), into a storage texture.
-fn measure(case: &Case) -> [u64; 8] {
+fn measure(case: &Case) -> [u64; 9] {
     let ctx = gpu();
     let (device, queue) = (&ctx.device, &ctx.queue);
     let world = &case.world;
@@ -176,6 +177,7 @@ fn measure(case: &Case) -> [u64; 8] {
         outline_lines,
         traced_pieces,
         overflowed,
+        chained_outlines,
         ..
     } = frame.edge_work(device, queue).unwrap();
     ctx.finish().unwrap();
@@ -187,13 +189,14 @@ fn measure(case: &Case) -> [u64; 8] {
         outline_lines,
         traced_pieces,
         overflowed,
+        chained_outlines,
         pass.pipelines_built() as u32,
     ]
     .map(u64::from)
 }
 
 /// The recorded table: each scene's name and counters.
-fn recorded() -> Vec<(String, [u64; 8])> {
+fn recorded() -> Vec<(String, [u64; 9])> {
     let text = std::fs::read_to_string(TABLE).unwrap_or_default();
     text.lines()
         .filter(|l| !l.trim_start().starts_with('#') && !l.trim().is_empty())
@@ -201,15 +204,15 @@ fn recorded() -> Vec<(String, [u64; 8])> {
             let mut words = l.split_whitespace();
             let name = words.next().unwrap().to_owned();
             let numbers: Vec<u64> = words.map(|w| w.parse().unwrap()).collect();
-            let row: [u64; 8] = numbers
+            let row: [u64; 9] = numbers
                 .try_into()
-                .unwrap_or_else(|n| panic!("{TABLE}: {name} has {n:?}, not 8 numbers"));
+                .unwrap_or_else(|n| panic!("{TABLE}: {name} has {n:?}, not 9 numbers"));
             (name, row)
         })
         .collect()
 }
 
-fn write_table(rows: &[(&str, [u64; 8])]) {
+fn write_table(rows: &[(&str, [u64; 9])]) {
     let mut text = String::from(
         "# The pass's work on fixed scenes (tests/work.rs): lavapipe or llvmpipe, Tuning::Software.\n\
          # A number more than 10 % off its record fails tests/work.rs until this table is\n\
@@ -218,7 +221,8 @@ fn write_table(rows: &[(&str, [u64; 8])]) {
          # tiles: 8x8 output tiles with foreground; traced: tiles the trace pass's lines\n\
          # reach; refined: pixels the refine dispatch decides; clusters: clusters the trace\n\
          # cull lists; lines: lines it lists pieces of; pieces: pieces it lists; overflowed:\n\
-         # clusters the piece list had no room for; pipelines: pipelines the frame built.\n",
+         # clusters the piece list had no room for; chained: outline edges the outline\n\
+         # chains were found for; pipelines: pipelines the frame built.\n",
     );
     text += &format!("# {:<20}", "scene");
     for c in COLUMNS {
@@ -238,7 +242,7 @@ fn write_table(rows: &[(&str, [u64; 8])]) {
 #[test]
 fn the_pass_does_the_recorded_work() {
     let cases = cases();
-    let measured: Vec<(&str, [u64; 8])> = cases.iter().map(|c| (c.name, measure(c))).collect();
+    let measured: Vec<(&str, [u64; 9])> = cases.iter().map(|c| (c.name, measure(c))).collect();
     for (name, row) in &measured {
         println!("{name}: {row:?}");
     }

@@ -1,9 +1,10 @@
 //! The lines of a drawing: every line the raster draws (drawn edges, outlines, cut lines,
 //! intersection lines), chained, and each chain's visible and hidden runs made into paths.
 //!
-//! Drawn edges chain as the pass chains them (`crate::mesh::chains`), and so do the
-//! outline edges that are not drawn edges (a silhouette loop of a smooth part), so a
-//! pattern runs on along a chain as one path with one phase. A run of one class that
+//! Drawn edges chain as the pass chains them (`crate::mesh::chains::chains`), and the
+//! outline edges that are not drawn edges (a silhouette loop of a smooth part) as the pass
+//! chains outlines each frame (`outline_chains`), so a pattern runs on along a chain as one
+//! path with one phase. A run of one class that
 //! reaches the vertex where the next edge of its chain starts with a run of the same class
 //! goes on in the same path. An outline edge between two triangles seen edge-on is left
 //! out: the edge-on part's own outline covers its projection.
@@ -12,7 +13,7 @@ use super::occlusion::{Frame, JOIN};
 use super::{Path, PathClass};
 use crate::edge_math::{is_edge_on, local_eye};
 use crate::mesh::adjacency::NO_NEIGHBOUR;
-use crate::mesh::chains::{chains, Chains};
+use crate::mesh::chains::{chains, outline_chains, Chains};
 use crate::mesh::par::*;
 use crate::style::{Color, Style};
 use glam::{DVec2, DVec3};
@@ -225,7 +226,10 @@ fn list(frame: &Frame<'_>, style: &Style, looks: &[Look]) -> Vec<Chain> {
             .filter(|&(t, i)| drawn_here.is_none_or(|(mask, _)| mask[t as usize] & (1 << i) == 0))
             .collect();
         if !undrawn.is_empty() {
-            let chained = chains(mesh.positions(), mesh.welded(), tris, &undrawn);
+            let undrawn: Vec<(u32, u32)> =
+                undrawn.iter().map(|&(t, i)| (t, u32::from(i))).collect();
+            let local = local_eye(object.transform, frame.eye);
+            let chained = outline_chains(mesh, &undrawn, local);
             out.extend(chained.iter().map(|edges| {
                 Chain {
                     object: o as u32,

@@ -12,8 +12,8 @@ use super::host_depth::{HostFrame, HostImport};
 use super::instance_crossings::PairCache;
 use super::mesh_store::MeshStore;
 use super::options::{OutputTarget, PassOptions, TriangleIds};
-use super::targets::{self, check_sampled, check_storage_output, TargetSpec, Targets, LIST_HEADER};
-use super::trace_pass::{piece_size_at, TracePass};
+use super::targets::{self, check_sampled, check_storage_output, TargetSpec, Targets};
+use super::trace_pass::{cluster_list_bytes, TracePass};
 use super::variants::{Mode, Variant};
 use super::visibility::Visibility;
 use super::{shaders, GpuTimer};
@@ -325,7 +325,7 @@ impl DeferredPass {
             self.targets = Some(Targets::new(device, spec)?);
         }
         // The cluster list, then the piece dispatch's size.
-        let cull_bytes = piece_size_at(&data) + LIST_HEADER;
+        let cull_bytes = cluster_list_bytes(&data);
         if self.cull.as_ref().map_or(0, wgpu::Buffer::size) < cull_bytes {
             let limit = device.limits().max_storage_buffer_binding_size;
             if cull_bytes > limit {

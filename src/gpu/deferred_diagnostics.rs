@@ -40,6 +40,9 @@ pub struct EdgeWork {
     /// Clusters (and groups of 64 intersection segments) whose pieces the list had no room
     /// for, which the piece dispatch drew 64 lanes each.
     pub overflowed: u32,
+    /// Outline edges the frame's outline chains were found for (those beyond their
+    /// capacity included), 0 where no outline's hidden parts are patterned.
+    pub chained_outlines: u32,
 }
 
 impl PreparedFrame {
@@ -49,7 +52,7 @@ impl PreparedFrame {
     /// reads it without blocking.
     #[cfg(not(target_arch = "wasm32"))]
     pub fn edge_work(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<EdgeWork> {
-        let mut counts = [0u32; 7];
+        let mut counts = [0u32; 8];
         for (count, (buffer, at)) in counts.iter_mut().zip(self.counters()) {
             if let Some(buffer) = buffer {
                 let bytes = super::readback::read_buffer(device, queue, buffer, at, 4)?;
@@ -65,7 +68,7 @@ impl PreparedFrame {
         device: &wgpu::Device,
         queue: &wgpu::Queue,
     ) -> Result<EdgeWork> {
-        let mut counts = [0u32; 7];
+        let mut counts = [0u32; 8];
         for (count, (buffer, at)) in counts.iter_mut().zip(self.counters()) {
             if let Some(buffer) = buffer {
                 let read = super::readback::read_buffer_async(device, queue, buffer, at, 4);
@@ -78,11 +81,14 @@ impl PreparedFrame {
 
     /// Where the counts lie (a list's is the last word of its header): the tile list, the
     /// traced tiles, the refine list, the cluster list, the lines and the pieces listed,
-    /// and the overflow list (the last five only where the trace pass ran).
-    fn counters(&self) -> [(Option<&wgpu::Buffer>, u64); 7] {
+    /// the overflow list (the last five only where the trace pass ran), and the outline
+    /// chains (where a frame has them).
+    fn counters(&self) -> [(Option<&wgpu::Buffer>, u64); 8] {
         let t = &self.targets;
         let traced = |b| self.data.traced.then_some(b);
         let count = LIST_HEADER - 4;
+        let (chains, chains_at, _) = self.data.outline_chains();
+        let chained = (chains > 0).then_some(&t.acc).and_then(traced);
         [
             (Some(&t.tiles), count),
             (traced(&t.acc), t.acc_tiles + count),
@@ -91,13 +97,14 @@ impl PreparedFrame {
             (traced(&t.acc), t.acc_overflow),
             (traced(&t.acc), t.acc_pieces + count),
             (traced(&t.acc), t.acc_overflow + count),
+            (chained, t.acc_phases + 4 * u64::from(chains_at) + count),
         ]
     }
 
     /// The work from the counts at [`counters`](Self::counters).
     fn edge_work_of(
         &self,
-        [tiles, traced_tiles, refined, clusters, lines, pieces, overflowed]: [u32; 7],
+        [tiles, traced_tiles, refined, clusters, lines, pieces, overflowed, chained]: [u32; 8],
     ) -> EdgeWork {
         let (w, h) = self.targets.output;
         let tile = super::edge_pass::TILE;
@@ -112,6 +119,7 @@ impl PreparedFrame {
             traced_pieces: pieces,
             piece_room: self.targets.piece_room(),
             overflowed,
+            chained_outlines: chained,
         }
     }
 

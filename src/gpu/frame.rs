@@ -108,6 +108,17 @@ pub(crate) const INSTANCE_PHASES: u32 = 64;
 /// within its `cross_box` the trace pass draws its edges and tests its lines' visibility
 /// over a wider window ([`CROSSING_BAND`]), and the edge pass leaves its edges.
 pub(crate) const INSTANCE_CROSSED: u32 = 128;
+/// `Instance.flags`: its outline's hidden parts are patterned, so its outline edges join
+/// the frame's outline chains (`outline_chain_ends` in trace.wgsl).
+pub(crate) const INSTANCE_OUTLINE_PHASES: u32 = 256;
+/// Words of the trace buffer's outline chain area per edge of its capacity (after a header
+/// of 4): a record, two looks back, four vertex buckets and two edge slots of 8, 4, 4, 16
+/// and 2 words (`outline_area` in trace.wgsl).
+pub(crate) const OUTLINE_CHAIN_WORDS: u32 = 34;
+/// The outline chain capacity of a frame: a quarter of the triangles of the instances that
+/// chain their outlines (a silhouette has far fewer edges than a mesh has triangles), within
+/// these bounds.
+const OUTLINE_CHAIN_CAPACITY: (u32, u32) = (1 << 10, 1 << 18);
 
 /// A linear RGBA colour as WGSL's `unpack2x16float` reads it from two words.
 fn pack_color(c: [f32; 4]) -> [u32; 2] {
@@ -335,6 +346,16 @@ impl FrameRecords {
             .map_err(|_| Error::InvalidScene(format!("{clusters} clusters over all instances")))?;
         let hidden_color = hidden_styles.iter().flatten().map(|h| h.color).next();
         let (chain_work, phase_words, chains) = phase_tables(store, scene, &order, &mut records)?;
+        let outline_chains = outline_chain_capacity(store, scene, &order, &mut records)?;
+        let phase_words = if chain_work.is_empty() {
+            0
+        } else {
+            phase_words
+        };
+        let phase_words = outline_chains
+            .map(|c| u64::from(phase_words) + 4 + u64::from(OUTLINE_CHAIN_WORDS) * u64::from(c))
+            .unwrap_or(u64::from(phase_words));
+        let phase_words = u32::try_from(phase_words).map_err(|_| too_many_chains())?;
         let intersections = if style.intersection_lines {
             intersection_records(store, scene, &order, &crossings.pairs)?
         } else {
@@ -400,14 +421,10 @@ impl FrameRecords {
             fill_opacity: style.fill_opacity,
             hidden_color: hidden_color.map_or([0.0; 4], |c| c.0),
             chain_work: [
-                if chain_work.is_empty() {
-                    0
-                } else {
-                    phase_words
-                },
+                phase_words,
                 chains,
                 chain_work.len() as u32,
-                0,
+                outline_chains.unwrap_or(0),
             ],
             section_color: style.section_color.0,
             sections: section_planes(&view, &scene.sections)?,
@@ -715,6 +732,36 @@ fn phase_tables(
     Ok((chain_work, phase_words, chains))
 }
 
+/// The capacity of the frame's outline chains, if any instance draws its outline's hidden
+/// parts in a pattern (each such record is marked `INSTANCE_OUTLINE_PHASES`): a power of
+/// two, at least `OUTLINE_CHAIN_CAPACITY.0` and at most `.1` edges; an outline edge beyond
+/// it runs its pattern from its own end.
+fn outline_chain_capacity(
+    store: &MeshStore,
+    scene: &Scene<'_>,
+    order: &[u32],
+    records: &mut [InstanceRecord],
+) -> Result<Option<u32>> {
+    let mut triangles = 0u64;
+    for (slot, record) in records.iter_mut().enumerate() {
+        let wanted = INSTANCE_OUTLINES | INSTANCE_HIDDEN;
+        if record.hidden_period > 0.0 && record.flags & wanted == wanted {
+            record.flags |= INSTANCE_OUTLINE_PHASES;
+            triangles += u64::from(
+                store
+                    .record(scene.instances[order[slot] as usize].mesh)?
+                    .triangles,
+            );
+        }
+    }
+    if triangles == 0 {
+        return Ok(None);
+    }
+    let (lo, hi) = OUTLINE_CHAIN_CAPACITY;
+    let wanted = (triangles / 4).clamp(u64::from(lo), u64::from(hi));
+    Ok(Some(wanted.next_power_of_two() as u32))
+}
+
 /// Pairs of instances (by their index in the scene) and where their surfaces cross.
 type PairCrossings = Vec<((usize, usize), Arc<[PairCrossing]>)>;
 
@@ -885,9 +932,19 @@ impl FrameData {
         self.uniforms.overflow_room
     }
 
-    /// Words of the trace buffer's phase tables, and the chains `chain_phases` visits.
+    /// Words of the trace buffer's phase tables (with the outline chains' area), and the
+    /// chains `chain_phases` visits.
     pub fn chain_phases(&self) -> (u32, u32) {
         (self.uniforms.chain_work[0], self.uniforms.chain_work[1])
+    }
+
+    /// The capacity of the frame's outline chains (0: none), and their area's first word
+    /// and words, counted from the phase tables' start.
+    pub fn outline_chains(&self) -> (u32, u32, u32) {
+        let c = self.uniforms.chain_work;
+        let words = 4 + OUTLINE_CHAIN_WORDS * c[3];
+        let words = if c[3] == 0 { 0 } else { words };
+        (c[3], c[0] - words, words)
     }
 
     /// Whether the store's vertex or per-triangle buffers are bound as two halves.

@@ -5,7 +5,9 @@
 //! may hold such an edge, one invocation per listed triangle listing the edges' pieces, one
 //! per piece drawing it; before them, for dashed or dotted lines, one invocation per chain
 //! of drawn edges finding where the patterns stand along it; with intersection lines, one
-//! invocation per intersection segment listing its pieces too, before the piece dispatch.
+//! invocation per intersection segment listing its pieces too, before the piece dispatch;
+//! where outlines' hidden parts are patterned, after the listing, a pass of indirect
+//! dispatches over the outline edges it listed finding the outline chains.
 //! Pieces are short enough that a piece's loops keep under llvmpipe's cap on them
 //! ([`loop_budget`](super::loop_budget)).
 
@@ -32,6 +34,8 @@ struct TracePipelines {
     /// Lists the intersection segments' pieces: built on first use, as few frames draw
     /// them.
     intersections: OnceLock<Intersections>,
+    /// Finds the outline chains (PATTERNS and HIDDEN): built on first use.
+    outline_chains: OnceLock<OutlineChains>,
     module: wgpu::ShaderModule,
     resources: Vec<Res>,
 }
@@ -42,10 +46,24 @@ struct Intersections {
     list: Compute,
 }
 
+/// The pipelines of a frame whose outlines' hidden parts are patterned: the outline
+/// chains' ends, their links, and the two ways of a round of looking back
+/// (`outline_chain_jump_ab` and `_ba` in trace.wgsl).
+struct OutlineChains {
+    ends: Compute,
+    start: Compute,
+    jump: [Compute; 2],
+}
+
 /// Where the piece dispatch's size lies in a frame's cluster list buffer: after the cluster
-/// list (header, then two words per cluster).
+/// list (header, then two words per cluster); the outline chains' dispatch size follows.
 pub(crate) fn piece_size_at(data: &FrameData) -> u64 {
     LIST_HEADER + 8 * u64::from(data.uniforms_clusters().max(1))
+}
+
+/// Bytes of a frame's cluster list buffer: the list, the piece and outline chain sizes.
+pub(crate) fn cluster_list_bytes(data: &FrameData) -> u64 {
+    piece_size_at(data) + 2 * LIST_HEADER
 }
 
 /// The trace pass's pipelines, built for each variant on first use.
@@ -73,7 +91,45 @@ impl TracePass {
         if intersections {
             self.intersections(device, &p)?;
         }
+        if v.patterns && v.hidden {
+            self.outline_chains(device, &p)?;
+        }
         Ok(())
+    }
+
+    /// The outline chains' pipelines of the set `p`, built on first use.
+    fn outline_chains<'p>(
+        &self,
+        device: &wgpu::Device,
+        p: &'p TracePipelines,
+    ) -> Result<&'p OutlineChains> {
+        if let Some(c) = p.outline_chains.get() {
+            return Ok(c);
+        }
+        let scope = crate::gpu::validation::Validation::begin(device);
+        let build = |entry| {
+            let resources = p.resources.clone();
+            Compute::new(
+                device,
+                &p.module,
+                entry,
+                resources,
+                self.format,
+                self.compiled.as_ref(),
+            )
+        };
+        let c = OutlineChains {
+            ends: build("outline_chain_ends")?,
+            start: build("outline_chain_start")?,
+            jump: [
+                build("outline_chain_jump_ab")?,
+                build("outline_chain_jump_ba")?,
+            ],
+        };
+        if let Some(e) = scope.end() {
+            return Err(Error::Device(format!("building the outline chains: {e}")));
+        }
+        Ok(p.outline_chains.get_or_init(|| c))
     }
 
     /// The intersection lines' pipeline of the set `p`, built on first use.
@@ -115,6 +171,7 @@ impl TracePass {
                 .map(|p| {
                     3 + usize::from(p.phases.is_some())
                         + usize::from(p.intersections.get().is_some())
+                        + 4 * usize::from(p.outline_chains.get().is_some())
                 })
                 .sum()
         })
@@ -219,6 +276,7 @@ impl TracePass {
             pieces,
             phases,
             intersections: OnceLock::new(),
+            outline_chains: OnceLock::new(),
             module,
             resources,
         });
@@ -255,6 +313,14 @@ impl TracePass {
             let groups = n.div_ceil(GROUP);
             Size::Grid(groups.clamp(1, max), groups.div_ceil(max).max(1))
         };
+        // The outline chains' area: cleared, its dispatch size reset, before the listing
+        // appends to it.
+        let (outline_capacity, outline_at, outline_words) = data.outline_chains();
+        let outline_at = t.acc_phases + 4 * u64::from(outline_at);
+        if outline_capacity > 0 {
+            encoder.clear_buffer(&t.acc, outline_at, Some(4 * u64::from(outline_words)));
+            encoder.copy_buffer_to_buffer(reset, 0, &t.acc, outline_at, LIST_HEADER);
+        }
         let chains = data.chain_phases().1;
         if let (Some(phases), true) = (&p.phases, chains > 0) {
             let group = phases.bind(device, sources)?;
@@ -294,6 +360,34 @@ impl TracePass {
                 pipeline,
                 grid(segments),
             );
+        }
+        if outline_capacity > 0 && variant.patterns && variant.hidden {
+            let chains = self.outline_chains(device, &p)?;
+            let size_at = piece_size_at(data) + LIST_HEADER;
+            encoder.copy_buffer_to_buffer(&t.acc, outline_at, list, size_at, LIST_HEADER);
+            let groups = [
+                chains.ends.bind(device, sources)?,
+                chains.start.bind(device, sources)?,
+                chains.jump[0].bind(device, sources)?,
+                chains.jump[1].bind(device, sources)?,
+            ];
+            // Rounds enough for a chain as long as the capacity, an even number so that the
+            // looks back end where `outline_chain_anchor` reads them.
+            let rounds = outline_capacity.trailing_zeros().next_multiple_of(2);
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("wirepass outline chains"),
+                timestamp_writes: timer
+                    .as_deref_mut()
+                    .and_then(|t| t.compute_span("trace.outline_chains")),
+            });
+            let steps = [(&chains.ends, &groups[0]), (&chains.start, &groups[1])];
+            let jumps =
+                (0..rounds).map(|r| (&chains.jump[r as usize % 2], &groups[2 + r as usize % 2]));
+            for (pipeline, group) in steps.into_iter().chain(jumps) {
+                pass.set_pipeline(&pipeline.pipeline);
+                pass.set_bind_group(0, group, &[]);
+                pass.dispatch_workgroups_indirect(list, size_at);
+            }
         }
         let group = p.pieces.bind(device, sources)?;
         // The piece dispatch's size, where no pass binding `acc` for writing reads it.

@@ -178,6 +178,134 @@ pub fn chains(
     out
 }
 
+/// The outline chains of `edges` (outline edges `(t, i)` of `mesh`, a shared one listed
+/// once) seen from `eye` (homogeneous, in the mesh's own coordinates), along which an
+/// outline's hidden-line pattern runs: each edge runs with the side that faces the eye on
+/// its left ([`outline_forward`](crate::edge_math::outline_forward)), the edges joined as
+/// [`directed_chains`] joins them at welded vertices, a closed chain starting at its edge
+/// whose start comes first in (x, y, z) order ([`comes_first`]). `outline_chain_ends` in
+/// trace.wgsl finds the same chains on the GPU each frame.
+pub fn outline_chains(
+    mesh: &crate::Mesh,
+    edges: &[(u32, u32)],
+    eye: glam::DVec4,
+) -> Vec<Vec<ChainEdge>> {
+    let p = mesh.positions();
+    let tris = mesh.triangles();
+    let neighbours = mesh.edge_neighbours();
+    let weld = mesh.welded();
+    let corner = |t: u32, k: usize| p[tris[t as usize][k % 3] as usize].as_dvec3();
+    let oriented: Vec<ChainEdge> = edges
+        .iter()
+        .map(|&(t, i)| {
+            let k = i as usize;
+            let n = neighbours[t as usize][k];
+            let d = (n != super::adjacency::NO_NEIGHBOUR)
+                .then(|| (corner(n, 0) + corner(n, 1) + corner(n, 2)) / 3.0);
+            let (a, b, c) = (corner(t, k), corner(t, k + 1), corner(t, k + 2));
+            ChainEdge {
+                t,
+                i: i as u8,
+                forward: crate::edge_math::outline_forward(a, b, c, d, eye),
+            }
+        })
+        .collect();
+    let ends: Vec<(u32, u32)> = oriented
+        .iter()
+        .map(|e| {
+            let corners = tris[e.t as usize];
+            let a = weld[corners[usize::from(e.i)] as usize];
+            let b = weld[corners[(usize::from(e.i) + 1) % 3] as usize];
+            if e.forward {
+                (a, b)
+            } else {
+                (b, a)
+            }
+        })
+        .collect();
+    // Each start's rank in (x, y, z) order, the key a closed chain starts at the least of.
+    let mut starts: Vec<u32> = ends.iter().map(|e| e.0).collect();
+    starts.sort_unstable_by(|&a, &b| {
+        let (a, b) = (p[a as usize], p[b as usize]);
+        match (comes_first(a, b), comes_first(b, a)) {
+            (true, _) => std::cmp::Ordering::Less,
+            (_, true) => std::cmp::Ordering::Greater,
+            _ => std::cmp::Ordering::Equal,
+        }
+    });
+    starts.dedup();
+    let rank: std::collections::HashMap<u32, u32> = (0..starts.len() as u32)
+        .map(|k| (starts[k as usize], k))
+        .collect();
+    let keys: Vec<u32> = ends.iter().map(|e| rank[&e.0]).collect();
+    directed_chains(&ends, &keys)
+        .into_iter()
+        .map(|chain| chain.into_iter().map(|e| oriented[e]).collect())
+        .collect()
+}
+
+/// The chains of directed edges `ends` (each `(start, end)`, welded vertices), as lists of
+/// edge indices in order: an edge runs on into the edge that starts where it ends when
+/// exactly one edge starts there and exactly one ends there. An open chain starts at its
+/// first edge; a closed one at its edge with the least key (`keys`, unique within a chain). The outline
+/// chains, along which an outline's hidden-line pattern runs (`outline_chain_ends` in
+/// trace.wgsl finds the same on the GPU each frame, as the outline depends on the view).
+pub fn directed_chains(ends: &[(u32, u32)], keys: &[u32]) -> Vec<Vec<usize>> {
+    use std::collections::HashMap;
+    // Per vertex: edges ending there, edges starting there, the first of each.
+    let mut at: HashMap<u32, (u32, u32, usize, usize)> = HashMap::new();
+    for (e, &(start, end)) in ends.iter().enumerate() {
+        let s = at.entry(start).or_insert((0, 0, e, e));
+        if s.1 == 0 {
+            s.3 = e;
+        }
+        s.1 += 1;
+        let v = at.entry(end).or_insert((0, 0, e, e));
+        if v.0 == 0 {
+            v.2 = e;
+        }
+        v.0 += 1;
+    }
+    let next = |e: usize| -> Option<usize> {
+        let &(ins, outs, _, out) = at.get(&ends[e].1)?;
+        (ins == 1 && outs == 1 && out != e).then_some(out)
+    };
+    let has_before = |e: usize| {
+        let (ins, outs, first_in, _) = at[&ends[e].0];
+        ins == 1 && outs == 1 && first_in != e
+    };
+    let mut used = vec![false; ends.len()];
+    let mut out = Vec::new();
+    let walk = |first: usize, used: &mut Vec<bool>| {
+        let mut chain = vec![first];
+        used[first] = true;
+        let mut e = first;
+        while let Some(n) = next(e).filter(|&n| !used[n]) {
+            used[n] = true;
+            chain.push(n);
+            e = n;
+        }
+        chain
+    };
+    for e in 0..ends.len() {
+        if !has_before(e) {
+            let chain = walk(e, &mut used);
+            out.push(chain);
+        }
+    }
+    for e in 0..ends.len() {
+        if !used[e] {
+            let mut chain = walk(e, &mut used);
+            let head = (0..chain.len())
+                .min_by_key(|&k| keys[chain[k]])
+                .unwrap_or(0);
+            chain.rotate_left(head);
+            out.push(chain);
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -228,6 +356,17 @@ mod tests {
         }));
         let tris = (0..n).map(|k| [0, 1 + k, 1 + (k + 1) % n]).collect();
         Mesh::new(p, None, tris, None).unwrap()
+    }
+
+    #[test]
+    fn directed_chains_close_at_their_least_key_and_break_where_ends_do_not_pair() {
+        // A loop 0 -> 1 -> 2 -> 0 (keys 5, 3, 9) and a path 3 -> 4 -> 5 -> 6 whose middle
+        // vertex 5 has a second edge starting there (5 -> 7).
+        let ends = [(0, 1), (1, 2), (2, 0), (3, 4), (4, 5), (5, 6), (5, 7)];
+        let keys = [5, 3, 9, 10, 11, 12, 13];
+        let mut chains = directed_chains(&ends, &keys);
+        chains.sort();
+        assert_eq!(chains, vec![vec![1, 2, 0], vec![3, 4], vec![5], vec![6]]);
     }
 
     #[test]

@@ -351,6 +351,30 @@ impl RayVisibility<'_> {
             let anchors = view.chain_anchors(mesh, &weld, first, &masks[object.mesh], periods);
             (weld, anchors)
         });
+        let chained = chained.as_ref();
+        // The outline chains, where the outline's hidden parts are patterned.
+        let outline_period = hidden
+            .filter(|_| style.outlines)
+            .map_or(0.0, |h| f64::from(h.pattern.dash_period()[1]));
+        let on_static_chain = |t: u32, i: u32| {
+            chained.is_some_and(|(weld, anchors)| {
+                let corners = tris[t as usize];
+                let (a, b) = (corners[i as usize], corners[(i as usize + 1) % 3]);
+                let (wa, wb) = (weld[a as usize], weld[b as usize]);
+                periods[0] > 0.0 && anchors.contains_key(&(wa.min(wb), wa.max(wb)))
+            })
+        };
+        let outline_anchors = (outline_period > 0.0).then(|| {
+            let edges: Vec<(u32, u32)> = merged
+                .iter()
+                .filter(|(_, d)| d.outline && d.hidden && d.cut.is_none() && d.crossing.is_none())
+                .map(|&(e, _)| e)
+                .filter(|&(t, i)| !on_static_chain(t, i))
+                .collect();
+            let local = edge_math::local_eye(object.transform, shot.view.eye());
+            view.outline_chain_anchors(mesh, first, &edges, local, outline_period)
+        });
+        let outline_anchors = outline_anchors.as_ref();
         merged
             .into_par_iter()
             .map(move |((t, i), draw)| {
@@ -400,7 +424,7 @@ impl RayVisibility<'_> {
                     },
                     ..draw
                 };
-                let on_chain = chained.as_ref().and_then(|(weld, anchors)| {
+                let on_chain = chained.and_then(|(weld, anchors)| {
                     let (wa, wb) = (weld[a as usize], weld[b as usize]);
                     let &(positions, entry) = anchors.get(&(wa.min(wb), wa.max(wb)))?;
                     Some((positions, entry == wa))
@@ -418,7 +442,13 @@ impl RayVisibility<'_> {
                 } else {
                     (patterns.0, along(1))
                 };
-                let lines = (visible, along(0));
+                let mut hidden_anchor = along(0);
+                if draw.outline && !on_static_chain(t, i) {
+                    if let Some(&anchor) = outline_anchors.and_then(|a| a.get(&(t, i))) {
+                        hidden_anchor = anchor;
+                    }
+                }
+                let lines = (visible, hidden_anchor);
                 view.stretches(
                     (first, first),
                     (t, n, ends),
@@ -671,6 +701,36 @@ impl RayVisibility<'_> {
                             0.0
                         };
                     }
+                }
+            }
+        }
+        out
+    }
+
+    /// Where the hidden-line pattern (of period `period`) stands on each outline edge
+    /// `(t, i)` in `edges` of `mesh` (the object whose first global id is `first`, its eye
+    /// `local` in its own coordinates), run along the outline chains
+    /// ([`outline_chains`](crate::mesh::chains::outline_chains)): the
+    /// position where the chain enters it (the summed projected lengths of the chain's
+    /// edges before it, modulo the period), and whether it runs from corner `i`.
+    fn outline_chain_anchors(
+        &self,
+        mesh: &crate::Mesh,
+        first: u32,
+        edges: &[(u32, u32)],
+        local: DVec4,
+        period: f64,
+    ) -> HashMap<(u32, u32), (f64, bool)> {
+        let mut out = HashMap::new();
+        for chain in crate::mesh::chains::outline_chains(mesh, edges, local) {
+            let mut position = 0.0;
+            for e in chain {
+                let (t, i) = (e.t, u32::from(e.i));
+                out.insert((t, i), (position, e.forward));
+                let corners = self.caster.corners(first + t);
+                let (a, b) = (corners[i as usize], corners[(i as usize + 1) % 3]);
+                if let Some((_, p0, p1)) = self.span(a, b, None) {
+                    position = (position + p0.xy.distance(p1.xy)).rem_euclid(period);
                 }
             }
         }
