@@ -225,6 +225,74 @@ pub fn outline_edges(mesh: &Mesh, eye: glam::DVec4) -> Vec<(u32, u32)> {
         .collect()
 }
 
+/// The outline chains of `edges` (outline edges `(t, i)` of `mesh`, a shared one listed
+/// once) seen from `eye` (homogeneous, in the mesh's own coordinates), along which an
+/// outline's hidden-line pattern runs: each edge runs with the side that faces the eye on
+/// its left ([`outline_forward`](crate::edge_math::outline_forward)), the edges joined as
+/// [`directed_chains`](crate::mesh::chains::directed_chains) joins them at welded vertices, a closed chain starting at its edge
+/// whose start comes first in (x, y, z) order
+/// ([`comes_first`](crate::mesh::chains::comes_first)). `outline_chain_ends` in
+/// trace.wgsl finds the same chains on the GPU each frame.
+pub fn outline_chains(
+    mesh: &crate::Mesh,
+    edges: &[(u32, u32)],
+    eye: glam::DVec4,
+) -> Vec<Vec<crate::mesh::chains::ChainEdge>> {
+    use crate::mesh::chains::comes_first;
+    let p = mesh.positions();
+    let tris = mesh.triangles();
+    let neighbours = mesh.edge_neighbours();
+    let weld = mesh.welded();
+    let corner = |t: u32, k: usize| p[tris[t as usize][k % 3] as usize].as_dvec3();
+    let oriented: Vec<crate::mesh::chains::ChainEdge> = edges
+        .iter()
+        .map(|&(t, i)| {
+            let k = i as usize;
+            let n = neighbours[t as usize][k];
+            let d = (n != crate::mesh::adjacency::NO_NEIGHBOUR)
+                .then(|| (corner(n, 0) + corner(n, 1) + corner(n, 2)) / 3.0);
+            let (a, b, c) = (corner(t, k), corner(t, k + 1), corner(t, k + 2));
+            crate::mesh::chains::ChainEdge {
+                t,
+                i: i as u8,
+                forward: crate::edge_math::outline_forward(a, b, c, d, eye),
+            }
+        })
+        .collect();
+    let ends: Vec<(u32, u32)> = oriented
+        .iter()
+        .map(|e| {
+            let corners = tris[e.t as usize];
+            let a = weld[corners[usize::from(e.i)] as usize];
+            let b = weld[corners[(usize::from(e.i) + 1) % 3] as usize];
+            if e.forward {
+                (a, b)
+            } else {
+                (b, a)
+            }
+        })
+        .collect();
+    // Each start's rank in (x, y, z) order, the key a closed chain starts at the least of.
+    let mut starts: Vec<u32> = ends.iter().map(|e| e.0).collect();
+    starts.sort_unstable_by(|&a, &b| {
+        let (a, b) = (p[a as usize], p[b as usize]);
+        match (comes_first(a, b), comes_first(b, a)) {
+            (true, _) => std::cmp::Ordering::Less,
+            (_, true) => std::cmp::Ordering::Greater,
+            _ => std::cmp::Ordering::Equal,
+        }
+    });
+    starts.dedup();
+    let rank: std::collections::HashMap<u32, u32> = (0..starts.len() as u32)
+        .map(|k| (starts[k as usize], k))
+        .collect();
+    let keys: Vec<u32> = ends.iter().map(|e| rank[&e.0]).collect();
+    crate::mesh::chains::directed_chains(&ends, &keys)
+        .into_iter()
+        .map(|chain| chain.into_iter().map(|e| oriented[e]).collect())
+        .collect()
+}
+
 /// The built-in scene: a torus and a sphere, two meshes drawing `edges`.
 pub fn default_world(edges: EdgeSelection) -> World {
     let mut world = World::default();

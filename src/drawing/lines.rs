@@ -13,9 +13,10 @@ use super::occlusion::{Frame, JOIN};
 use super::{Path, PathClass};
 use crate::edge_math::{is_edge_on, local_eye};
 use crate::mesh::adjacency::NO_NEIGHBOUR;
-use crate::mesh::chains::{chains, outline_chains, Chains};
+use crate::mesh::chains::{chains, Chains};
 use crate::mesh::par::*;
 use crate::style::{Color, Style};
+use crate::world::outline_chains;
 use glam::{DVec2, DVec3};
 use std::collections::HashMap;
 

@@ -710,7 +710,7 @@ impl RayVisibility<'_> {
     /// Where the hidden-line pattern (of period `period`) stands on each outline edge
     /// `(t, i)` in `edges` of `mesh` (the object whose first global id is `first`, its eye
     /// `local` in its own coordinates), run along the outline chains
-    /// ([`outline_chains`](crate::mesh::chains::outline_chains)): the
+    /// ([`outline_chains`](crate::world::outline_chains)): the
     /// position where the chain enters it (the summed projected lengths of the chain's
     /// edges before it, modulo the period), and whether it runs from corner `i`.
     fn outline_chain_anchors(
@@ -722,7 +722,7 @@ impl RayVisibility<'_> {
         period: f64,
     ) -> HashMap<(u32, u32), (f64, bool)> {
         let mut out = HashMap::new();
-        for chain in crate::mesh::chains::outline_chains(mesh, edges, local) {
+        for chain in crate::world::outline_chains(mesh, edges, local) {
             let mut position = 0.0;
             for e in chain {
                 let (t, i) = (e.t, u32::from(e.i));
