@@ -178,6 +178,7 @@ pub fn chains(
     out
 }
 
+#[cfg(any(feature = "truth", feature = "drawing"))]
 /// The chains of directed edges `ends` (each `(start, end)`, welded vertices), as lists of
 /// edge indices in order: an edge runs on into the edge that starts where it ends when
 /// exactly one edge starts there and exactly one ends there. An open chain starts at its
@@ -292,6 +293,7 @@ mod tests {
         Mesh::new(p, None, tris, None).unwrap()
     }
 
+    #[cfg(any(feature = "truth", feature = "drawing"))]
     #[test]
     fn directed_chains_close_at_their_least_key_and_break_where_ends_do_not_pair() {
         // A loop 0 -> 1 -> 2 -> 0 (keys 5, 3, 9) and a path 3 -> 4 -> 5 -> 6 whose middle
