@@ -115,10 +115,12 @@ pub(crate) const INSTANCE_OUTLINE_PHASES: u32 = 256;
 /// of 4): a record, two looks back, four vertex buckets and two edge slots of 8, 4, 4, 16
 /// and 2 words (`outline_area` in trace.wgsl).
 pub(crate) const OUTLINE_CHAIN_WORDS: u32 = 34;
-/// The outline chain capacity of a frame: a quarter of the triangles of the instances that
-/// chain their outlines (a silhouette has far fewer edges than a mesh has triangles), within
-/// these bounds.
-const OUTLINE_CHAIN_CAPACITY: (u32, u32) = (1 << 10, 1 << 18);
+/// The outline chain capacity of a frame: one edge per `OUTLINE_CHAIN_SHARE` triangles of
+/// the instances that chain their outlines (a smooth mesh's outline has far fewer: about
+/// 2√n edges; a noisy scan's, a few per cent of its edges), within these bounds. The area
+/// is cleared each frame: 136 bytes per edge of capacity, at most 17.8 MB.
+const OUTLINE_CHAIN_SHARE: u64 = 32;
+const OUTLINE_CHAIN_CAPACITY: (u32, u32) = (1 << 10, 1 << 17);
 
 /// A linear RGBA colour as WGSL's `unpack2x16float` reads it from two words.
 fn pack_color(c: [f32; 4]) -> [u32; 2] {
@@ -735,7 +737,7 @@ fn phase_tables(
 /// The capacity of the frame's outline chains, if any instance draws its outline's hidden
 /// parts in a pattern (each such record is marked `INSTANCE_OUTLINE_PHASES`): a power of
 /// two, at least `OUTLINE_CHAIN_CAPACITY.0` and at most `.1` edges; an outline edge beyond
-/// it runs its pattern from its own end.
+/// it runs its pattern from its own end, and the chains break there.
 fn outline_chain_capacity(
     store: &MeshStore,
     scene: &Scene<'_>,
@@ -758,7 +760,7 @@ fn outline_chain_capacity(
         return Ok(None);
     }
     let (lo, hi) = OUTLINE_CHAIN_CAPACITY;
-    let wanted = (triangles / 4).clamp(u64::from(lo), u64::from(hi));
+    let wanted = (triangles / OUTLINE_CHAIN_SHARE).clamp(u64::from(lo), u64::from(hi));
     Ok(Some(wanted.next_power_of_two() as u32))
 }
 
