@@ -1715,7 +1715,11 @@ fn class_at(x: vec2<f32>, near: f32, w: f32, reverse: f32, on: On, cap: u32, end
     if host_hides_point(x - frame.target_origin, reverse) {
         return 2u;
     }
+    // The last triangle walked from, and its walk's steps: a walk starts from a triangle,
+    // not from its pixel, so the same triangle again needs walking only with more steps (a
+    // triangle met first in the outer ring, then next to x).
     var last = vec2<u32>(BACKGROUND_ID, 0u);
+    var last_steps = 0u;
     // The nearest surface in front of the point within HIDDEN_MARGIN: its near row, and 1
     // where it faces away (where none is, the line's own triangles tell).
     var front = vec2<f32>(near, select(0.0, 1.0, cap == CAP_INSIDE));
@@ -1726,12 +1730,13 @@ fn class_at(x: vec2<f32>, near: f32, w: f32, reverse: f32, on: On, cap: u32, end
     for (var k = 0; k < across * across; k++) {
         let offset = vec2<i32>(k % across - r, k / across - r);
         let id = id_at(centre + offset);
-        if id.x >= HOST_ID || lies_on(on, id.x, id.y) || all(id == last) {
+        // The outer ring's walks only cross the sheet's last few triangles to x.
+        let steps = select(WALK_STEPS, FOLD_STEPS, max(abs(offset.x), abs(offset.y)) > 1);
+        if id.x >= HOST_ID || lies_on(on, id.x, id.y) || (all(id == last) && steps <= last_steps) {
             continue;
         }
         last = id;
-        // The outer ring's walks only cross the sheet's last few triangles to x.
-        let steps = select(WALK_STEPS, FOLD_STEPS, max(abs(offset.x), abs(offset.y)) > 1);
+        last_steps = steps;
         if hides(locate(id.x, id.y, x, steps, true), on, ends, near, w, &front) {
             return 1u;
         }

@@ -578,3 +578,50 @@ fn crossed_instances_draw_the_same_frame_every_time() {
         }
     }
 }
+
+/// A teapot (its spout and handle pass through its body, so its lines look for surfaces in
+/// front of them over a wider window) behind a slab whose top face, seen nearly edge-on,
+/// lies between two rows of pixel centres: the top face hides the teapot's outline where it
+/// passes behind it, found by a walk from the slab's front face. That face is met first at
+/// the window's outer ring, whose walks take few steps, and again next to the point.
+#[test]
+fn a_face_between_pixel_centres_hides_an_outline_in_the_wide_window() {
+    let slab = Arc::new(wirepass::mesh::Procedural::Cube(300).build().unwrap());
+    let mut world = World {
+        sections: Vec::new(),
+        meshes: vec![
+            WorldMesh {
+                mesh: Arc::new(load("teapot.obj")),
+                edges: EdgeSelection::Feature(30.0),
+                name: "teapot".into(),
+            },
+            WorldMesh {
+                mesh: slab,
+                edges: EdgeSelection::Feature(30.0),
+                name: "slab".into(),
+            },
+        ],
+        objects: vec![
+            Object::new(0, DMat4::IDENTITY),
+            Object::new(
+                1,
+                DMat4::from_translation(DVec3::new(0.3, 1.4, 2.2))
+                    * DMat4::from_scale(DVec3::new(1.6, 0.9, 0.3)),
+            ),
+        ],
+    };
+    for object in &mut world.objects {
+        object.style.edges = Some(false);
+    }
+    // The slab's top face spans image rows 97.55 to 98.3 where the outline passes behind it.
+    let view = wirepass::Camera {
+        eye: Vec3::new(0.5, 2.5, 9.0),
+        target: Vec3::new(0.217, 1.575, 0.25),
+        up: Vec3::Y,
+        fov_y_deg: 45.0,
+        near: 0.05,
+        far: 100.0,
+    }
+    .to_view(f64::from(SIZE.0) / f64::from(SIZE.1));
+    check("teapot behind a slab", &world, view, &Style::default());
+}
