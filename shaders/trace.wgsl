@@ -611,17 +611,15 @@ fn list_triangle(inst: u32, t: u32) -> bool {
         all = list_outline(inst, t, p, found.words[j]) && all;
     }
 #if PATTERNS
-#if HIDDEN
-    // Outlines whose hidden parts are patterned join the frame's outline chains.
+    // Patterned outlines join the frame's outline chains.
     let chained = (instances[slot(inst)].flags & INSTANCE_OUTLINE_PHASES) != 0u;
     for (var j = select(found.count, 0u, chained); j < found.count; j++) {
         let mode = found.words[j] >> 2u;
         let i = found.words[j] & 3u;
-        if (mode & (DRAW_OUTLINE | DRAW_HIDDEN)) == (DRAW_OUTLINE | DRAW_HIDDEN) && !hidden_on_chain(inst, t, i) {
+        if (mode & DRAW_OUTLINE) != 0u && !hidden_on_chain(inst, t, i) {
             push_outline_edge(inst, t, p, i);
         }
     }
-#endif
 #endif
     return all;
 }
@@ -748,13 +746,10 @@ fn pattern_anchor(inst: u32, t: u32, i: u32, a: vec3<f32>, b: vec3<f32>, mode: u
             anchor = vec4<f32>(anchor.xy, e.x, e.z);
         }
     }
-#if HIDDEN
-    let outline_hidden = DRAW_OUTLINE | DRAW_HIDDEN;
-    if (flags & INSTANCE_OUTLINE_PHASES) != 0u && (mode & outline_hidden) == outline_hidden && !hidden_on_chain(inst, t, i) {
+    if (flags & INSTANCE_OUTLINE_PHASES) != 0u && (mode & DRAW_OUTLINE) != 0u && !hidden_on_chain(inst, t, i) {
         let o = outline_chain_anchor(inst, phase_key(t, i));
-        anchor = select(anchor, vec4<f32>(anchor.xy, o), o.y != 0.0);
+        anchor = select(anchor, vec4<f32>(o.y, o.z, o.x, o.z), o.z != 0.0);
     }
-#endif
 #endif
     return anchor;
 }
@@ -862,10 +857,10 @@ fn chain_anchor(inst: u32, key: u32) -> vec3<f32> {
 #endif
 
 #if PATTERNS
-#if HIDDEN
-// Outline chains. An outline's hidden-line pattern runs on along the frame's chains of
-// outline edges, as a drawn edge's runs along its chain: a silhouette of a smooth part is a
-// loop of edges a pixel or two long, and a pattern restarting on each would look solid. The
+// Outline chains. An outline's patterns (its visible line's, its hidden parts') run on
+// along the frame's chains of outline edges, as a drawn edge's run along its chain: a
+// silhouette of a smooth part is a loop of edges a pixel or two long, and a pattern
+// restarting on each would look solid. The
 // chains depend on the view, so they are found each frame (src/truth/traced.rs defines the
 // same in f64): each outline edge of an instance flagged INSTANCE_OUTLINE_PHASES, but one
 // whose hidden part runs along a chain of drawn edges, runs with its front side on its left
@@ -873,7 +868,7 @@ fn chain_anchor(inst: u32, key: u32) -> vec3<f32> {
 // exactly one such edge starts there and exactly one ends there (vertices compared by
 // position). A chain that closes starts at its edge whose start comes first in (x, y, z)
 // order (`comes_first`), an open one at its first edge; the pattern's position on an edge
-// is the projected length of the chain before it, modulo the period.
+// is the projected length of the chain before it, modulo each pattern's period.
 //
 // `trace_list_main` appends the edges (`push_outline_edge`); `outline_chain_ends` counts
 // the ends at each vertex and hashes the edges by key; `outline_chain_start` links each edge
@@ -886,8 +881,9 @@ fn chain_anchor(inst: u32, key: u32) -> vec3<f32> {
 // The area, after the phase tables, for a capacity of C edges (`frame.chain_work.w`, a power
 // of two; OUTLINE_CHAIN_WORDS per edge): a header (indirect dispatch size x, y, z, count),
 // per edge (instance, key, forward, projected length, start x, y, z, unused), the looks back
-// A and B per edge (the edge before the window or OUTLINE_NONE, length from it to the edge,
-// the edge in the window whose start comes first, length from it), 4C vertex buckets (tag: 2 edge + end + 1, ends in | out << 16,
+// A and B per edge (the edge before the window or OUTLINE_NONE, the edge in the window whose
+// start comes first, the lengths from the window's start to the edge and from that edge,
+// each modulo the hidden-line and the outline pattern's periods), 4C vertex buckets (tag: 2 edge + end + 1, ends in | out << 16,
 // the first edge to end there, the first to start there), and 2C edge slots (edge + 1).
 const OUTLINE_NONE: u32 = 0xffffffffu;
 
@@ -900,11 +896,11 @@ fn outline_record(e: u32) -> u32 {
 }
 
 fn outline_look(e: u32, b: bool) -> u32 {
-    return outline_area() + 4u + 4u * frame.chain_work.w * select(2u, 3u, b) + 4u * e;
+    return outline_area() + 4u + frame.chain_work.w * select(8u, 14u, b) + 6u * e;
 }
 
 fn outline_buckets() -> u32 {
-    return outline_area() + 4u + 16u * frame.chain_work.w;
+    return outline_area() + 4u + 20u * frame.chain_work.w;
 }
 
 // The start of outline chain edge e (`outline_chain_ends` stores it).
@@ -1064,40 +1060,53 @@ fn outline_chain_start(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_i
         before = atomicLoad(&acc_rw[start + 2u]);
     }
     before = select(before, OUTLINE_NONE, before == e);
-    let look = outline_look(e, false);
-    atomicStore(&acc_rw[look], before);
-    atomicStore(&acc_rw[look + 1u], 0u);
-    atomicStore(&acc_rw[look + 2u], e);
-    atomicStore(&acc_rw[look + 3u], 0u);
+    store_look(outline_look(e, false), OutlineLook(before, e, vec2<f32>(0.0), vec2<f32>(0.0)));
 }
 
-// x modulo the period p (> 0).
-fn wrap_period(x: f32, p: f32) -> f32 {
-    return x - p * floor(x / p);
+// A look back (`outline_look`): the edge before the window, the edge in it whose start comes
+// first, and the patterns' positions (hidden line, outline) from the window's start to the
+// edge and from that edge.
+struct OutlineLook {
+    before: u32,
+    best: u32,
+    total: vec2<f32>,
+    back: vec2<f32>,
+}
+
+fn load_look(at: u32) -> OutlineLook {
+    let total = vec2<u32>(atomicLoad(&acc_rw[at + 2u]), atomicLoad(&acc_rw[at + 3u]));
+    let back = vec2<u32>(atomicLoad(&acc_rw[at + 4u]), atomicLoad(&acc_rw[at + 5u]));
+    return OutlineLook(atomicLoad(&acc_rw[at]), atomicLoad(&acc_rw[at + 1u]), bitcast<vec2<f32>>(total), bitcast<vec2<f32>>(back));
+}
+
+fn store_look(at: u32, l: OutlineLook) {
+    atomicStore(&acc_rw[at], l.before);
+    atomicStore(&acc_rw[at + 1u], l.best);
+    atomicStore(&acc_rw[at + 2u], bitcast<u32>(l.total.x));
+    atomicStore(&acc_rw[at + 3u], bitcast<u32>(l.total.y));
+    atomicStore(&acc_rw[at + 4u], bitcast<u32>(l.back.x));
+    atomicStore(&acc_rw[at + 5u], bitcast<u32>(l.back.y));
+}
+
+// x modulo the periods p; 0 where a period is 0 (no pattern).
+fn wrap_periods(x: vec2<f32>, p: vec2<f32>) -> vec2<f32> {
+    return select(vec2<f32>(0.0), x - p * floor(x / p), p > vec2<f32>(0.0));
 }
 
 // One round of looking back: edge e's window joins the window of the edge before it.
 fn outline_jump(e: u32, from_b: bool) {
-    let mine = outline_look(e, from_b);
-    let out = outline_look(e, !from_b);
-    let j = atomicLoad(&acc_rw[mine]);
-    var next = vec4<u32>(j, atomicLoad(&acc_rw[mine + 1u]), atomicLoad(&acc_rw[mine + 2u]), atomicLoad(&acc_rw[mine + 3u]));
+    var next = load_look(outline_look(e, from_b));
+    let j = next.before;
     for (var go = j != OUTLINE_NONE; go; go = false) {
-        let theirs = outline_look(j, from_b);
+        let theirs = load_look(outline_look(j, from_b));
         let r = outline_record(j);
-        let period = instances[slot(atomicLoad(&acc_rw[r]))].hidden_period;
-        let own = bitcast<f32>(next.y);
-        let step = bitcast<f32>(atomicLoad(&acc_rw[r + 3u])) + own;
-        let total = wrap_period(bitcast<f32>(atomicLoad(&acc_rw[theirs + 1u])) + step, period);
-        let best = atomicLoad(&acc_rw[theirs + 2u]);
-        let back = wrap_period(bitcast<f32>(atomicLoad(&acc_rw[theirs + 3u])) + step, period);
-        let take = comes_first(outline_start(best), outline_start(next.z));
-        next = vec4<u32>(atomicLoad(&acc_rw[theirs]), bitcast<u32>(total), select(next.z, best, take), select(next.w, bitcast<u32>(back), take));
+        let inst = instances[slot(atomicLoad(&acc_rw[r]))];
+        let periods = vec2<f32>(inst.hidden_period, inst.outline_pattern.y);
+        let step = bitcast<f32>(atomicLoad(&acc_rw[r + 3u])) + next.total;
+        let take = comes_first(outline_start(theirs.best), outline_start(next.best));
+        next = OutlineLook(theirs.before, select(next.best, theirs.best, take), wrap_periods(theirs.total + step, periods), select(next.back, wrap_periods(theirs.back + step, periods), take));
     }
-    atomicStore(&acc_rw[out], next.x);
-    atomicStore(&acc_rw[out + 1u], next.y);
-    atomicStore(&acc_rw[out + 2u], next.z);
-    atomicStore(&acc_rw[out + 3u], next.w);
+    store_look(outline_look(e, !from_b), next);
 }
 
 @compute @workgroup_size(64)
@@ -1116,10 +1125,11 @@ fn outline_chain_jump_ba(@builtin(workgroup_id) group: vec3<u32>, @builtin(local
     }
 }
 
-// Where the hidden-line pattern stands on outline edge `key` of `inst`: its position at the
-// edge's start along the pattern, and +1 as it runs from corner i, -1 from corner i + 1; a
-// direction 0 where the edge is not in the outline chains (beyond their capacity).
-fn outline_chain_anchor(inst: u32, key: u32) -> vec2<f32> {
+// Where the patterns stand on outline edge `key` of `inst`: the hidden line's and the
+// outline's position at the edge's start along the pattern, and +1 as they run from corner
+// i, -1 from corner i + 1; a direction 0 where the edge is not in the outline chains (beyond
+// their capacity).
+fn outline_chain_anchor(inst: u32, key: u32) -> vec3<f32> {
     let mask = 2u * frame.chain_work.w - 1u;
     var h = outline_slot(inst, key);
     let slots = outline_slots();
@@ -1131,16 +1141,14 @@ fn outline_chain_anchor(inst: u32, key: u32) -> vec2<f32> {
         let r = outline_record(k - 1u);
         if atomicLoad(&acc_rw[r]) == inst && atomicLoad(&acc_rw[r + 1u]) == key {
             // The looks back end in A: the rounds are even.
-            let look = outline_look(k - 1u, false);
-            let closed = atomicLoad(&acc_rw[look]) != OUTLINE_NONE;
-            let position = bitcast<f32>(atomicLoad(&acc_rw[look + select(1u, 3u, closed)]));
-            return vec2<f32>(position, select(-1.0, 1.0, atomicLoad(&acc_rw[r + 2u]) != 0u));
+            let look = load_look(outline_look(k - 1u, false));
+            let position = select(look.total, look.back, look.before != OUTLINE_NONE);
+            return vec3<f32>(position, select(-1.0, 1.0, atomicLoad(&acc_rw[r + 2u]) != 0u));
         }
         h = (h + 1u) & mask;
     }
-    return vec2<f32>(0.0);
+    return vec3<f32>(0.0);
 }
-#endif
 #endif
 
 // What a listed edge draws: its visible runs (into the lines), its hidden runs (HIDDEN, into

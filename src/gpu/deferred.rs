@@ -429,9 +429,12 @@ impl DeferredPass {
         // The floor's pipeline is built with the pass.
         if let Some(mode) = self.mode(target)? {
             let variant = self.variant(frame);
-            let intersections = frame.data.intersections() > 0;
+            let extras = (
+                frame.data.intersections() > 0,
+                frame.data.outline_chains().0 > 0,
+            );
             let trace = || match variant.traced {
-                true => self.trace.warm_up(device, variant, intersections),
+                true => self.trace.warm_up(device, variant, extras),
                 false => Ok(()),
             };
             let edge = || self.edge.pipelines(device, mode, variant).map(|_| ());

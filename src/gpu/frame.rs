@@ -108,17 +108,17 @@ pub(crate) const INSTANCE_PHASES: u32 = 64;
 /// within its `cross_box` the trace pass draws its edges and tests its lines' visibility
 /// over a wider window ([`CROSSING_BAND`]), and the edge pass leaves its edges.
 pub(crate) const INSTANCE_CROSSED: u32 = 128;
-/// `Instance.flags`: its outline's hidden parts are patterned, so its outline edges join
-/// the frame's outline chains (`outline_chain_ends` in trace.wgsl).
+/// `Instance.flags`: its outline, or the outline's hidden parts, are patterned, so its
+/// outline edges join the frame's outline chains (`outline_chain_ends` in trace.wgsl).
 pub(crate) const INSTANCE_OUTLINE_PHASES: u32 = 256;
 /// Words of the trace buffer's outline chain area per edge of its capacity (after a header
-/// of 4): a record, two looks back, four vertex buckets and two edge slots of 8, 4, 4, 16
+/// of 4): a record, two looks back, four vertex buckets and two edge slots of 8, 6, 6, 16
 /// and 2 words (`outline_area` in trace.wgsl).
-pub(crate) const OUTLINE_CHAIN_WORDS: u32 = 34;
+pub(crate) const OUTLINE_CHAIN_WORDS: u32 = 38;
 /// The outline chain capacity of a frame: one edge per `OUTLINE_CHAIN_SHARE` triangles of
 /// the instances that chain their outlines (a smooth mesh's outline has far fewer: about
 /// 2√n edges; a noisy scan's, a few per cent of its edges), within these bounds. The area
-/// is cleared each frame: 136 bytes per edge of capacity, at most 17.8 MB.
+/// is cleared each frame: 152 bytes per edge of capacity, at most 19.9 MB.
 const OUTLINE_CHAIN_SHARE: u64 = 32;
 const OUTLINE_CHAIN_CAPACITY: (u32, u32) = (1 << 10, 1 << 17);
 
@@ -734,8 +734,9 @@ fn phase_tables(
     Ok((chain_work, phase_words, chains))
 }
 
-/// The capacity of the frame's outline chains, if any instance draws its outline's hidden
-/// parts in a pattern (each such record is marked `INSTANCE_OUTLINE_PHASES`): a power of
+/// The capacity of the frame's outline chains, if any instance draws its outline, or the
+/// outline's hidden parts, in a pattern (each such record is marked
+/// `INSTANCE_OUTLINE_PHASES`): a power of
 /// two, at least `OUTLINE_CHAIN_CAPACITY.0` and at most `.1` edges; an outline edge beyond
 /// it runs its pattern from its own end, and the chains break there.
 fn outline_chain_capacity(
@@ -746,8 +747,9 @@ fn outline_chain_capacity(
 ) -> Result<Option<u32>> {
     let mut triangles = 0u64;
     for (slot, record) in records.iter_mut().enumerate() {
-        let wanted = INSTANCE_OUTLINES | INSTANCE_HIDDEN;
-        if record.hidden_period > 0.0 && record.flags & wanted == wanted {
+        let hidden = record.hidden_period > 0.0 && record.flags & INSTANCE_HIDDEN != 0;
+        let patterned = hidden || record.outline_pattern[1] > 0.0;
+        if patterned && record.flags & INSTANCE_OUTLINES != 0 {
             record.flags |= INSTANCE_OUTLINE_PHASES;
             triangles += u64::from(
                 store

@@ -6,8 +6,8 @@
 //! per piece drawing it; before them, for dashed or dotted lines, one invocation per chain
 //! of drawn edges finding where the patterns stand along it; with intersection lines, one
 //! invocation per intersection segment listing its pieces too, before the piece dispatch;
-//! where outlines' hidden parts are patterned, after the listing, a pass of indirect
-//! dispatches over the outline edges it listed finding the outline chains.
+//! where outlines or their hidden parts are patterned, after the listing, a pass of
+//! indirect dispatches over the outline edges it listed finding the outline chains.
 //! Pieces are short enough that a piece's loops keep under llvmpipe's cap on them
 //! ([`loop_budget`](super::loop_budget)).
 
@@ -34,7 +34,7 @@ struct TracePipelines {
     /// Lists the intersection segments' pieces: built on first use, as few frames draw
     /// them.
     intersections: OnceLock<Intersections>,
-    /// Finds the outline chains (PATTERNS and HIDDEN): built on first use.
+    /// Finds the outline chains (PATTERNS): built on first use.
     outline_chains: OnceLock<OutlineChains>,
     module: wgpu::ShaderModule,
     resources: Vec<Res>,
@@ -46,7 +46,7 @@ struct Intersections {
     list: Compute,
 }
 
-/// The pipelines of a frame whose outlines' hidden parts are patterned: the outline
+/// The pipelines of a frame whose outlines, or their hidden parts, are patterned: the outline
 /// chains' ends, their links, and the two ways of a round of looking back
 /// (`outline_chain_jump_ab` and `_ba` in trace.wgsl).
 struct OutlineChains {
@@ -80,18 +80,18 @@ pub(crate) struct TracePass {
 
 impl TracePass {
     /// Builds the pipelines of variant `v` now (with `intersections`, the intersection
-    /// lines' too), if they are not built yet.
+    /// lines' too, and with `outline_chains` the outline chains'), if they are not built yet.
     pub(crate) fn warm_up(
         &self,
         device: &wgpu::Device,
         v: Variant,
-        intersections: bool,
+        (intersections, outline_chains): (bool, bool),
     ) -> Result<()> {
         let p = self.pipelines(device, v)?;
         if intersections {
             self.intersections(device, &p)?;
         }
-        if v.patterns && v.hidden {
+        if outline_chains && v.patterns {
             self.outline_chains(device, &p)?;
         }
         Ok(())
@@ -361,7 +361,7 @@ impl TracePass {
                 grid(segments),
             );
         }
-        if outline_capacity > 0 && variant.patterns && variant.hidden {
+        if outline_capacity > 0 && variant.patterns {
             let chains = self.outline_chains(device, &p)?;
             let size_at = piece_size_at(data) + LIST_HEADER;
             encoder.copy_buffer_to_buffer(&t.acc, outline_at, list, size_at, LIST_HEADER);

@@ -353,9 +353,16 @@ impl RayVisibility<'_> {
         });
         let chained = chained.as_ref();
         // The outline chains, where the outline's hidden parts are patterned.
-        let outline_period = hidden
-            .filter(|_| style.outlines)
-            .map_or(0.0, |h| f64::from(h.pattern.dash_period()[1]));
+        // The outline's patterns' periods, the hidden line's and the visible line's (0 for
+        // none).
+        let outline_periods = if style.outlines {
+            [
+                hidden.map_or(0.0, |h| f64::from(h.pattern.dash_period()[1])),
+                patterns.1[1],
+            ]
+        } else {
+            [0.0; 2]
+        };
         let on_static_chain = |t: u32, i: u32| {
             chained.is_some_and(|(weld, anchors)| {
                 let corners = tris[t as usize];
@@ -364,15 +371,15 @@ impl RayVisibility<'_> {
                 periods[0] > 0.0 && anchors.contains_key(&(wa.min(wb), wa.max(wb)))
             })
         };
-        let outline_anchors = (outline_period > 0.0).then(|| {
+        let outline_anchors = outline_periods.iter().any(|&p| p > 0.0).then(|| {
             let edges: Vec<(u32, u32)> = merged
                 .iter()
-                .filter(|(_, d)| d.outline && d.hidden && d.cut.is_none() && d.crossing.is_none())
+                .filter(|(_, d)| d.outline && d.cut.is_none() && d.crossing.is_none())
                 .map(|&(e, _)| e)
                 .filter(|&(t, i)| !on_static_chain(t, i))
                 .collect();
             let local = edge_math::local_eye(object.transform, shot.view.eye());
-            view.outline_chain_anchors(mesh, first, &edges, local, outline_period)
+            view.outline_chain_anchors(mesh, first, &edges, local, outline_periods)
         });
         let outline_anchors = outline_anchors.as_ref();
         merged
@@ -437,15 +444,17 @@ impl RayVisibility<'_> {
                     Some((positions, forward)) if periods[k] > 0.0 => (positions[k], forward),
                     _ => own,
                 };
-                let visible = if draw.outline {
+                let mut visible = if draw.outline {
                     (patterns.1, own)
                 } else {
                     (patterns.0, along(1))
                 };
                 let mut hidden_anchor = along(0);
+                // An outline's patterns run along the outline chains.
                 if draw.outline && !on_static_chain(t, i) {
-                    if let Some(&anchor) = outline_anchors.and_then(|a| a.get(&(t, i))) {
-                        hidden_anchor = anchor;
+                    if let Some(&(at, forward)) = outline_anchors.and_then(|a| a.get(&(t, i))) {
+                        hidden_anchor = (at[0], forward);
+                        visible.1 = (at[1], forward);
                     }
                 }
                 let lines = (visible, hidden_anchor);
@@ -707,30 +716,37 @@ impl RayVisibility<'_> {
         out
     }
 
-    /// Where the hidden-line pattern (of period `period`) stands on each outline edge
-    /// `(t, i)` in `edges` of `mesh` (the object whose first global id is `first`, its eye
-    /// `local` in its own coordinates), run along the outline chains
-    /// ([`outline_chains`](crate::world::outline_chains)): the
-    /// position where the chain enters it (the summed projected lengths of the chain's
-    /// edges before it, modulo the period), and whether it runs from corner `i`.
+    /// Where the outline's patterns (of periods `periods`, the hidden line's and the visible
+    /// line's; 0 for none) stand on each outline edge `(t, i)` in `edges` of `mesh` (the
+    /// object whose first global id is `first`, its eye `local` in its own coordinates), run
+    /// along the outline chains ([`outline_chains`](crate::world::outline_chains)): each
+    /// pattern's position where the chain enters the edge (the summed projected lengths of
+    /// the chain's edges before it, modulo its period), and whether it runs from corner `i`.
     fn outline_chain_anchors(
         &self,
         mesh: &crate::Mesh,
         first: u32,
         edges: &[(u32, u32)],
         local: DVec4,
-        period: f64,
-    ) -> HashMap<(u32, u32), (f64, bool)> {
+        periods: [f64; 2],
+    ) -> HashMap<(u32, u32), ([f64; 2], bool)> {
         let mut out = HashMap::new();
         for chain in crate::world::outline_chains(mesh, edges, local) {
-            let mut position = 0.0;
+            let mut position = [0.0; 2];
             for e in chain {
                 let (t, i) = (e.t, u32::from(e.i));
                 out.insert((t, i), (position, e.forward));
                 let corners = self.caster.corners(first + t);
                 let (a, b) = (corners[i as usize], corners[(i as usize + 1) % 3]);
                 if let Some((_, p0, p1)) = self.span(a, b, None) {
-                    position = (position + p0.xy.distance(p1.xy)).rem_euclid(period);
+                    let length = p0.xy.distance(p1.xy);
+                    for (s, &period) in position.iter_mut().zip(&periods) {
+                        *s = if period > 0.0 {
+                            (*s + length).rem_euclid(period)
+                        } else {
+                            0.0
+                        };
+                    }
                 }
             }
         }
