@@ -860,31 +860,30 @@ fn chain_anchor(inst: u32, key: u32) -> vec3<f32> {
 // Outline chains. An outline's patterns (its visible line's, its hidden parts') run on
 // along the frame's chains of outline edges, as a drawn edge's run along its chain: a
 // silhouette of a smooth part is a loop of edges a pixel or two long, and a pattern
-// restarting on each would look solid. The
-// chains depend on the view, so they are found each frame (src/truth/traced.rs defines the
-// same in f64): each outline edge of an instance flagged INSTANCE_OUTLINE_PHASES, but one
-// whose hidden part runs along a chain of drawn edges, runs with its front side on its left
-// (`outline_forward`), and it continues into the edge that starts where it ends when
-// exactly one such edge starts there and exactly one ends there (vertices compared by
-// position). A chain that closes starts at its edge whose start comes first in (x, y, z)
-// order (`comes_first`), an open one at its first edge; the pattern's position on an edge
-// is the projected length of the chain before it, modulo each pattern's period.
+// restarting on each would look solid. The chains depend on the view, so they are found
+// each frame (src/truth/traced.rs defines the same in f64): each outline edge of an
+// instance flagged INSTANCE_OUTLINE_PHASES, but one whose hidden part runs along a chain of
+// drawn edges, runs with its front side on its left (`outline_forward`), and it continues
+// into the edge that starts where it ends when exactly one such edge starts there and
+// exactly one ends there (vertices compared by position). A chain that closes starts at
+// its edge whose start comes first in (x, y, z) order (`comes_first`), an open one at its
+// first edge; a pattern's position on an edge is the projected length of the chain before
+// it, modulo the pattern's period.
 //
 // `trace_list_main` appends the edges (`push_outline_edge`); `outline_chain_ends` counts
 // the ends at each vertex and hashes the edges by key; `outline_chain_start` links each edge
 // to the one before it; then 2⌈log₂(capacity)/2⌉ rounds of `outline_chain_jump_ab` and
 // `_ba`, each doubling how far every edge has looked back (list ranking by pointer
 // jumping): the lengths summed on the way back to the chain's start, and the edge seen
-// whose start comes first, with the length back to it. An edge never looks back more than the capacity, so every
-// chain is seen whole, closed or not.
+// whose start comes first, with the length back to it. No chain is longer than the
+// capacity, so every chain is seen whole, closed or not.
 //
 // The area, after the phase tables, for a capacity of C edges (`frame.chain_work.w`, a power
-// of two; OUTLINE_CHAIN_WORDS per edge): a header (indirect dispatch size x, y, z, count),
-// per edge (instance, key, forward, projected length, start x, y, z, unused), the looks back
-// A and B per edge (the edge before the window or OUTLINE_NONE, the edge in the window whose
-// start comes first, the lengths from the window's start to the edge and from that edge,
-// each modulo the hidden-line and the outline pattern's periods), 4C vertex buckets (tag: 2 edge + end + 1, ends in | out << 16,
-// the first edge to end there, the first to start there), and 2C edge slots (edge + 1).
+// of two; OUTLINE_CHAIN_WORDS per edge): a header (indirect dispatch size x, y, z, count);
+// per edge (instance, key, forward, projected length, start x, y, z, unused); the looks back
+// A and B, 6 words per edge (`OutlineLook`); 4C vertex buckets (tag: 2 edge + end + 1; ends
+// in | out << 16; the first edge to end there; the first to start there); and 2C edge slots
+// (edge + 1).
 const OUTLINE_NONE: u32 = 0xffffffffu;
 
 fn outline_area() -> u32 {
