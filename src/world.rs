@@ -227,13 +227,13 @@ pub fn outline_edges(mesh: &Mesh, eye: glam::DVec4) -> Vec<(u32, u32)> {
 
 /// The outline chains of `edges` (outline edges `(t, i)` of `mesh`, a shared one listed
 /// once) seen from `eye` (homogeneous, in the mesh's own coordinates), along which an
-/// outline's hidden-line pattern runs: each edge runs with the side that faces the eye on
-/// its left ([`outline_forward`](crate::edge_math::outline_forward)), the edges joined as
-/// [`directed_chains`](crate::mesh::chains::directed_chains) joins them at welded vertices, a closed chain starting at its edge
-/// whose start comes first in (x, y, z) order
-/// ([`comes_first`](crate::mesh::chains::comes_first)). `outline_chain_ends` in
-/// trace.wgsl finds the same chains on the GPU each frame.
-pub fn outline_chains(
+/// outline's patterns run: each edge runs with the side that faces the eye on its left
+/// ([`outline_forward`](crate::edge_math::outline_forward)), the edges joined as
+/// [`directed_chains`](crate::mesh::chains::directed_chains) joins them at welded
+/// vertices, a closed chain starting at its edge whose start comes first in (x, y, z) order
+/// ([`comes_first`](crate::mesh::chains::comes_first)). `outline_chain_ends` in trace.wgsl
+/// finds the same chains on the GPU each frame.
+pub(crate) fn outline_chains(
     mesh: &crate::Mesh,
     edges: &[(u32, u32)],
     eye: glam::DVec4,

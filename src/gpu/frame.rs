@@ -736,9 +736,9 @@ fn phase_tables(
 
 /// The capacity of the frame's outline chains, if any instance draws its outline, or the
 /// outline's hidden parts, in a pattern (each such record is marked
-/// `INSTANCE_OUTLINE_PHASES`): a power of
-/// two, at least `OUTLINE_CHAIN_CAPACITY.0` and at most `.1` edges; an outline edge beyond
-/// it runs its pattern from its own end, and the chains break there.
+/// `INSTANCE_OUTLINE_PHASES`): a power of two, at least `OUTLINE_CHAIN_CAPACITY.0` and at
+/// most `.1` edges; an outline edge beyond it runs its pattern from its own end, and the
+/// chains break there.
 fn outline_chain_capacity(
     store: &MeshStore,
     scene: &Scene<'_>,
