@@ -106,29 +106,18 @@ impl TracePass {
         if let Some(c) = p.outline_chains.get() {
             return Ok(c);
         }
-        let scope = crate::gpu::validation::Validation::begin(device);
-        let build = |entry| {
-            let resources = p.resources.clone();
-            Compute::new(
-                device,
-                &p.module,
-                entry,
-                resources,
-                self.format,
-                self.compiled.as_ref(),
-            )
-        };
+        let entries = [
+            "outline_chain_ends",
+            "outline_chain_start",
+            "outline_chain_jump_ab",
+            "outline_chain_jump_ba",
+        ];
+        let [ends, start, ab, ba] = self.build_extras(device, p, entries, "the outline chains")?;
         let c = OutlineChains {
-            ends: build("outline_chain_ends")?,
-            start: build("outline_chain_start")?,
-            jump: [
-                build("outline_chain_jump_ab")?,
-                build("outline_chain_jump_ba")?,
-            ],
+            ends,
+            start,
+            jump: [ab, ba],
         };
-        if let Some(e) = scope.end() {
-            return Err(Error::Device(format!("building the outline chains: {e}")));
-        }
         Ok(p.outline_chains.get_or_init(|| c))
     }
 
@@ -141,27 +130,38 @@ impl TracePass {
         if let Some(c) = p.intersections.get() {
             return Ok(c);
         }
+        let [list] =
+            self.build_extras(device, p, ["intersection_main"], "the intersection lines")?;
+        Ok(p.intersections.get_or_init(|| Intersections { list }))
+    }
+
+    /// Pipelines of the set `p`'s module for `entries`, with its resources, that only some
+    /// frames use (`what` names them in an error).
+    fn build_extras<const N: usize>(
+        &self,
+        device: &wgpu::Device,
+        p: &TracePipelines,
+        entries: [&str; N],
+        what: &str,
+    ) -> Result<[Compute; N]> {
         let scope = crate::gpu::validation::Validation::begin(device);
-        let build = |entry| {
-            let resources = p.resources.clone();
-            Compute::new(
+        let mut built = Vec::with_capacity(N);
+        for entry in entries {
+            built.push(Compute::new(
                 device,
                 &p.module,
                 entry,
-                resources,
+                p.resources.clone(),
                 self.format,
                 self.compiled.as_ref(),
-            )
-        };
-        let c = Intersections {
-            list: build("intersection_main")?,
-        };
-        if let Some(e) = scope.end() {
-            return Err(Error::Device(format!(
-                "building the intersection lines: {e}"
-            )));
+            )?);
         }
-        Ok(p.intersections.get_or_init(|| c))
+        if let Some(e) = scope.end() {
+            return Err(Error::Device(format!("building {what}: {e}")));
+        }
+        built
+            .try_into()
+            .map_err(|_| Error::Device(format!("building {what}: a pipeline is missing")))
     }
 
     /// How many pipelines the pass holds.

@@ -700,20 +700,27 @@ impl RayVisibility<'_> {
                 let (wa, wb) = (weld[a as usize], weld[b as usize]);
                 let entry = if e.forward { wa } else { wb };
                 out.insert((wa.min(wb), wa.max(wb)), (position, entry));
-                let corners = self.caster.corners(first + e.t);
-                if let Some((_, p0, p1)) = self.span(corners[i], corners[(i + 1) % 3], None) {
-                    let length = p0.xy.distance(p1.xy);
-                    for (s, &period) in position.iter_mut().zip(&periods) {
-                        *s = if period > 0.0 {
-                            (*s + length).rem_euclid(period)
-                        } else {
-                            0.0
-                        };
-                    }
-                }
+                self.pass_edge(first + e.t, i, &mut position, periods);
             }
         }
         out
+    }
+
+    /// The patterns' positions `position` (of periods `periods`; 0 for none) carried past
+    /// edge `i` of the triangle of global id `t`: on by the length of its projection
+    /// ([`Self::span`]), modulo each period.
+    fn pass_edge(&self, t: u32, i: usize, position: &mut [f64; 2], periods: [f64; 2]) {
+        let corners = self.caster.corners(t);
+        if let Some((_, p0, p1)) = self.span(corners[i], corners[(i + 1) % 3], None) {
+            let length = p0.xy.distance(p1.xy);
+            for (s, &period) in position.iter_mut().zip(&periods) {
+                *s = if period > 0.0 {
+                    (*s + length).rem_euclid(period)
+                } else {
+                    0.0
+                };
+            }
+        }
     }
 
     /// Where the outline's patterns (of periods `periods`, the hidden line's and the visible
@@ -736,18 +743,7 @@ impl RayVisibility<'_> {
             for e in chain {
                 let (t, i) = (e.t, u32::from(e.i));
                 out.insert((t, i), (position, e.forward));
-                let corners = self.caster.corners(first + t);
-                let (a, b) = (corners[i as usize], corners[(i as usize + 1) % 3]);
-                if let Some((_, p0, p1)) = self.span(a, b, None) {
-                    let length = p0.xy.distance(p1.xy);
-                    for (s, &period) in position.iter_mut().zip(&periods) {
-                        *s = if period > 0.0 {
-                            (*s + length).rem_euclid(period)
-                        } else {
-                            0.0
-                        };
-                    }
-                }
+                self.pass_edge(first + t, i as usize, &mut position, periods);
             }
         }
         out
