@@ -7,7 +7,10 @@
 
 mod common;
 
-use common::{load, spot_beside_suzanne, truth_and_frame, within_bounds, SIDE_BY_SIDE, THROUGH};
+use common::{
+    load, spot_beside_suzanne, teapot_behind_slab, truth_and_frame, within_bounds, SIDE_BY_SIDE,
+    THROUGH,
+};
 use glam::{DMat4, DVec3, Vec3};
 use std::sync::Arc;
 use wirepass::world::{LineClass, Object, World, WorldMesh};
@@ -586,33 +589,7 @@ fn crossed_instances_draw_the_same_frame_every_time() {
 /// the window's outer ring, whose walks take few steps, and again next to the point.
 #[test]
 fn a_face_between_pixel_centres_hides_an_outline_in_the_wide_window() {
-    let slab = Arc::new(wirepass::mesh::Procedural::Cube(300).build().unwrap());
-    let mut world = World {
-        sections: Vec::new(),
-        meshes: vec![
-            WorldMesh {
-                mesh: Arc::new(load("teapot.obj")),
-                edges: EdgeSelection::Feature(30.0),
-                name: "teapot".into(),
-            },
-            WorldMesh {
-                mesh: slab,
-                edges: EdgeSelection::Feature(30.0),
-                name: "slab".into(),
-            },
-        ],
-        objects: vec![
-            Object::new(0, DMat4::IDENTITY),
-            Object::new(
-                1,
-                DMat4::from_translation(DVec3::new(0.3, 1.4, 2.2))
-                    * DMat4::from_scale(DVec3::new(1.6, 0.9, 0.3)),
-            ),
-        ],
-    };
-    for object in &mut world.objects {
-        object.style.edges = Some(false);
-    }
+    let world = teapot_behind_slab();
     // The slab's top face spans image rows 97.55 to 98.3 where the outline passes behind it.
     let view = wirepass::Camera {
         eye: Vec3::new(0.5, 2.5, 9.0),

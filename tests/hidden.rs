@@ -5,8 +5,8 @@
 mod common;
 
 use common::{
-    channel_difference, cylinder, framing, load, shoot_world, truth_and_frame, within_bounds,
-    worst_hidden,
+    channel_difference, cylinder, framing, load, shoot_world, teapot_behind_slab, truth_and_frame,
+    within_bounds, worst_hidden,
 };
 use glam::{DMat4, DVec3};
 use std::sync::Arc;
@@ -396,32 +396,8 @@ fn dashes_run_on_along_a_chain_of_short_edges() {
 /// orthographic, and with two instances, one mirrored.
 #[test]
 fn hidden_outlines_dash_along_the_silhouette() {
-    let mut world = World {
-        sections: Vec::new(),
-        meshes: vec![
-            WorldMesh {
-                mesh: Arc::new(load("teapot.obj")),
-                edges: EdgeSelection::Feature(30.0),
-                name: "teapot".into(),
-            },
-            WorldMesh {
-                mesh: Arc::new(Procedural::Cube(300).build().unwrap()),
-                edges: EdgeSelection::Feature(30.0),
-                name: "slab".into(),
-            },
-        ],
-        objects: vec![
-            Object::new(0, DMat4::IDENTITY),
-            Object::new(
-                1,
-                DMat4::from_translation(DVec3::new(0.3, 1.4, 2.2))
-                    * DMat4::from_scale(DVec3::new(1.6, 0.9, 0.3)),
-            ),
-        ],
-    };
     // Outlines only: the pattern runs along nothing but the outline chains.
-    world.objects[0].style.edges = Some(false);
-    world.objects[1].style.edges = Some(false);
+    let mut world = teapot_behind_slab();
     let dashed = Style {
         hidden: Some(HiddenLines {
             edges: false,
