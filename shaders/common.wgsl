@@ -63,6 +63,9 @@ struct Frame {
     intersection_width: f32,
     section_line_color: vec4<f32>,
     intersection_line_color: vec4<f32>,
+    // The clip-space w of every point of the near plane (`View::near_plane_w`), 0 where the
+    // projection gives them none.
+    near_w: f32,
 }
 
 // Per instance (src/gpu/frame.rs, InstanceRecord). "Local" coordinates are the mesh

@@ -1284,8 +1284,8 @@ fn edge_span(inst: u32, a: vec3<f32>, b: vec3<f32>, skip: u32) -> Span {
     let cb = clip * hb;
     let depth_row = instances[slot(inst)].depth_row;
     let fade_row = instances[slot(inst)].fade_row;
-    var s = keep_positive(vec2<f32>(0.0, 1.0), ca.z, cb.z);
-    s = keep_positive(s, dot(depth_row, ha), dot(depth_row, hb));
+    let near_cut = keep_positive(vec2<f32>(0.0, 1.0), ca.z, cb.z);
+    var s = keep_positive(near_cut, dot(depth_row, ha), dot(depth_row, hb));
     // Not behind a section plane (unused planes are 0, which keeps everything); a cut line
     // is not clipped by its own plane, on which it lies (`skip`).
 #if SECTIONS
@@ -1302,9 +1302,17 @@ fn edge_span(inst: u32, a: vec3<f32>, b: vec3<f32>, skip: u32) -> Span {
     let db = dot(depth_row, hb);
     let fa = dot(fade_row, ha);
     let fb = dot(fade_row, hb);
-    span.p0 = project(mix(ca, cb, s.x), mix(da, db, s.x), mix(fa, fb, s.x));
-    span.p1 = project(mix(ca, cb, s.y), mix(da, db, s.y), mix(fa, fb, s.y));
+    span.p0 = project(on_near_plane(mix(ca, cb, s.x), s.x > 0.0 && s.x == near_cut.x), mix(da, db, s.x), mix(fa, fb, s.x));
+    span.p1 = project(on_near_plane(mix(ca, cb, s.y), s.y < 1.0 && s.y == near_cut.y), mix(da, db, s.y), mix(fa, fb, s.y));
     return span;
+}
+
+// Clip-space point c, where the near plane cut the edge there (`cut`), with the near plane's
+// own w (`frame.near_w`) and near row 0: interpolated between the edge's ends, w loses its
+// leading digits where they lie far from the plane, and a cut that projects far off-screen
+// moves by pixels, and with it the patterns measured from it.
+fn on_near_plane(c: vec4<f32>, cut: bool) -> vec4<f32> {
+    return select(c, vec4<f32>(c.xy, 0.0, frame.near_w), cut && frame.near_w > 0.0);
 }
 
 // Line a -> b (in the local coordinates of `on.inst`) on screen: its segment in front of

@@ -147,6 +147,26 @@ impl View {
         }
     }
 
+    /// The clip-space w that every point of the near plane has, where the projection gives
+    /// them one (a perspective projection whose near plane is a plane of constant view
+    /// depth, or an orthographic one), else `None`. The trace pass projects an edge's cut by
+    /// the near plane with it: interpolated between the edge's ends, w there loses its
+    /// leading digits where the ends lie far from the plane, and a cut that projects far
+    /// off-screen moved by pixels.
+    pub(crate) fn near_plane_w(&self) -> Option<f64> {
+        let rows = self.clip_rows(DMat4::IDENTITY);
+        let (near, w) = (rows.clip.row(2), rows.clip.row(3));
+        if w.truncate() == DVec3::ZERO {
+            return Some(w.w);
+        }
+        // near = a w + b (0, 0, 0, 1): then near = 0 where w = -b / a.
+        let a = near.truncate().dot(w.truncate()) / w.truncate().length_squared();
+        let off = (near.truncate() - a * w.truncate()).length();
+        let b = near.w - a * w.w;
+        let at = -b / a;
+        (off <= 1e-9 * near.truncate().length() && at.is_finite() && at > 0.0).then_some(at)
+    }
+
     /// The clip rows of this view for a model matrix (object → world).
     pub fn clip_rows(&self, model: DMat4) -> ClipRows {
         let m = self.projection * self.view * model;
@@ -506,6 +526,28 @@ impl Orbit {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_near_plane_has_one_w_where_the_projection_gives_it_one() {
+        let close = |a: Option<f64>, b: f64| a.is_some_and(|a| (a - b).abs() < 1e-12 * b);
+        let c = cam();
+        assert!(close(c.to_view(1.5).near_plane_w(), f64::from(c.near)));
+        let look = look_at_mat4(DVec3::new(1.0, 2.0, 3.0), DVec3::ZERO, DVec3::Y);
+        let reversed = View::new(
+            look,
+            proj::perspective_infinite_reverse(0.8, 1.5, 0.01),
+            DepthRange::Reversed,
+        );
+        assert!(close(reversed.near_plane_w(), 0.01));
+        let at = (DVec3::new(1.0, 2.0, 3.0), DVec3::ZERO, DVec3::Y);
+        let ortho = View::orthographic(at, 2.0, 1.5, (0.1, 10.0));
+        assert!(close(ortho.near_plane_w(), 1.0));
+        // An oblique near plane (tilted by a clip plane, as for a mirror): w varies on it.
+        let mut oblique = c.projection(1.5);
+        oblique.x_axis.z += 0.3;
+        let tilted = View::new(c.view(), oblique, DepthRange::Standard);
+        assert_eq!(tilted.near_plane_w(), None);
+    }
 
     fn cam() -> Camera {
         Camera {

@@ -126,6 +126,63 @@ fn dashed_edges_and_dotted_outlines_match_the_ground_truth() {
     check("with hidden lines", &world, view, &both);
 }
 
+/// An edge that starts behind the eye: its patterns are measured from where the near plane
+/// cuts it, which projects some 3·10⁴ px off-screen here (the eye 0.05 above a grid whose
+/// edges are 1 long, near plane 0.001 away). The dashes stand where the ground truth puts
+/// them, visible and hidden, perspective and with the depth range reversed.
+#[test]
+fn dashes_keep_their_phase_where_the_near_plane_cuts_far_off_screen() {
+    let world = World::single(Procedural::Grid(8).build().unwrap(), EdgeSelection::All);
+    let camera = wirepass::Camera {
+        eye: Vec3::new(0.3, 0.5, 0.05),
+        target: Vec3::new(0.3, 2.0, 0.0),
+        up: Vec3::Z,
+        fov_y_deg: 60.0,
+        near: 0.001,
+        far: 10.0,
+    };
+    let aspect = f64::from(SIZE.0) / f64::from(SIZE.1);
+    let style = Style {
+        edge_pattern: DASHED,
+        ..Style::default()
+    };
+    let pixels = check("grid", &world, camera.to_view(aspect), &style);
+    assert!(pixels > 500, "{pixels} line pixels");
+    // A small upright grid in front hides the far part of those edges: their hidden parts'
+    // dashes are measured from the near plane's cut too.
+    let mut screened = world.clone();
+    screened.objects.push(Object::new(
+        0,
+        DMat4::from_translation(DVec3::new(0.3, 0.8, 0.0))
+            * DMat4::from_rotation_x(std::f64::consts::FRAC_PI_2)
+            * DMat4::from_scale(DVec3::splat(0.3)),
+    ));
+    let hidden = Style {
+        hidden: Some(HiddenLines {
+            pattern: LinePattern::Dashed {
+                dash: 5.0,
+                gap: 3.0,
+            },
+            ..HiddenLines::default()
+        }),
+        ..style
+    };
+    check(
+        "grid behind a screen",
+        &screened,
+        camera.to_view(aspect),
+        &hidden,
+    );
+    // Reverse-Z with an infinite far plane, as game engines draw.
+    use wirepass::glam::dcamera::rh::{proj::directx as proj, view::look_at_mat4};
+    let reversed = View::new(
+        look_at_mat4(camera.eye.as_dvec3(), camera.target.as_dvec3(), DVec3::Z),
+        proj::perspective_infinite_reverse(60f64.to_radians(), aspect, 0.001),
+        wirepass::DepthRange::Reversed,
+    );
+    check("grid, reverse-Z", &world, reversed, &style);
+}
+
 /// A rim of edges shorter than a dash dashes evenly (its pattern's share of the solid
 /// line's core, not a dash restarted at every vertex), where the ground truth puts the
 /// dashes; and each instance, one mirrored, in its own phase.

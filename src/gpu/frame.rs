@@ -48,6 +48,8 @@ pub(crate) struct FrameUniforms {
     intersection_width: f32,
     section_line_color: [f32; 4],
     intersection_line_color: [f32; 4],
+    near_w: f32,
+    pad: [f32; 3],
 }
 
 /// Mirror of WGSL `struct Instance`; field order and padding match it.
@@ -436,6 +438,8 @@ impl FrameRecords {
             intersection_width: style.intersection_width(),
             section_line_color: style.section_line_color.0,
             intersection_line_color: style.intersection_line_color.0,
+            near_w: view.near_plane_w().unwrap_or(0.0) as f32,
+            pad: [0.0; 3],
         };
         Ok(FrameRecords {
             uniforms,
@@ -1100,7 +1104,7 @@ mod tests {
     fn records_match_their_wgsl_layout() {
         assert_eq!(std::mem::size_of::<InstanceRecord>(), 288);
         assert!(u64::from(UNIFORM_INSTANCE_CAPACITY) * INSTANCE_BYTES <= 65536);
-        assert_eq!(std::mem::size_of::<FrameUniforms>(), 336);
+        assert_eq!(std::mem::size_of::<FrameUniforms>(), 352);
         assert_eq!(std::mem::size_of::<IntersectionRecord>(), 48);
         let r = InstanceRecord::zeroed_for_test();
         let base = &r as *const _ as usize;
