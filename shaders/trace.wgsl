@@ -83,9 +83,11 @@ struct TraceListRead {
 //
 // Where the piece list has no room for all of a cluster's pieces (or all of a group of 64
 // intersection segments'), its entry goes to the overflow list (a header, whose first word
-// counts the lines listed and last the entries, then up to `frame.overflow_room` entries), and the piece dispatch grows by 64 lanes for it, each
-// drawing every piece of one of its triangles (`lane_work`): the listing dispatch itself
-// holds no drawing code, which a software rasterizer would run for every lane.
+// counts the lines listed, the second from 1 the pieces found settled (`hidden_settled`)
+// and the last the entries, then up to `frame.overflow_room` entries), and the piece
+// dispatch grows by 64 lanes for it, each drawing every piece of one of its triangles
+// (`lane_work`): the listing dispatch itself holds no drawing code, which a software
+// rasterizer would run for every lane.
 fn overflow_list() -> u32 {
     return phase_tables() + frame.chain_work.x;
 }
@@ -400,11 +402,85 @@ fn listed_edge(item: Listed) -> Clipped {
     return c;
 }
 
-// Draws the listed piece `item` of the segment `c`.
+// Draws the listed piece `item` of the segment `c`, unless only its hidden line is drawn and
+// that can change no pixel (`hidden_settled`). (Loops, not `if`s: a software rasterizer
+// skips a loop no lane enters, and runs the body of an `if` for every lane.)
 fn draw_listed(item: Listed, c: Clipped) {
     let pieces = f32(item.pieces);
-    draw_piece(c.seg, f32(item.piece) / pieces, f32(item.piece + 1u) / pieces, c.length_px, item.mode);
+    let k0 = f32(item.piece) / pieces;
+    let k1 = f32(item.piece + 1u) / pieces;
+#if HIDDEN
+    var settled = false;
+    for (var hidden_only = item.mode == DRAW_HIDDEN; hidden_only; hidden_only = false) {
+        settled = hidden_settled(c.seg, k0, k1, c.length_px * (k1 - k0));
+        if settled {
+            // Counted for PreparedFrame::edge_work in the overflow list's header.
+            atomicAdd(&acc_rw[overflow_list() + 1u], 1u);
+        }
+    }
+    for (var draw = !settled; draw; draw = false) {
+        draw_piece(c.seg, k0, k1, c.length_px, item.mode);
+    }
+#else
+    draw_piece(c.seg, k0, k1, c.length_px, item.mode);
+#endif
 }
+
+#if HIDDEN
+// Whether every pixel within reach of the segment's part k0..k1 (`length_px` long) already
+// holds a hidden-line key at least as strong as any this part could write there
+// (`splat_runs`, whatever its runs and pattern): then its hidden runs cannot change the
+// frame, and finding them is skipped. Where hidden edges are denser than pixels, most
+// pixels near a piece hold a nearer line by the time it is drawn. Only parts up to
+// SETTLE_PX long of lines whose reach is up to SETTLE_REACH are looked at (a bounded loop).
+fn hidden_settled(seg: Segment, k0: f32, k1: f32, length_px: f32) -> bool {
+    let inst = seg.on.inst;
+    let width = instances[slot(inst)].hidden_width;
+    let reach = line_reach(width);
+    if !(length_px <= SETTLE_PX) || reach > SETTLE_REACH {
+        return false;
+    }
+    // Target pixel coordinates.
+    let q0 = mix(seg.start.xy, seg.end.xy, k0) - frame.target_origin;
+    let q1 = mix(seg.start.xy, seg.end.xy, k1) - frame.target_origin;
+    let lo = max(vec2<i32>(floor(min(q0, q1) - reach)), vec2<i32>(0));
+    let hi = min(vec2<i32>(ceil(max(q0, q1) + reach)), vec2<i32>(frame.target_size) - 1);
+    let box = hi - lo + 1;
+    let d = q1 - q0;
+    let dd = dot(d, d);
+    let words = hidden_lines();
+    for (var k = 0; k < box.x * box.y; k++) {
+        let xy = lo + vec2<i32>(k % box.x, k / box.x);
+        let p = vec2<f32>(xy) + 0.5;
+        let u = select(0.0, clamp(dot(p - q0, d) / dd, 0.0, 1.0), dd > 0.0);
+        // The nearest any point of the part can be, less the rounding of splat_runs' own
+        // distance.
+        let near = max(distance(p, q0 + u * d) - SETTLE_SLACK, 0.0);
+        if !(near < reach + REACH_SLACK) {
+            continue;
+        }
+        let bound = line_key(line_intensity(near, width), near);
+        let index = u32(xy.y) * u32(frame.target_size.x) + u32(xy.x);
+#if COLORS
+        // And the colour word, whose ties the higher instance wins.
+        let held = atomicLoad(&acc_rw[words + 2u * index]);
+        let owner = atomicLoad(&acc_rw[words + 2u * index + 1u]);
+        if held < bound || owner < ((bound & 0xfff00000u) | inst) {
+            return false;
+        }
+#else
+        if atomicLoad(&acc_rw[words + index]) < bound {
+            return false;
+        }
+#endif
+    }
+    return true;
+}
+
+// What hidden_settled takes off a pixel's distance to a piece: more than f32 rounding
+// of the pixel coordinates makes of `splat_runs`' own distance.
+const SETTLE_SLACK: f32 = 1e-3;
+#endif
 
 // What a lane of the piece dispatch draws: one listed piece, or (a lane past the list's
 // room, for an overflow entry) every piece of a triangle's lines (`found`, each i | mode << 2)

@@ -767,24 +767,7 @@ fn gpu_tuning_draws_what_the_software_tuning_draws() {
             ..PassOptions::default()
         };
         let mut pass = DeferredPass::new(device, options).unwrap();
-        let frame = pass
-            .prepare(device, &store, &scene, &Style::default(), size)
-            .unwrap();
-        let mut encoder = device.create_command_encoder(&Default::default());
-        use wirepass::wgpu::TextureUsages as U;
-        let usage = U::STORAGE_BINDING | U::RENDER_ATTACHMENT;
-        let out = wirepass::gpu::texture_2d(device, "out", size, pass.output_format(), usage);
-        let view = out.create_view(&Default::default());
-        pass.encode(
-            device,
-            &mut encoder,
-            &store,
-            &frame,
-            OutputTarget::Shaded(&view),
-        )
-        .unwrap();
-        ctx.queue.submit([encoder.finish()]);
-        frame.edge_work(device, &ctx.queue).unwrap().traced_pieces
+        common::frame_work(&mut pass, &store, &scene, &Style::default(), size).traced_pieces
     });
     assert!(
         pieces[0] > 50 && 2 * pieces[1] > 3 * pieces[0],

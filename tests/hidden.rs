@@ -537,3 +537,49 @@ fn hidden_line_styles_per_instance() {
         assert!(worst <= 2, "{name}: worst channel difference {worst}");
     }
 }
+
+/// Hidden edges denser than the pixels (a sphere of sub-pixel triangles seen from above its
+/// pole, every edge drawn, its back half behind its front): most pieces find every pixel in
+/// their reach holding a nearer hidden line already and skip finding their runs
+/// (`EdgeWork::settled_pieces`), and the frame still matches the ground truth on every
+/// pixel, dashed and solid.
+#[test]
+fn dense_hidden_edges_settle_and_match_the_ground_truth() {
+    let mesh = Procedural::Sphere(120_000).build().unwrap();
+    let world = World::single(mesh, EdgeSelection::All);
+    let aspect = f64::from(SIZE.0) / f64::from(SIZE.1);
+    let camera = wirepass::Camera {
+        eye: glam::Vec3::new(0.3, 3.2, 0.2),
+        target: glam::Vec3::ZERO,
+        up: glam::Vec3::Z,
+        fov_y_deg: 40.0,
+        near: 0.05,
+        far: 100.0,
+    };
+    let view = camera.to_view(aspect);
+    let dashed = style(
+        LinePattern::Dashed {
+            dash: 4.0,
+            gap: 2.0,
+        },
+        1.5,
+    );
+    let pixels = check("dense sphere", &world, view, &dashed);
+    assert!(pixels > 20_000, "{pixels} hidden-line pixels");
+    let mut solid = dashed.clone();
+    if let Some(h) = solid.hidden.as_mut() {
+        h.pattern = LinePattern::Solid;
+    }
+    check("dense sphere, solid", &world, view, &solid);
+
+    let ctx = common::gpu();
+    let up = wirepass::tools::offline::Uploaded::new(&ctx.device, &ctx.queue, &world).unwrap();
+    let scene = up.scene(&world, view);
+    let mut pass = wirepass::gpu::DeferredPass::new(&ctx.device, Default::default()).unwrap();
+    let work = common::frame_work(&mut pass, &up.store, &scene, &dashed, SIZE);
+    println!("{work:?}");
+    assert!(
+        10 * work.settled_pieces > work.traced_pieces,
+        "few pieces settled: {work:?}"
+    );
+}

@@ -13,9 +13,9 @@
 
 mod common;
 
-use common::{gpu, load, spot_beside_suzanne, SIDE_BY_SIDE, THROUGH};
+use common::{frame_work, gpu, load, spot_beside_suzanne, SIDE_BY_SIDE, THROUGH};
 use glam::DVec3;
-use wirepass::gpu::{DeferredPass, EdgeWork, OutputTarget, PassOptions, Tuning};
+use wirepass::gpu::{DeferredPass, EdgeWork, PassOptions, Tuning};
 use wirepass::tools::offline::Uploaded;
 use wirepass::world::World;
 use wirepass::{Camera, EdgeSelection, HiddenLines, SectionPlane, Style};
@@ -153,22 +153,6 @@ fn measure(case: &Case) -> [u64; 9] {
         ..PassOptions::default()
     };
     let mut pass = DeferredPass::new(device, options).unwrap();
-    let frame = pass
-        .prepare(device, &up.store, &scene, &case.style, case.size)
-        .unwrap();
-    let usage = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::RENDER_ATTACHMENT;
-    let output = wirepass::gpu::texture_2d(device, "out", case.size, pass.output_format(), usage);
-    let view = output.create_view(&Default::default());
-    let mut encoder = device.create_command_encoder(&Default::default());
-    pass.encode(
-        device,
-        &mut encoder,
-        &up.store,
-        &frame,
-        OutputTarget::Shaded(&view),
-    )
-    .unwrap();
-    queue.submit([encoder.finish()]);
     let EdgeWork {
         tiles,
         traced_tiles,
@@ -179,7 +163,7 @@ fn measure(case: &Case) -> [u64; 9] {
         overflowed,
         chained_outlines,
         ..
-    } = frame.edge_work(device, queue).unwrap();
+    } = frame_work(&mut pass, &up.store, &scene, &case.style, case.size);
     ctx.finish().unwrap();
     [
         tiles,

@@ -43,6 +43,10 @@ pub struct EdgeWork {
     /// Outline edges the frame's outline chains were found for (those beyond their
     /// capacity included), 0 where no outline's hidden parts are patterned.
     pub chained_outlines: u32,
+    /// Pieces drawn for their hidden line alone that the trace pass found settled, every
+    /// pixel in their reach holding a nearer hidden line already, and found no runs for.
+    /// Which pieces these are depends on the order the GPU draws them in.
+    pub settled_pieces: u32,
 }
 
 impl PreparedFrame {
@@ -52,7 +56,7 @@ impl PreparedFrame {
     /// reads it without blocking.
     #[cfg(not(target_arch = "wasm32"))]
     pub fn edge_work(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<EdgeWork> {
-        let mut counts = [0u32; 8];
+        let mut counts = [0u32; 9];
         for (count, (buffer, at)) in counts.iter_mut().zip(self.counters()) {
             if let Some(buffer) = buffer {
                 let bytes = super::readback::read_buffer(device, queue, buffer, at, 4)?;
@@ -68,7 +72,7 @@ impl PreparedFrame {
         device: &wgpu::Device,
         queue: &wgpu::Queue,
     ) -> Result<EdgeWork> {
-        let mut counts = [0u32; 8];
+        let mut counts = [0u32; 9];
         for (count, (buffer, at)) in counts.iter_mut().zip(self.counters()) {
             if let Some(buffer) = buffer {
                 let read = super::readback::read_buffer_async(device, queue, buffer, at, 4);
@@ -81,9 +85,10 @@ impl PreparedFrame {
 
     /// Where the counts lie (a list's is the last word of its header): the tile list, the
     /// traced tiles, the refine list, the cluster list, the lines and the pieces listed,
-    /// the overflow list (the last five only where the trace pass ran), and the outline
-    /// chains (where a frame has them).
-    fn counters(&self) -> [(Option<&wgpu::Buffer>, u64); 8] {
+    /// the overflow list (the last five only where the trace pass ran), the outline chains
+    /// (where a frame has them), and the settled pieces (the overflow list's second word,
+    /// less the 1 it starts at).
+    fn counters(&self) -> [(Option<&wgpu::Buffer>, u64); 9] {
         let t = &self.targets;
         let traced = |b| self.data.traced.then_some(b);
         let count = LIST_HEADER - 4;
@@ -98,13 +103,14 @@ impl PreparedFrame {
             (traced(&t.acc), t.acc_pieces + count),
             (traced(&t.acc), t.acc_overflow + count),
             (chained, t.acc_phases + 4 * u64::from(chains_at) + count),
+            (traced(&t.acc), t.acc_overflow + 4),
         ]
     }
 
     /// The work from the counts at [`counters`](Self::counters).
     fn edge_work_of(
         &self,
-        [tiles, traced_tiles, refined, clusters, lines, pieces, overflowed, chained]: [u32; 8],
+        [tiles, traced_tiles, refined, clusters, lines, pieces, overflowed, chained, settled]: [u32; 9],
     ) -> EdgeWork {
         let (w, h) = self.targets.output;
         let tile = super::edge_pass::TILE;
@@ -120,6 +126,8 @@ impl PreparedFrame {
             piece_room: self.targets.piece_room(),
             overflowed,
             chained_outlines: chained,
+            // A list header's second word starts at 1 (an indirect dispatch's y).
+            settled_pieces: settled.saturating_sub(1),
         }
     }
 

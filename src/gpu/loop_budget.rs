@@ -18,8 +18,10 @@
 //! at the pixel ids of a window round its point and walking from each ([`WALK_STEPS`] from
 //! the 3×3 pixels round it, [`FOLD_STEPS`] from those further out and from the line's
 //! triangles' other neighbours); then the pixels in reach of the piece, each against up to
-//! [`MAX_RUNS`] runs, for its visible and its hidden line. The wider the window, the shorter
-//! the pieces. A GPU has no such cap, and its pieces are 1 px whatever the window.
+//! [`MAX_RUNS`] runs, for its visible and its hidden line; and first, for a short piece
+//! drawn for its hidden line alone, the pixels of its box ([`SETTLE_PX`]). The wider the
+//! window, the shorter the pieces. A GPU has no such cap, and its pieces are 1 px whatever
+//! the window.
 //!
 //! Three loops are not bounded here: the pieces of a cluster whose lines the piece list had
 //! no room for, which a lane of the piece dispatch draws for each of its triangles, one
@@ -52,6 +54,14 @@ pub(crate) const RUN_SAMPLES_PER_PX: u32 = 4;
 pub(crate) const RUN_BISECTIONS: u32 = 12;
 /// Visible (and hidden) runs a piece keeps; past them the last run absorbs the rest.
 pub(crate) const MAX_RUNS: u32 = 8;
+/// The longest piece (px) and the widest hidden line's reach (px) for which the trace pass
+/// first checks whether the piece's hidden line is settled, every pixel in its reach holding
+/// a nearer line already (`hidden_settled`), before finding its runs: a loop over the pixels
+/// of the piece's box grown by the reach, at most [`SETTLE_LOOPS`] iterations.
+pub(crate) const SETTLE_PX: u32 = 2;
+pub(crate) const SETTLE_REACH: u32 = 3;
+/// The pixels of that box: the piece and the reach either side, each end rounded out.
+const SETTLE_LOOPS: u32 = (SETTLE_PX + 2 * SETTLE_REACH + 3) * (SETTLE_PX + 2 * SETTLE_REACH + 3);
 /// The widest line (px) whose pieces [`piece_loops`] keeps under [`LOOP_CAP`].
 pub(crate) const COVERED_WIDTH: u32 = 16;
 /// What the pieces' other loops may take: the section planes' clip of an edge, the
@@ -94,7 +104,7 @@ pub(crate) const fn piece_loops(piece_px: u32, r: u32) -> u32 {
     let along = piece_px + 2 * reach + 3;
     let across = 2 * (reach * 3 / 2 + 1) + 3;
     let splat = along * (1 + across * (1 + MAX_RUNS));
-    samples * (sample_loops(r) + 1) + 2 * splat + OTHER_LOOPS
+    samples * (sample_loops(r) + 1) + 2 * splat + SETTLE_LOOPS + OTHER_LOOPS
 }
 
 const fn longest_piece(r: u32) -> u32 {
@@ -124,6 +134,8 @@ pub(crate) fn wgsl() -> String {
          const RUN_SAMPLES_PER_PX: f32 = {RUN_SAMPLES_PER_PX}.0;\n\
          const RUN_BISECTIONS: u32 = {RUN_BISECTIONS}u;\n\
          const MAX_RUNS: u32 = {MAX_RUNS}u;\n\
+         const SETTLE_PX: f32 = {SETTLE_PX}.0;\n\
+         const SETTLE_REACH: f32 = {SETTLE_REACH}.0;\n\
          const SOFTWARE_PIECE_PX: vec3<f32> = vec3<f32>({narrow}.0, {section}.0, {crossed}.0);\n\
          const WINDOW_RADII: vec3<i32> = vec3<i32>({r0}, {r1}, {r2});"
     )

@@ -6,13 +6,36 @@ pub mod gltf_file;
 use glam::{DVec2, Vec3};
 use std::path::PathBuf;
 use std::sync::OnceLock;
-use wirepass::gpu::{DeferredPass, GpuContext, PassOptions, TriangleIds};
+use wirepass::gpu::{DeferredPass, EdgeWork, GpuContext, MeshStore, PassOptions, TriangleIds};
 use wirepass::tools::offline::{draw, Method};
 use wirepass::truth::accuracy::{
     distance_error, hidden_distance_error, hidden_distance_errors, id_agreement, DistanceError,
 };
 use wirepass::world::{Rendering, Shot, World};
-use wirepass::{edge_math, Camera, EdgeSelection, Mesh, Style};
+use wirepass::{edge_math, Camera, EdgeSelection, Mesh, Scene, Style};
+
+/// What the pass took on (`PreparedFrame::edge_work`) for one frame of `scene`, drawn shaded
+/// into a storage texture of `size`.
+pub fn frame_work(
+    pass: &mut DeferredPass,
+    store: &MeshStore,
+    scene: &Scene<'_>,
+    style: &Style,
+    size: (u32, u32),
+) -> EdgeWork {
+    let ctx = gpu();
+    let (device, queue) = (&ctx.device, &ctx.queue);
+    let frame = pass.prepare(device, store, scene, style, size).unwrap();
+    let usage = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::RENDER_ATTACHMENT;
+    let output = wirepass::gpu::texture_2d(device, "out", size, pass.output_format(), usage);
+    let view = output.create_view(&Default::default());
+    let mut encoder = device.create_command_encoder(&Default::default());
+    let target = wirepass::gpu::OutputTarget::Shaded(&view);
+    pass.encode(device, &mut encoder, store, &frame, target)
+        .unwrap();
+    queue.submit([encoder.finish()]);
+    frame.edge_work(device, queue).unwrap()
+}
 
 /// One device for the whole test binary. A missing adapter fails loudly: GPU tests never
 /// pass by skipping.

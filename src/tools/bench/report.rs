@@ -82,12 +82,13 @@ pub fn markdown(runs: &[Run]) -> String {
         if let Some(w) = r.edge_work {
             other.push(format!(
                 "tiles {:.1} %, traced tiles {:.1} %, refined {:.2} % of pixels, {} outline \
-                 clusters, {} traced pieces",
+                 clusters, {} traced pieces ({} settled)",
                 100.0 * w.tiles,
                 100.0 * w.traced_tiles,
                 100.0 * w.refined,
                 w.traced_clusters,
-                w.traced_pieces
+                w.traced_pieces,
+                w.settled_pieces
             ));
         }
         out += &format!(

@@ -94,6 +94,9 @@ pub struct EdgeShares {
     /// Pieces of outline edges the trace pass's piece dispatch drew (or found beyond its
     /// list's room).
     pub traced_pieces: u32,
+    /// Of them, those drawn for their hidden line alone that were found settled, every
+    /// pixel in their reach holding a nearer hidden line already.
+    pub settled_pieces: u32,
 }
 
 /// A method being measured: its pass, prepared frame and output.
@@ -611,6 +614,7 @@ fn edge_shares(ctx: &GpuContext, subject: &Subject) -> Result<Option<EdgeShares>
         refined: f64::from(w.refined) / f64::from(w.pixels.max(1)),
         traced_clusters: w.traced_clusters,
         traced_pieces: w.traced_pieces,
+        settled_pieces: w.settled_pieces,
     }))
 }
 
